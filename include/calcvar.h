@@ -1,0 +1,272 @@
+/* include/calcvar.h — public C API of calcvar, direct solution of variational problems.
+ * SPDX-License-Identifier: MIT
+ *
+ * calcvar makes the functional  I[y] = \int_a^b F(x, y, y') dx,  y : [a, b] -> R^n,
+ * stationary by direct discretisation: y lives on a mesh of polynomial elements
+ * (Gauss-Lobatto-Legendre nodes), the discrete action is integrated by Gauss-Legendre
+ * quadrature, and Newton's method on the exact gradient and Hessian (sparse LDL^T,
+ * CHOLMOD) finds the stationary point. See docs/theory.md for the formulas.
+ *
+ * Handles are opaque (cv_problem, cv_solver). Every function that can fail returns a
+ * cv_status; 0 (CVAR_OK) means success and nothing else does. Constructors return NULL on
+ * failure and fill an optional `why`. The library never prints and never exits. Outputs
+ * go to caller-owned buffers whose lengths are documented per function.
+ *
+ * Thread safety: distinct handles may be used from distinct threads; one handle must not be
+ * used concurrently. Callbacks are never re-entered on the same handle.
+ *
+ * Minimal use (the catenary, see examples/catenary.c):
+ * \code
+ *   cv_status why;
+ *   cv_problem *p = cv_problem_new(1, -1.0, 1.0, &why);
+ *   cv_problem_set_integrand(p, catenary_F, NULL);
+ *   cv_problem_set_dirichlet(p, 0, 2 * cosh(0.5), 2 * cosh(0.5));
+ *   cv_solver *s = cv_solver_new(&why);
+ *   cv_solver_set_elements(s, 64);
+ *   cv_solver_set_degree(s, 2);
+ *   if (cv_solve(s, p) == CVAR_OK) {
+ *     int nn = cv_solver_get_num_nodes(s);
+ *     double *x = malloc(nn * sizeof *x), *y = malloc(nn * sizeof *y);
+ *     cv_solver_get_nodes(s, x);
+ *     cv_solver_get_values(s, y);
+ *     ...
+ *   }
+ *   cv_solver_free(s);
+ *   cv_problem_free(p);
+ * \endcode
+ */
+#ifndef CALCVAR_H
+#define CALCVAR_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** \name Version */
+/**@{*/
+#define CVAR_VERSION_MAJOR 0
+#define CVAR_VERSION_MINOR 1
+#define CVAR_VERSION_PATCH 0
+/** Pack a version for `#if` tests: CVAR_VERSION_PACK(0, 1, 0). */
+#define CVAR_VERSION_PACK(a, b, c) ((a) * 10000 + (b) * 100 + (c))
+#define CVAR_VERSION CVAR_VERSION_PACK(CVAR_VERSION_MAJOR, CVAR_VERSION_MINOR, CVAR_VERSION_PATCH)
+/** The library's version, to compare with the header's. Any pointer may be NULL. */
+void cv_version(int *major, int *minor, int *patch);
+/**@}*/
+
+/** \name Status codes
+ * One X-macro list generates the enum and the message table (cv_strerror). */
+/**@{*/
+#define CVAR_STATUS_LIST(X)                                                                    \
+  X(CVAR_OK, "success")                                                                       \
+  X(CVAR_EINVAL, "invalid argument")                                                          \
+  X(CVAR_ENOMEM, "out of memory")                                                             \
+  X(CVAR_ECALLBACK, "a user callback reported an error")                                      \
+  X(CVAR_ENONFINITE, "non-finite value in the integrand or an iterate")                       \
+  X(CVAR_ESINGULAR, "singular or degenerate Hessian")                                         \
+  X(CVAR_EMAXITER, "maximum number of iterations reached before convergence")                 \
+  X(CVAR_ESTALL, "no further progress possible (round-off or stagnation)")                    \
+  X(CVAR_EDIVERGED, "the iteration diverged")                                                 \
+  X(CVAR_ENOTMIN, "the stationary point is not a minimum")                                   \
+  X(CVAR_EDEPENDENCY, "failure inside a dependency (CHOLMOD, NLopt)")                         \
+  X(CVAR_ESTATE, "no solution available (call cv_solve first)")
+
+#define CVAR_ENUM_ITEM(name, msg) name,
+/** Result of every fallible call. CVAR_OK is 0; all other values are failures. */
+typedef enum { CVAR_STATUS_LIST(CVAR_ENUM_ITEM) CVAR_NUM_STATUS } cv_status;
+#undef CVAR_ENUM_ITEM
+
+/** A static sentence for a status; never NULL (unknown codes give "unknown status"). */
+const char *cv_strerror(cv_status s);
+/** The symbolic name of a status, e.g. "CVAR_EMAXITER"; never NULL. */
+const char *cv_status_name(cv_status s);
+/**@}*/
+
+/** \name Integrand callbacks */
+/**@{*/
+
+/** Bits of `need`: which outputs the solver asks for in one call. */
+enum {
+  CVAR_NEED_F = 1u,    /**< F itself */
+  CVAR_NEED_GRAD = 2u, /**< F_y and F_y' */
+  CVAR_NEED_HESS = 4u  /**< F_yy, F_yy', F_y'y' */
+};
+
+/** Output buffers of an integrand call at m points, structure of arrays.
+ * A member is NULL exactly when its group was not asked for in `need`.
+ * With n unknowns and point index k (0 <= k < m):
+ *  - F[k]
+ *  - Fy[i*m + k]  = dF/dy_i,   Fp[i*m + k] = dF/dy'_i             (i < n)
+ *  - Fyy[(i*n + j)*m + k] = d2F/dy_i dy_j     (symmetric)
+ *  - Fyp[(i*n + j)*m + k] = d2F/dy_i dy'_j    (not symmetric in general)
+ *  - Fpp[(i*n + j)*m + k] = d2F/dy'_i dy'_j   (symmetric)
+ * The solver fills every entry it hands over with NaN before the call, so entries the
+ * callback forgets are caught as non-finite. */
+typedef struct {
+  double *F;
+  double *Fy, *Fp;
+  double *Fyy, *Fyp, *Fpp;
+} cv_partials;
+
+/** Integrand F(x, y, y') and its partials at m points.
+ * \param m     number of points (1 <= m <= 256)
+ * \param x     x[k], length m
+ * \param y     y[i*m + k], length n*m
+ * \param dy    y'[i*m + k], length n*m
+ * \param need  OR of CVAR_NEED_* bits
+ * \param out   buffers to fill, see cv_partials
+ * \param user  the pointer given to cv_problem_set_integrand, untouched
+ * \return 0 on success; > 0 "cannot evaluate here" (e.g. outside the domain: the line
+ *         search shortens the step); < 0 abort (the solve returns CVAR_ECALLBACK). */
+typedef int (*cv_integrand_fn)(int m, const double *x, const double *y, const double *dy,
+                               unsigned need, cv_partials *out, void *user);
+
+/** Initial guess: fill y[i*m + k] for the m abscissae x[k]. Return 0 on success. */
+typedef int (*cv_guess_fn)(int m, const double *x, double *y, void *user);
+/**@}*/
+
+/** \name Problem: what is to be made stationary */
+/**@{*/
+typedef struct cv_problem cv_problem;
+
+/** A new problem with n >= 1 unknown functions on [a, b], a < b, both finite.
+ * Returns NULL on failure and sets *why (may be NULL) to CVAR_EINVAL or CVAR_ENOMEM.
+ * End values start as fixed at 0; no integrand is set. */
+cv_problem *cv_problem_new(int n, double a, double b, cv_status *why);
+/** Release a problem; NULL is a no-op. */
+void cv_problem_free(cv_problem *p);
+/** The integrand (required before solving). `user` is passed through untouched. */
+cv_status cv_problem_set_integrand(cv_problem *p, cv_integrand_fn F, void *user);
+/** Fix unknown k (0 <= k < n) to ya at a and yb at b. Values must be finite. */
+cv_status cv_problem_set_dirichlet(cv_problem *p, int k, double ya, double yb);
+/** Fix unknown k at one end: end 0 is a, end 1 is b. */
+cv_status cv_problem_set_end_value(cv_problem *p, int k, int end, double value);
+/** Leave unknown k free at one end (0 = a, 1 = b): the natural boundary condition
+ * dF/dy'_k = 0 holds there at the solution. */
+cv_status cv_problem_set_free_end(cv_problem *p, int k, int end);
+/** Initial guess (default: the straight line between the end values; with a free end,
+ * the constant fixed value; with both ends free, 0). NULL restores the default. */
+cv_status cv_problem_set_guess(cv_problem *p, cv_guess_fn g, void *user);
+int cv_problem_get_num_unknowns(const cv_problem *p);
+/** The interval; a or b may be NULL. */
+void cv_problem_get_interval(const cv_problem *p, double *a, double *b);
+
+/** The integrand as a formula string, with exact symbolic derivatives (no callback to
+ * write). `variable` names the independent variable (NULL for "x"); `unknowns` is a comma
+ * separated list of n names (n must equal the problem's); `F` uses the scene grammar of
+ * docs/scenes.md (y' is dy/dx). `parameters` is NULL or a comma separated list of
+ * `name = constant expression`. On failure returns CVAR_EINVAL and writes a sentence to
+ * err (errlen bytes, may be NULL/0). The problem owns the compiled integrand. */
+cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
+                                        const char *unknowns, const char *F,
+                                        const char *parameters, char *err, size_t errlen);
+
+/** Outcome of cv_problem_check_derivatives. */
+typedef struct {
+  double worst;      /**< worst relative difference |analytic - FD| / max(1, |analytic|) */
+  int point;         /**< point index of the worst entry */
+  char which[32];    /**< e.g. "Fyp[1][0]" */
+  double analytic;   /**< the callback's value there */
+  double fd;         /**< the central finite-difference value */
+} cv_derivcheck;
+
+/** Compare the callback's first and second partials against central finite differences
+ * of F (for the first partials) and of the first partials (for the second), at m points
+ * (x[k], y[i*m+k], dy[i*m+k]); 1 <= m <= 256. Fills *report with the worst entry.
+ * Returns CVAR_ECALLBACK/CVAR_ENONFINITE if the callback fails at a point. */
+cv_status cv_problem_check_derivatives(const cv_problem *p, int m, const double *x,
+                                       const double *y, const double *dy,
+                                       cv_derivcheck *report);
+/**@}*/
+
+/** \name Solver: discretisation, options, results */
+/**@{*/
+typedef struct cv_solver cv_solver;
+
+/** Mesh grading end for cv_solver_set_mesh_graded. */
+enum { CVAR_GRADE_A = 0, CVAR_GRADE_B = 1, CVAR_GRADE_BOTH = 2 };
+
+/** A new solver with defaults: 100 uniform elements of degree 1, p+1 Gauss points,
+ * rtol = atol = 1e-10, 50 iterations. NULL on failure (*why set when why != NULL). */
+cv_solver *cv_solver_new(cv_status *why);
+/** Release a solver and its results; NULL is a no-op. */
+void cv_solver_free(cv_solver *s);
+
+/** Number of elements of a uniform mesh (>= 1). Replaces a user or graded mesh. */
+cv_status cv_solver_set_elements(cv_solver *s, int elements);
+/** Polynomial degree 1..8 of every element. */
+cv_status cv_solver_set_degree(cv_solver *s, int degree);
+/** Gauss-Legendre points per element, 0 for the default p+1, else 1..32. */
+cv_status cv_solver_set_quadrature_points(cv_solver *s, int q);
+/** Graded mesh: element boundaries a + (b-a) t_i^k with t_i = i/E towards end a
+ * (CVAR_GRADE_A), mirrored towards b, or symmetric towards both; grading k >= 1. */
+cv_status cv_solver_set_mesh_graded(cv_solver *s, int elements, double grading, int end);
+/** A user mesh on the reference interval [0, 1]: t[0] = 0 < t[1] < ... < t[E] = 1, mapped
+ * affinely onto the problem's [a, b]. The array is copied; E >= 1. */
+cv_status cv_solver_set_mesh(cv_solver *s, int elements, const double *t);
+/** Points in (a, b) at which the mesh must have nodes (where the integrand may jump), in
+ * the problem's variable. The nearest element boundary is moved onto each breakpoint (the
+ * mesh is split there when moving would tangle it). nb = 0 clears. */
+cv_status cv_solver_set_breakpoints(cv_solver *s, int nb, const double *xb);
+/** Tolerances on the Newton step, weighted as 1/(rtol |y_i| + atol * scale), where scale
+ * is the largest end value magnitude (or 1). Both >= 0, not both 0; rtol >= 10 eps. */
+cv_status cv_solver_set_tolerances(cv_solver *s, double rtol, double atol);
+/** Maximum Newton iterations (>= 1). */
+cv_status cv_solver_set_max_iterations(cv_solver *s, int maxit);
+
+/** Make the discrete action of p stationary, starting from p's guess (or, after
+ * cv_solver_set_start, from given nodal values). Results stay in s until the next solve.
+ * Returns CVAR_OK only when converged; otherwise a failure status, with a sentence in
+ * cv_solver_last_error(). On failure the results still describe the last iterate (for
+ * diagnosis) but cv_solver_get_status() tells it did not converge. */
+cv_status cv_solve(cv_solver *s, const cv_problem *p);
+
+/** Start the next solve from nodal values y (node-major, length nodes*n as laid out by
+ * the current mesh and degree); NULL returns to the problem's guess. Copied. */
+cv_status cv_solver_set_start(cv_solver *s, int len, const double *y);
+
+/** Status of the last solve (CVAR_ESTATE before any). */
+cv_status cv_solver_get_status(const cv_solver *s);
+/** One sentence about the last failure or outcome; never NULL. */
+const char *cv_solver_last_error(const cv_solver *s);
+/** Nodes of the mesh of the last solve, including both ends (0 before any solve). */
+int cv_solver_get_num_nodes(const cv_solver *s);
+int cv_solver_get_num_elements(const cv_solver *s);
+int cv_solver_get_degree(const cv_solver *s);
+/** x[j] of node j, length cv_solver_get_num_nodes(). */
+cv_status cv_solver_get_nodes(const cv_solver *s, double *x);
+/** Nodal values, node-major: y[j*n + i] is unknown i at node j; length nodes*n. */
+cv_status cv_solver_get_values(const cv_solver *s, double *y);
+/** Discrete action S_h at the last iterate. */
+double cv_solver_get_action(const cv_solver *s);
+/** Max-norm of the discrete Euler-Lagrange residual scaled by the lumped nodal weights
+ * (theory (N-3)); mesh independent. */
+double cv_solver_get_gradient_norm(const cv_solver *s);
+int cv_solver_get_num_iterations(const cv_solver *s);
+/** Wall-clock seconds of the last cv_solve. */
+double cv_solver_get_time(const cv_solver *s);
+/** Number of negative pivots of the LDL^T factor of the Hessian at the last iterate (the
+ * Morse index), or -1 when unknown. */
+int cv_solver_get_morse_index(const cv_solver *s);
+/** Nonzero when the Hessian at the last iterate has a (numerically) zero pivot. */
+int cv_solver_get_degenerate(const cv_solver *s);
+/** Number of free scalar unknowns of the discrete problem (size of the Hessian). */
+int cv_solver_get_num_free(const cv_solver *s);
+
+/** Quadrature points of the last solve's mesh: count, then the points with weights and
+ * the solution there. Each output may be NULL. x, w: length nq; y, dy: n*nq, laid out
+ * y[i*nq + k] (structure of arrays). Sum_k w[k] g(x[k]) is the solver's integral of g. */
+int cv_solver_get_num_qpoints(const cv_solver *s);
+cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double *y,
+                                double *dy);
+/** Evaluate the last solution (degree-p interpolant) at m abscissae in [a, b]:
+ * y[i*m + k] and, if dy != NULL, y'[i*m + k]. */
+cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y, double *dy);
+/**@}*/
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* CALCVAR_H */

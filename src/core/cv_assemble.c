@@ -1,0 +1,177 @@
+/* src/core/cv_assemble.c — discrete action, its gradient and Hessian, theory (A-1)-(A-3).
+ * SPDX-License-Identifier: MIT */
+#include <math.h>
+#include <string.h>
+
+#include "cv_internal.h"
+
+cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc *d) {
+  size_t n = (size_t)p->n, m = CV_BATCH;
+  memset(as, 0, sizeof *as);
+  as->prob = p;
+  as->disc = d;
+  size_t nl = (size_t)(d->p + 1) * n;
+  as->buf = cv_malloc((3 + 4 * n + 3 * n * n) * m * sizeof *as->buf);
+  as->K = cv_malloc(nl * nl * sizeof *as->K);
+  as->fl = cv_malloc(nl * sizeof *as->fl);
+  if (!as->buf || !as->K || !as->fl) {
+    cv_assembler_free(as);
+    return CVAR_ENOMEM;
+  }
+  double *w = as->buf;
+  as->x = w, w += m;
+  as->y = w, w += n * m;
+  as->dy = w, w += n * m;
+  as->out.F = w, w += m;
+  as->out.Fy = w, w += n * m;
+  as->out.Fp = w, w += n * m;
+  as->out.Fyy = w, w += n * n * m;
+  as->out.Fyp = w, w += n * n * m;
+  as->out.Fpp = w;
+  return CVAR_OK;
+}
+
+void cv_assembler_free(cv_assembler *as) {
+  if (!as) return;
+  cv_free(as->buf);
+  cv_free(as->K);
+  cv_free(as->fl);
+  as->buf = as->K = NULL;
+  as->fl = NULL;
+}
+
+static int all_finite(const double *v, size_t len) {
+  for (size_t i = 0; i < len; i++)
+    if (!isfinite(v[i])) return 0;
+  return 1;
+}
+
+/* Fill the batch of quadrature points of elements e0 .. e0+ne-1: x, and y, y' from the
+ * nodal values through the basis tables, theory (E-3). */
+static void fill_points(cv_assembler *as, const double *Y, int e0, int ne) {
+  const cv_disc *d = as->disc;
+  const cv_refelem *r = &d->ref;
+  int n = d->n, p = d->p, q = r->q, P1 = p + 1, m = ne * q;
+  for (int el = 0; el < ne; el++) {
+    int e = e0 + el;
+    double x0 = d->xe[e], h = d->xe[e + 1] - x0, rh = 2.0 / h;
+    const double *Ye = Y + (size_t)e * p * n;
+    for (int k = 0; k < q; k++) {
+      int idx = el * q + k;
+      const double *Bk = r->B + k * P1, *Dk = r->D + k * P1;
+      as->x[idx] = x0 + 0.5 * (r->tau[k] + 1.0) * h;
+      for (int i = 0; i < n; i++) {
+        double yv = 0.0, dv = 0.0;
+        for (int l = 0; l < P1; l++) {
+          double c = Ye[l * n + i];
+          yv += c * Bk[l];
+          dv += c * Dk[l];
+        }
+        as->y[i * m + idx] = yv;
+        as->dy[i * m + idx] = dv * rh;
+      }
+    }
+  }
+}
+
+/* Call the integrand for m points; NaN-fill first so forgotten outputs are caught. */
+static cv_status call_integrand(cv_assembler *as, int m, unsigned need) {
+  const cv_problem *p = as->prob;
+  size_t n = (size_t)p->n;
+  cv_partials o = {as->out.F, NULL, NULL, NULL, NULL, NULL};
+  size_t len1 = n * m, len2 = n * n * m;
+  if (need & CVAR_NEED_GRAD) o.Fy = as->out.Fy, o.Fp = as->out.Fp;
+  if (need & CVAR_NEED_HESS) o.Fyy = as->out.Fyy, o.Fyp = as->out.Fyp, o.Fpp = as->out.Fpp;
+  for (int k = 0; k < m; k++) o.F[k] = NAN;
+  if (o.Fy)
+    for (size_t k = 0; k < len1; k++) o.Fy[k] = o.Fp[k] = NAN;
+  if (o.Fyy)
+    for (size_t k = 0; k < len2; k++) o.Fyy[k] = o.Fyp[k] = o.Fpp[k] = NAN;
+  as->nevals += m;
+  int rc = p->F(m, as->x, as->y, as->dy, need, &o, p->user);
+  as->cb_status = rc;
+  if (rc < 0) return CVAR_ECALLBACK;
+  if (rc > 0) return CVAR_ENONFINITE;
+  if (!all_finite(o.F, (size_t)m)) return CVAR_ENONFINITE;
+  if (o.Fy && (!all_finite(o.Fy, len1) || !all_finite(o.Fp, len1))) return CVAR_ENONFINITE;
+  if (o.Fyy && (!all_finite(o.Fyy, len2) || !all_finite(o.Fyp, len2) ||
+                !all_finite(o.Fpp, len2)))
+    return CVAR_ENONFINITE;
+  return CVAR_OK;
+}
+
+/* S_h = sum_e sum_k (h_e/2) w_k F(x_ek, y_ek, y'_ek)                          (A-1)
+ * dS_h/dY_{l,i} = sum (h/2) w_k (F_yi phi_l + F_y'i phi_l' (2/h))             (A-2)
+ * d2S_h/dY_{l,i}dY_{r,j} = sum (h/2) w_k (F_yiyj phi_l phi_r
+ *     + F_yiy'j phi_l phi_r' (2/h) + F_yjy'i phi_l' phi_r (2/h) + F_y'iy'j phi_l' phi_r' (2/h)^2)
+ *                                                                              (A-3)  */
+cv_status cv_assemble(cv_assembler *as, const double *Y, double *S, double *g,
+                      const long *colptr, double *Ax) {
+  const cv_disc *d = as->disc;
+  const cv_refelem *r = &d->ref;
+  int n = d->n, p = d->p, q = r->q, P1 = p + 1, nl = P1 * n;
+  int nb = CV_BATCH / q;
+  unsigned need = CVAR_NEED_F | (g ? CVAR_NEED_GRAD : 0u) | (Ax ? CVAR_NEED_HESS : 0u);
+  double Ssum = 0.0, *K = as->K;
+  int *flp = as->fl;
+  cv_status st;
+  if (g) memset(g, 0, (size_t)d->nfree * sizeof *g);
+  if (Ax) memset(Ax, 0, (size_t)colptr[d->nfree] * sizeof *Ax);
+  for (int e0 = 0; e0 < d->E; e0 += nb) {
+    int ne = d->E - e0 < nb ? d->E - e0 : nb, m = ne * q;
+    fill_points(as, Y, e0, ne);
+    st = call_integrand(as, m, need);
+    if (st) return st;
+    const double *F = as->out.F, *Fy = as->out.Fy, *Fp = as->out.Fp;
+    const double *Fyy = as->out.Fyy, *Fyp = as->out.Fyp, *Fpp = as->out.Fpp;
+    for (int el = 0; el < ne; el++) {
+      int e = e0 + el;
+      double h = d->xe[e + 1] - d->xe[e], J = 0.5 * h, rh = 2.0 / h;
+      for (int a = 0; a < nl; a++) flp[a] = cv_disc_fidx(d, (long)e * p * n + a);
+      if (Ax) memset(K, 0, (size_t)nl * nl * sizeof *K);
+      for (int k = 0; k < q; k++) {
+        int idx = el * q + k;
+        double wk = J * r->omega[k];
+        const double *Bk = r->B + k * P1, *Dk = r->D + k * P1;
+        Ssum += wk * F[idx];
+        if (g) {
+          for (int l = 0; l < P1; l++)
+            for (int i = 0; i < n; i++) {
+              int fi = flp[l * n + i];
+              if (fi >= 0)
+                g[fi] += wk * (Fy[i * m + idx] * Bk[l] + Fp[i * m + idx] * Dk[l] * rh);
+            }
+        }
+        if (Ax) {
+          for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+              double yy = wk * Fyy[(i * n + j) * m + idx];
+              double yp = wk * rh * Fyp[(i * n + j) * m + idx];  /* F_{y_i y'_j} */
+              double py = wk * rh * Fyp[(j * n + i) * m + idx];  /* F_{y'_i y_j} */
+              double pp = wk * rh * rh * Fpp[(i * n + j) * m + idx];
+              for (int l = 0; l < P1; l++) {
+                double bl = Bk[l], dl = Dk[l];
+                double cy = yy * bl + py * dl, cp = yp * bl + pp * dl;
+                double *Krow = K + (l * n + i) * nl + j;
+                for (int rr = 0; rr < P1; rr++) Krow[rr * n] += cy * Bk[rr] + cp * Dk[rr];
+              }
+            }
+        }
+      }
+      if (Ax) {
+        /* Scatter the upper triangle; column c holds rows c+1-len(c) .. c (E-2). */
+        for (int bcol = 0; bcol < nl; bcol++) {
+          int fb = flp[bcol];
+          if (fb < 0) continue;
+          long c0 = colptr[fb], rs = fb + 1 - (colptr[fb + 1] - c0);
+          for (int arow = 0; arow <= bcol; arow++) {
+            int fa = flp[arow];
+            if (fa >= 0) Ax[c0 + fa - rs] += K[arow * nl + bcol];
+          }
+        }
+      }
+    }
+  }
+  *S = Ssum;
+  return isfinite(Ssum) ? CVAR_OK : CVAR_ENONFINITE;
+}

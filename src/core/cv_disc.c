@@ -1,0 +1,73 @@
+/* src/core/cv_disc.c — the discretisation of one solve: mesh, reference element, dof map.
+ * SPDX-License-Identifier: MIT */
+#include <string.h>
+
+#include "cv_internal.h"
+
+void cv_disc_free(cv_disc *d) {
+  if (!d) return;
+  cv_free(d->xe);
+  cv_free(d->fix0);
+  cv_free(d->fix1);
+  cv_free(d->mass);
+  memset(d, 0, sizeof *d);
+}
+
+double cv_disc_node_x(const cv_disc *d, long j) {
+  if (j >= d->nodes - 1) return d->xe[d->E];
+  long e = j / d->p;
+  int l = (int)(j - e * d->p);
+  double h = d->xe[e + 1] - d->xe[e];
+  return l == 0 ? d->xe[e] : d->xe[e] + 0.5 * (d->ref.xi[l] + 1.0) * h;
+}
+
+/* Unknowns are node-major (theory E-2); fixed end values are removed, so free indices are
+ * the global ones shifted by the fixed components of node 0, except at the two end nodes. */
+cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
+                       size_t len) {
+  cv_status st;
+  int n = p->n;
+  memset(d, 0, sizeof *d);
+  st = cv_mesh_build(&s->mesh, p->a, p->b, &d->E, &d->xe, msg, len);
+  if (st) return st;
+  d->n = n;
+  d->p = s->degree;
+  d->a = p->a;
+  d->b = p->b;
+  d->nodes = d->E * d->p + 1;
+  if ((double)d->nodes * n > 2.0e9) {
+    cv_set_msg(msg, len, "%d elements of degree %d with %d unknowns exceed 2e9 unknowns",
+               d->E, d->p, n);
+    cv_disc_free(d);
+    return CVAR_EINVAL;
+  }
+  d->ndof = d->nodes * n;
+  cv_refelem_init(&d->ref, d->p, s->nq ? s->nq : d->p + 1);
+  d->fix0 = cv_malloc((size_t)n * sizeof *d->fix0);
+  d->fix1 = cv_malloc((size_t)n * sizeof *d->fix1);
+  if (!d->fix0 || !d->fix1) {
+    cv_disc_free(d);
+    return CVAR_ENOMEM;
+  }
+  int f = 0;
+  for (int i = 0; i < n; i++) d->fix0[i] = p->fixed[2 * i] ? -1 : f++;
+  d->nfree0 = f;
+  f += (d->nodes - 2) * n;
+  for (int i = 0; i < n; i++) d->fix1[i] = p->fixed[2 * i + 1] ? -1 : f++;
+  d->nfree = f;
+  d->mass = cv_calloc((size_t)(f ? f : 1), sizeof *d->mass);
+  if (!d->mass) {
+    cv_disc_free(d);
+    return CVAR_ENOMEM;
+  }
+  /* Lumped weight of a node: the integral of its basis function, (h/2) w_l^GLL (N-3). */
+  for (int e = 0; e < d->E; e++) {
+    double h = d->xe[e + 1] - d->xe[e];
+    for (int l = 0; l <= d->p; l++)
+      for (int i = 0; i < n; i++) {
+        int fi = cv_disc_fidx(d, (long)(e * d->p + l) * n + i);
+        if (fi >= 0) d->mass[fi] += 0.5 * h * d->ref.wl[l];
+      }
+  }
+  return CVAR_OK;
+}

@@ -1,0 +1,153 @@
+/* src/core/cv_internal.h — private structures shared by the core files.
+ * SPDX-License-Identifier: MIT */
+#ifndef CV_INTERNAL_H
+#define CV_INTERNAL_H
+
+#include <stddef.h>
+#include "calcvar.h"
+#include "cv_internal_owned.h"
+
+/* Largest batch handed to an integrand callback (documented in calcvar.h). */
+#define CV_BATCH 256
+#define CV_MAX_DEGREE 8
+#define CV_MAX_QUAD 32
+#define CV_PI 3.14159265358979323846
+
+/* ---- memory: the one allocator (tests may inject failures) ---- */
+void *cv_malloc(size_t n);
+void *cv_calloc(size_t count, size_t size);
+void cv_free(void *ptr);
+/* Fail the k-th allocation from now on (k >= 0); -1 disables. For tests only. */
+void cv_debug_fail_alloc_after(long k);
+
+struct cv_problem {
+  int n;
+  double a, b;
+  cv_integrand_fn F;
+  void *user;
+  void (*release)(void *);
+  int *fixed;      /* fixed[2*k + end]: 1 fixed, 0 free (natural condition) */
+  double *endval;  /* endval[2*k + end] */
+  cv_guess_fn guess;
+  void *guess_user;
+};
+
+/* ---- reference element: GLL nodes, Gauss-Legendre rule, basis tables (cv_quadrature.c) */
+typedef struct {
+  int p, q;
+  double xi[CV_MAX_DEGREE + 1];   /* GLL nodes on [-1, 1] */
+  double wl[CV_MAX_DEGREE + 1];   /* GLL weights (= integral of each basis function) */
+  double tau[CV_MAX_QUAD];        /* Gauss points */
+  double omega[CV_MAX_QUAD];      /* Gauss weights */
+  double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];  /* B[k*(p+1)+l] = phi_l(tau_k) */
+  double D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];  /* D[k*(p+1)+l] = phi_l'(tau_k) on [-1,1] */
+} cv_refelem;
+
+void cv_gauss_legendre(int q, double *t, double *w);
+void cv_gauss_lobatto(int p, double *xi, double *w);
+/* Lagrange basis on nodes xi[0..p] at s: phi[l] and (if dphi) phi_l'(s). */
+void cv_lagrange(int p, const double *xi, double s, double *phi, double *dphi);
+void cv_refelem_init(cv_refelem *r, int p, int q);
+
+/* ---- mesh (cv_mesh.c) ---- */
+enum { CV_MESH_UNIFORM, CV_MESH_GRADED, CV_MESH_USER };
+typedef struct {
+  int kind, elements, grade_end;
+  double grading;
+  double *t;   /* user mesh on [0,1], elements+1 */
+  int nbreak;
+  double *breaks;
+} cv_meshspec;
+/* Element boundaries on [a, b] from a spec; *xe is allocated (E+1 entries). */
+cv_status cv_mesh_build(const cv_meshspec *m, double a, double b, int *E, double **xe,
+                        char *msg, size_t len);
+
+/* ---- discretisation of one solve (cv_disc.c) ---- */
+typedef struct {
+  int n, p, E, nodes, ndof, nfree;
+  double a, b;
+  double *xe;          /* element boundaries, E+1 */
+  cv_refelem ref;
+  int *fix0, *fix1;    /* free index of each component at node 0 / last, or -1 */
+  int nfree0;          /* free components at node 0 */
+  double *mass;        /* lumped nodal weight of each free dof (theory N-3) */
+} cv_disc;
+
+/* free index of global dof g = node*n + i, or -1 when fixed */
+static inline int cv_disc_fidx(const cv_disc *d, long g) {
+  long node = g / d->n;
+  int i = (int)(g - node * d->n);
+  if (node == 0) return d->fix0[i];
+  if (node == d->nodes - 1) return d->fix1[i];
+  return (int)(g - d->n + d->nfree0);
+}
+double cv_disc_node_x(const cv_disc *d, long j);
+
+/* ---- sparse symmetric LDL^T (cv_cholmod.c: the only file that includes CHOLMOD) ---- */
+typedef struct cv_ldlt cv_ldlt;
+/* Upper triangle in compressed columns: column c holds rows rstart(c)..c, contiguous. */
+cv_ldlt *cv_ldlt_new(int nfree, const long *colptr);
+void cv_ldlt_free(cv_ldlt *L);
+double *cv_ldlt_values(cv_ldlt *L);      /* Ax, length colptr[nfree] */
+/* Factor numerically (analysis happens on the first call). Returns CVAR_OK, or
+ * CVAR_ESINGULAR with *minor set when a pivot is exactly zero/NaN. *neg = number of
+ * negative pivots, *dmin the smallest |D(j)| / |A(j,j)|, *dmax the largest |D(j)|. */
+cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg,
+                         size_t len);
+/* Solve in place: x <- A^{-1} x. */
+cv_status cv_ldlt_solve(cv_ldlt *L, double *x);
+
+/* ---- assembly (cv_assemble.c) ---- */
+typedef struct {
+  const cv_problem *prob;
+  const cv_disc *disc;
+  double *buf;          /* batch buffers */
+  double *K;            /* element matrix, ((p+1) n)^2 */
+  int *fl;              /* free index of each local dof, (p+1) n */
+  double *x, *y, *dy;
+  cv_partials out;
+  int cb_status;        /* last callback return value (>0 cannot evaluate, <0 abort) */
+  long nevals;
+} cv_assembler;
+
+cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc *d);
+void cv_assembler_free(cv_assembler *as);
+/* S_h, gradient over free dofs (g may be NULL), and Hessian values into Ax (may be NULL)
+ * with the column layout colptr, at nodal values y (length nodes*n). Returns CVAR_OK,
+ * CVAR_ENONFINITE (non-finite output or >0 from the callback) or CVAR_ECALLBACK. */
+cv_status cv_assemble(cv_assembler *as, const double *y, double *S, double *g,
+                      const long *colptr, double *Ax);
+
+/* ---- Newton (cv_newton.c) ---- */
+typedef struct {
+  int iterations, morse, degenerate;
+  double action, gnorm;
+  char msg[320];
+} cv_newton_result;
+
+struct cv_solver {
+  cv_meshspec mesh;
+  int degree, nq, maxit;
+  double rtol, atol;
+  double *start;
+  int start_len;
+
+  /* results of the last solve */
+  cv_status status;
+  char msg[320];
+  int n, have;
+  cv_disc disc;
+  double *y;   /* nodes*n */
+  double action, gnorm, time;
+  int iterations, morse, degenerate;
+};
+
+cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *y);
+
+void cv_disc_free(cv_disc *d);
+cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
+                       size_t len);
+void cv_set_msg(char *msg, size_t len, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+#endif /* CV_INTERNAL_H */

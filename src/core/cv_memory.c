@@ -1,0 +1,29 @@
+/* src/core/cv_memory.c — the one allocator of the library, with failure injection for tests.
+ * SPDX-License-Identifier: MIT */
+#include <stdlib.h>
+
+#include "cv_internal.h"
+
+/* Countdown to an injected failure; -1 = never. Only tests set it (single-threaded). */
+static long fail_after = -1;
+
+void cv_debug_fail_alloc_after(long k) { fail_after = k; }
+
+static int should_fail(void) {
+  if (fail_after < 0) return 0;
+  if (fail_after == 0) return 1;
+  fail_after--;
+  return 0;
+}
+
+void *cv_malloc(size_t n) {
+  if (should_fail()) return NULL;
+  return malloc(n ? n : 1);
+}
+
+void *cv_calloc(size_t count, size_t size) {
+  if (should_fail()) return NULL;
+  return calloc(count ? count : 1, size ? size : 1);
+}
+
+void cv_free(void *ptr) { free(ptr); }

@@ -1,0 +1,103 @@
+/* src/core/cv_problem.c — the problem object: interval, unknowns, end values, integrand, guess.
+ * SPDX-License-Identifier: MIT */
+#include <math.h>
+
+#include "cv_internal.h"
+
+cv_problem *cv_problem_new(int n, double a, double b, cv_status *why) {
+  cv_status st = CVAR_OK;
+  cv_problem *p = NULL;
+  /* !(a < b) also rejects NaN ends. */
+  if (n < 1 || !isfinite(a) || !isfinite(b) || !(a < b)) {
+    st = CVAR_EINVAL;
+    goto cleanup;
+  }
+  p = cv_calloc(1, sizeof *p);
+  if (!p) {
+    st = CVAR_ENOMEM;
+    goto cleanup;
+  }
+  p->n = n;
+  p->a = a;
+  p->b = b;
+  p->fixed = cv_malloc(2 * (size_t)n * sizeof *p->fixed);
+  p->endval = cv_calloc(2 * (size_t)n, sizeof *p->endval);
+  if (!p->fixed || !p->endval) {
+    st = CVAR_ENOMEM;
+    cv_problem_free(p);
+    p = NULL;
+    goto cleanup;
+  }
+  for (int k = 0; k < 2 * n; k++) p->fixed[k] = 1;
+cleanup:
+  if (why) *why = st;
+  return p;
+}
+
+static void release_integrand(cv_problem *p) {
+  if (p->release) p->release(p->user);
+  p->release = NULL;
+  p->user = NULL;
+  p->F = NULL;
+}
+
+void cv_problem_free(cv_problem *p) {
+  if (!p) return;
+  release_integrand(p);
+  cv_free(p->fixed);
+  cv_free(p->endval);
+  cv_free(p);
+}
+
+cv_status cv_problem_set_integrand_owned(cv_problem *p, cv_integrand_fn F, void *user,
+                                         void (*release)(void *)) {
+  if (!p || !F) {
+    if (release) release(user);
+    return CVAR_EINVAL;
+  }
+  release_integrand(p);
+  p->F = F;
+  p->user = user;
+  p->release = release;
+  return CVAR_OK;
+}
+
+cv_status cv_problem_set_integrand(cv_problem *p, cv_integrand_fn F, void *user) {
+  return cv_problem_set_integrand_owned(p, F, user, NULL);
+}
+
+cv_status cv_problem_set_end_value(cv_problem *p, int k, int end, double value) {
+  if (!p || k < 0 || k >= p->n || (end != 0 && end != 1) || !isfinite(value))
+    return CVAR_EINVAL;
+  p->fixed[2 * k + end] = 1;
+  p->endval[2 * k + end] = value;
+  return CVAR_OK;
+}
+
+cv_status cv_problem_set_dirichlet(cv_problem *p, int k, double ya, double yb) {
+  if (!p || !isfinite(ya) || !isfinite(yb)) return CVAR_EINVAL;
+  cv_status st = cv_problem_set_end_value(p, k, 0, ya);
+  return st ? st : cv_problem_set_end_value(p, k, 1, yb);
+}
+
+cv_status cv_problem_set_free_end(cv_problem *p, int k, int end) {
+  if (!p || k < 0 || k >= p->n || (end != 0 && end != 1)) return CVAR_EINVAL;
+  p->fixed[2 * k + end] = 0;
+  p->endval[2 * k + end] = 0.0;
+  return CVAR_OK;
+}
+
+cv_status cv_problem_set_guess(cv_problem *p, cv_guess_fn g, void *user) {
+  if (!p) return CVAR_EINVAL;
+  p->guess = g;
+  p->guess_user = g ? user : NULL;
+  return CVAR_OK;
+}
+
+int cv_problem_get_num_unknowns(const cv_problem *p) { return p ? p->n : 0; }
+
+void cv_problem_get_interval(const cv_problem *p, double *a, double *b) {
+  if (!p) return;
+  if (a) *a = p->a;
+  if (b) *b = p->b;
+}

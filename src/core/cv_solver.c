@@ -1,0 +1,342 @@
+/* src/core/cv_solver.c — the solver object: options, the solve driver, results and getters.
+ * SPDX-License-Identifier: MIT */
+#include <float.h>
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+#include "cv_internal.h"
+
+cv_solver *cv_solver_new(cv_status *why) {
+  cv_solver *s = cv_calloc(1, sizeof *s);
+  if (why) *why = s ? CVAR_OK : CVAR_ENOMEM;
+  if (!s) return NULL;
+  s->mesh.kind = CV_MESH_UNIFORM;
+  s->mesh.elements = 100;
+  s->mesh.grading = 1.0;
+  s->degree = 1;
+  s->rtol = s->atol = 1e-10;
+  s->maxit = 50;
+  s->status = CVAR_ESTATE;
+  s->morse = -1;
+  cv_set_msg(s->msg, sizeof s->msg, "no solve yet");
+  return s;
+}
+
+void cv_solver_free(cv_solver *s) {
+  if (!s) return;
+  cv_free(s->mesh.t);
+  cv_free(s->mesh.breaks);
+  cv_free(s->start);
+  cv_free(s->y);
+  cv_disc_free(&s->disc);
+  cv_free(s);
+}
+
+static void mesh_reset(cv_solver *s, int kind, int elements) {
+  cv_free(s->mesh.t);
+  s->mesh.t = NULL;
+  s->mesh.kind = kind;
+  s->mesh.elements = elements;
+}
+
+cv_status cv_solver_set_elements(cv_solver *s, int elements) {
+  if (!s || elements < 1) return CVAR_EINVAL;
+  mesh_reset(s, CV_MESH_UNIFORM, elements);
+  return CVAR_OK;
+}
+
+cv_status cv_solver_set_degree(cv_solver *s, int degree) {
+  if (!s || degree < 1 || degree > CV_MAX_DEGREE) return CVAR_EINVAL;
+  s->degree = degree;
+  return CVAR_OK;
+}
+
+cv_status cv_solver_set_quadrature_points(cv_solver *s, int q) {
+  if (!s || q < 0 || q > CV_MAX_QUAD) return CVAR_EINVAL;
+  s->nq = q;
+  return CVAR_OK;
+}
+
+cv_status cv_solver_set_mesh_graded(cv_solver *s, int elements, double grading, int end) {
+  if (!s || elements < 1 || !(grading >= 1.0 && grading <= 20.0) ||
+      (end != CVAR_GRADE_A && end != CVAR_GRADE_B && end != CVAR_GRADE_BOTH))
+    return CVAR_EINVAL;
+  mesh_reset(s, CV_MESH_GRADED, elements);
+  s->mesh.grading = grading;
+  s->mesh.grade_end = end;
+  return CVAR_OK;
+}
+
+cv_status cv_solver_set_mesh(cv_solver *s, int elements, const double *t) {
+  if (!s || elements < 1 || !t || t[0] != 0.0 || t[elements] != 1.0) return CVAR_EINVAL;
+  for (int i = 0; i < elements; i++)
+    if (!(t[i + 1] > t[i])) return CVAR_EINVAL;
+  double *c = cv_malloc((size_t)(elements + 1) * sizeof *c);
+  if (!c) return CVAR_ENOMEM;
+  memcpy(c, t, (size_t)(elements + 1) * sizeof *c);
+  mesh_reset(s, CV_MESH_USER, elements);
+  s->mesh.t = c;
+  return CVAR_OK;
+}
+
+cv_status cv_solver_set_breakpoints(cv_solver *s, int nb, const double *xb) {
+  if (!s || nb < 0 || (nb > 0 && !xb)) return CVAR_EINVAL;
+  for (int i = 0; i < nb; i++)
+    if (!isfinite(xb[i])) return CVAR_EINVAL;
+  double *c = NULL;
+  if (nb > 0) {
+    c = cv_malloc((size_t)nb * sizeof *c);
+    if (!c) return CVAR_ENOMEM;
+    memcpy(c, xb, (size_t)nb * sizeof *c);
+  }
+  cv_free(s->mesh.breaks);
+  s->mesh.breaks = c;
+  s->mesh.nbreak = nb;
+  return CVAR_OK;
+}
+
+cv_status cv_solver_set_tolerances(cv_solver *s, double rtol, double atol) {
+  /* rtol below ~10 eps asks for more than double precision can give (STYLE 8). */
+  if (!s || !(rtol >= 0) || !(atol >= 0) || !isfinite(rtol) || !isfinite(atol) ||
+      (rtol == 0 && atol == 0) || (rtol > 0 && rtol < 10 * DBL_EPSILON) || rtol >= 1)
+    return CVAR_EINVAL;
+  s->rtol = rtol;
+  s->atol = atol;
+  return CVAR_OK;
+}
+
+cv_status cv_solver_set_max_iterations(cv_solver *s, int maxit) {
+  if (!s || maxit < 1) return CVAR_EINVAL;
+  s->maxit = maxit;
+  return CVAR_OK;
+}
+
+cv_status cv_solver_set_start(cv_solver *s, int len, const double *y) {
+  if (!s || len < 0 || (len > 0 && !y)) return CVAR_EINVAL;
+  double *c = NULL;
+  if (len > 0) {
+    c = cv_malloc((size_t)len * sizeof *c);
+    if (!c) return CVAR_ENOMEM;
+    memcpy(c, y, (size_t)len * sizeof *c);
+  }
+  cv_free(s->start);
+  s->start = c;
+  s->start_len = len;
+  return CVAR_OK;
+}
+
+/* Initial nodal values: user start, guess callback, or the straight line between the end
+ * values (a free end takes the other end's value; both free: 0). Fixed ends always win. */
+static cv_status initial_values(cv_solver *s, const cv_problem *p, const cv_disc *d,
+                                double *Y) {
+  int n = p->n;
+  if (s->start) {
+    if (s->start_len != d->ndof) {
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "start vector has %d values but the mesh has %d nodes x %d unknowns",
+                 s->start_len, d->nodes, n);
+      return CVAR_EINVAL;
+    }
+    memcpy(Y, s->start, (size_t)d->ndof * sizeof *Y);
+  } else if (p->guess) {
+    double xb[CV_BATCH], *yb = cv_malloc((size_t)n * CV_BATCH * sizeof *yb);
+    if (!yb) return CVAR_ENOMEM;
+    for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
+      int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
+      for (int k = 0; k < m; k++) xb[k] = cv_disc_node_x(d, j0 + k);
+      int rc = p->guess(m, xb, yb, p->guess_user);
+      for (int k = 0; k < m && rc == 0; k++)
+        for (int i = 0; i < n; i++) {
+          if (!isfinite(yb[i * m + k])) rc = 1;
+          Y[(j0 + k) * n + i] = yb[i * m + k];
+        }
+      if (rc) {
+        cv_free(yb);
+        cv_set_msg(s->msg, sizeof s->msg,
+                   "the initial guess is not finite (or its callback failed) near x = %g",
+                   xb[0]);
+        return CVAR_ECALLBACK;
+      }
+    }
+    cv_free(yb);
+  } else {
+    for (int i = 0; i < n; i++) {
+      int fa = p->fixed[2 * i], fb = p->fixed[2 * i + 1];
+      double ya = p->endval[2 * i], yb = p->endval[2 * i + 1];
+      if (!fa) ya = fb ? yb : 0.0;
+      if (!fb) yb = ya;
+      for (long j = 0; j < d->nodes; j++) {
+        double t = (cv_disc_node_x(d, j) - d->a) / (d->b - d->a);
+        Y[j * n + i] = ya + (yb - ya) * t;
+      }
+    }
+  }
+  for (int i = 0; i < n; i++) {
+    if (p->fixed[2 * i]) Y[i] = p->endval[2 * i];
+    if (p->fixed[2 * i + 1]) Y[(size_t)(d->nodes - 1) * n + i] = p->endval[2 * i + 1];
+  }
+  return CVAR_OK;
+}
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+cv_status cv_solve(cv_solver *s, const cv_problem *p) {
+  if (!s) return CVAR_EINVAL;
+  double t0 = now();
+  cv_status st;
+  cv_free(s->y);
+  s->y = NULL;
+  cv_disc_free(&s->disc);
+  s->have = 0;
+  s->iterations = 0;
+  s->morse = -1;
+  s->degenerate = 0;
+  s->action = s->gnorm = NAN;
+  if (!p || !p->F) {
+    st = CVAR_EINVAL;
+    cv_set_msg(s->msg, sizeof s->msg, p ? "no integrand set" : "problem is NULL");
+    goto done;
+  }
+  s->n = p->n;
+  st = cv_disc_init(&s->disc, p, s, s->msg, sizeof s->msg);
+  if (st) {
+    if (st == CVAR_ENOMEM) cv_set_msg(s->msg, sizeof s->msg, "out of memory building the mesh");
+    goto done;
+  }
+  s->y = cv_malloc((size_t)s->disc.ndof * sizeof *s->y);
+  if (!s->y) {
+    st = CVAR_ENOMEM;
+    cv_set_msg(s->msg, sizeof s->msg, "out of memory for %d nodal values", s->disc.ndof);
+    goto done;
+  }
+  st = initial_values(s, p, &s->disc, s->y);
+  if (st) goto done;
+  s->have = 1;
+  st = cv_newton_run(s, p, &s->disc, s->y);
+done:
+  s->status = st;
+  s->time = now() - t0;
+  return st;
+}
+
+cv_status cv_solver_get_status(const cv_solver *s) { return s ? s->status : CVAR_EINVAL; }
+const char *cv_solver_last_error(const cv_solver *s) {
+  return s ? s->msg : "solver is NULL";
+}
+int cv_solver_get_num_nodes(const cv_solver *s) { return s && s->have ? s->disc.nodes : 0; }
+int cv_solver_get_num_elements(const cv_solver *s) { return s && s->have ? s->disc.E : 0; }
+int cv_solver_get_degree(const cv_solver *s) { return s && s->have ? s->disc.p : 0; }
+int cv_solver_get_num_free(const cv_solver *s) { return s && s->have ? s->disc.nfree : 0; }
+double cv_solver_get_action(const cv_solver *s) { return s ? s->action : NAN; }
+double cv_solver_get_gradient_norm(const cv_solver *s) { return s ? s->gnorm : NAN; }
+int cv_solver_get_num_iterations(const cv_solver *s) { return s ? s->iterations : 0; }
+double cv_solver_get_time(const cv_solver *s) { return s ? s->time : 0.0; }
+int cv_solver_get_morse_index(const cv_solver *s) { return s ? s->morse : -1; }
+int cv_solver_get_degenerate(const cv_solver *s) { return s ? s->degenerate : 0; }
+
+cv_status cv_solver_get_nodes(const cv_solver *s, double *x) {
+  if (!s || !x) return CVAR_EINVAL;
+  if (!s->have) return CVAR_ESTATE;
+  for (long j = 0; j < s->disc.nodes; j++) x[j] = cv_disc_node_x(&s->disc, j);
+  return CVAR_OK;
+}
+
+cv_status cv_solver_get_values(const cv_solver *s, double *y) {
+  if (!s || !y) return CVAR_EINVAL;
+  if (!s->have) return CVAR_ESTATE;
+  memcpy(y, s->y, (size_t)s->disc.ndof * sizeof *y);
+  return CVAR_OK;
+}
+
+int cv_solver_get_num_qpoints(const cv_solver *s) {
+  return s && s->have ? s->disc.E * s->disc.ref.q : 0;
+}
+
+/* The solution and its derivative on element e at reference coordinate t (E-3). */
+static void eval_local(const cv_solver *s, long e, const double *phi,
+                       const double *dphi, double *yv, double *dv) {
+  const cv_disc *d = &s->disc;
+  int n = d->n, P1 = d->p + 1;
+  double rh = 2.0 / (d->xe[e + 1] - d->xe[e]);
+  const double *Ye = s->y + (size_t)e * d->p * n;
+  for (int i = 0; i < n; i++) {
+    double a = 0.0, b = 0.0;
+    for (int l = 0; l < P1; l++) {
+      a += Ye[l * n + i] * phi[l];
+      b += Ye[l * n + i] * dphi[l];
+    }
+    yv[i] = a;
+    dv[i] = b * rh;
+  }
+}
+
+cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double *y,
+                                double *dy) {
+  if (!s) return CVAR_EINVAL;
+  if (!s->have) return CVAR_ESTATE;
+  const cv_disc *d = &s->disc;
+  const cv_refelem *r = &d->ref;
+  int n = d->n, q = r->q, P1 = d->p + 1;
+  long nq = (long)d->E * q;
+  double yv[64], dv[64];
+  double *yb = yv, *db = dv, *big = NULL;
+  if (n > 64) {
+    big = cv_malloc(2 * (size_t)n * sizeof *big);
+    if (!big) return CVAR_ENOMEM;
+    yb = big;
+    db = big + n;
+  }
+  for (long e = 0; e < d->E; e++) {
+    double h = d->xe[e + 1] - d->xe[e];
+    for (int k = 0; k < q; k++) {
+      long idx = e * q + k;
+      if (x) x[idx] = d->xe[e] + 0.5 * (r->tau[k] + 1.0) * h;
+      if (w) w[idx] = 0.5 * h * r->omega[k];
+      if (y || dy) {
+        eval_local(s, e, r->B + k * P1, r->D + k * P1, yb, db);
+        for (int i = 0; i < n; i++) {
+          if (y) y[i * nq + idx] = yb[i];
+          if (dy) dy[i * nq + idx] = db[i];
+        }
+      }
+    }
+  }
+  cv_free(big);
+  return CVAR_OK;
+}
+
+cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y, double *dy) {
+  if (!s || m < 0 || (m > 0 && (!x || !y))) return CVAR_EINVAL;
+  if (!s->have) return CVAR_ESTATE;
+  const cv_disc *d = &s->disc;
+  int n = d->n;
+  double phi[CV_MAX_DEGREE + 1], dphi[CV_MAX_DEGREE + 1];
+  double *buf = cv_malloc(2 * (size_t)n * sizeof *buf);
+  if (!buf) return CVAR_ENOMEM;
+  for (int k = 0; k < m; k++) {
+    if (!(x[k] >= d->a && x[k] <= d->b)) {
+      cv_free(buf);
+      return CVAR_EINVAL;
+    }
+    long lo = 0, hi = d->E; /* find e with xe[e] <= x < xe[e+1] */
+    while (hi - lo > 1) {
+      long mid = (lo + hi) / 2;
+      if (d->xe[mid] <= x[k]) lo = mid;
+      else hi = mid;
+    }
+    double h = d->xe[lo + 1] - d->xe[lo], t = 2.0 * (x[k] - d->xe[lo]) / h - 1.0;
+    cv_lagrange(d->p, d->ref.xi, t, phi, dphi);
+    eval_local(s, lo, phi, dphi, buf, buf + n);
+    for (int i = 0; i < n; i++) {
+      y[i * m + k] = buf[i];
+      if (dy) dy[i * m + k] = buf[n + i];
+    }
+  }
+  cv_free(buf);
+  return CVAR_OK;
+}
