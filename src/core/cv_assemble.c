@@ -48,9 +48,8 @@ static int all_finite(const double *v, size_t len) {
 
 /* Fill the batch of quadrature points of elements e0 .. e0+ne-1: x, and y, y' from the
  * nodal values through the basis tables, theory (E-3). */
-static void fill_points(cv_assembler *as, const double *Y, int e0, int ne) {
+static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int e0, int ne) {
   const cv_disc *d = as->disc;
-  const cv_refelem *r = &d->ref;
   int n = d->n, p = d->p, q = r->q, P1 = p + 1, m = ne * q;
   for (int el = 0; el < ne; el++) {
     int e = e0 + el;
@@ -108,18 +107,23 @@ static cv_status call_integrand(cv_assembler *as, int m, unsigned need) {
 cv_status cv_assemble(cv_assembler *as, const double *Y, double *S, double *g,
                       const long *colptr, double *Ax) {
   const cv_disc *d = as->disc;
-  const cv_refelem *r = &d->ref;
-  int n = d->n, p = d->p, q = r->q, P1 = p + 1, nl = P1 * n;
-  int nb = CV_BATCH / q;
+  int n = d->n, p = d->p, P1 = p + 1, nl = P1 * n;
   unsigned need = CVAR_NEED_F | (g ? CVAR_NEED_GRAD : 0u) | (Ax ? CVAR_NEED_HESS : 0u);
   double Ssum = 0.0, *K = as->K;
   int *flp = as->fl;
   cv_status st;
   if (g) memset(g, 0, (size_t)d->nfree * sizeof *g);
   if (Ax) memset(Ax, 0, (size_t)colptr[d->nfree] * sizeof *Ax);
-  for (int e0 = 0; e0 < d->E; e0 += nb) {
-    int ne = d->E - e0 < nb ? d->E - e0 : nb, m = ne * q;
-    fill_points(as, Y, e0, ne);
+  for (int e0 = 0, ne; e0 < d->E; e0 += ne) {
+    /* A batch: one singular-end element alone, or up to CV_BATCH points of regular ones. */
+    cv_rule rule = cv_disc_rule(d, e0), *r = &rule;
+    int q = r->q, nb = CV_BATCH / q;
+    int special = (e0 == 0 && d->sing_a) || (e0 == d->E - 1 && d->sing_b);
+    int last = d->sing_b ? d->E - 1 : d->E; /* regular elements end before a singular b */
+    ne = special ? 1 : (last - e0 < nb ? last - e0 : nb);
+    if (ne < 1) ne = 1;
+    int m = ne * q;
+    fill_points(as, Y, r, e0, ne);
     st = call_integrand(as, m, need);
     if (st) return st;
     const double *F = as->out.F, *Fy = as->out.Fy, *Fp = as->out.Fp;

@@ -71,3 +71,18 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
   }
   return CVAR_OK;
 }
+
+cv_rule cv_disc_rule(const cv_disc *d, long e) {
+  const cv_refelem *r = &d->ref;
+  cv_rule R = {r->q, r->tau, r->omega, r->B, r->D};
+  if (e == 0 && d->sing_a) R = (cv_rule){r->qs, r->tsa, r->wsa, r->Bsa, r->Dsa};
+  else if (e == d->E - 1 && d->sing_b) R = (cv_rule){r->qs, r->tsb, r->wsb, r->Bsb, r->Dsb};
+  return R;
+}
+
+long cv_disc_num_qpoints(const cv_disc *d) {
+  long nq = (long)d->E * d->ref.q;
+  if (d->sing_a) nq += d->ref.qs - d->ref.q;
+  if (d->sing_b && (d->E > 1 || !d->sing_a)) nq += d->ref.qs - d->ref.q;
+  return nq;
+}

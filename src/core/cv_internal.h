@@ -41,7 +41,19 @@ typedef struct {
   double omega[CV_MAX_QUAD];      /* Gauss weights */
   double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];  /* B[k*(p+1)+l] = phi_l(tau_k) */
   double D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];  /* D[k*(p+1)+l] = phi_l'(tau_k) on [-1,1] */
+  /* Rules for an end element whose integrand is singular at the end (theory Q-2): Gauss
+   * in t after xi = -1 + 2 t^2 (end a) or xi = 1 - 2 t^2 (end b). */
+  int qs;
+  double tsa[CV_MAX_QUAD], tsb[CV_MAX_QUAD], wsa[CV_MAX_QUAD], wsb[CV_MAX_QUAD];
+  double Bsa[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], Dsa[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
+  double Bsb[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], Dsb[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
 } cv_refelem;
+
+/* One quadrature rule on the reference element with its basis tables. */
+typedef struct {
+  int q;
+  const double *tau, *omega, *B, *D;
+} cv_rule;
 
 void cv_gauss_legendre(int q, double *t, double *w);
 void cv_gauss_lobatto(int p, double *xi, double *w);
@@ -71,7 +83,13 @@ typedef struct {
   int *fix0, *fix1;    /* free index of each component at node 0 / last, or -1 */
   int nfree0;          /* free components at node 0 */
   double *mass;        /* lumped nodal weight of each free dof (theory N-3) */
+  int sing_a, sing_b;  /* integrand singular at that end: its element uses rule Q-2 */
 } cv_disc;
+
+/* The rule of element e (Gauss, or the singular-end rule on a flagged end element). */
+cv_rule cv_disc_rule(const cv_disc *d, long e);
+/* Total number of quadrature points over the mesh. */
+long cv_disc_num_qpoints(const cv_disc *d);
 
 /* free index of global dof g = node*n + i, or -1 when fixed */
 static inline int cv_disc_fidx(const cv_disc *d, long g) {

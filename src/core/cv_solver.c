@@ -179,6 +179,34 @@ static cv_status initial_values(cv_solver *s, const cv_problem *p, const cv_disc
   return CVAR_OK;
 }
 
+/* An end where F itself is not finite at the end value (the brachistochrone's 1/sqrt(y) at
+ * y = 0) gets the singular-end rule (Q-2) on its element; Gauss points avoid the end, but a
+ * fixed Gauss rule under-integrates there and the discrete minimiser exploits it. */
+static void detect_singular_ends(const cv_problem *p, cv_disc *d, const double *Y) {
+  int n = p->n;
+  double x, *buf = cv_malloc((2 * (size_t)n + 1) * sizeof *buf);
+  if (!buf) return;
+  for (int end = 0; end < 2; end++) {
+    long node = end ? d->nodes - 1 : 0;
+    long e = end ? d->E - 1 : 0;
+    double h = d->xe[e + 1] - d->xe[e], phi[CV_MAX_DEGREE + 1], dphi[CV_MAX_DEGREE + 1];
+    cv_lagrange(d->p, d->ref.xi, end ? 1.0 : -1.0, phi, dphi);
+    for (int i = 0; i < n; i++) {
+      double dv = 0.0;
+      for (int l = 0; l <= d->p; l++) dv += Y[(e * d->p + l) * n + i] * dphi[l];
+      buf[i] = Y[node * n + i];
+      buf[n + i] = dv * 2.0 / h;
+    }
+    x = end ? d->b : d->a;
+    cv_partials o = {buf + 2 * n, NULL, NULL, NULL, NULL, NULL};
+    int rc = p->F(1, &x, buf, buf + n, CVAR_NEED_F, &o, p->user);
+    int singular = rc > 0 || (rc == 0 && !isfinite(o.F[0]));
+    if (end) d->sing_b = singular;
+    else d->sing_a = singular;
+  }
+  cv_free(buf);
+}
+
 static double now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -217,6 +245,7 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   st = initial_values(s, p, &s->disc, s->y);
   if (st) goto done;
   s->have = 1;
+  detect_singular_ends(p, &s->disc, s->y);
   st = cv_newton_run(s, p, &s->disc, s->y);
 done:
   s->status = st;
@@ -254,7 +283,7 @@ cv_status cv_solver_get_values(const cv_solver *s, double *y) {
 }
 
 int cv_solver_get_num_qpoints(const cv_solver *s) {
-  return s && s->have ? s->disc.E * s->disc.ref.q : 0;
+  return s && s->have ? (int)cv_disc_num_qpoints(&s->disc) : 0;
 }
 
 /* The solution and its derivative on element e at reference coordinate t (E-3). */
@@ -280,9 +309,8 @@ cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double
   if (!s) return CVAR_EINVAL;
   if (!s->have) return CVAR_ESTATE;
   const cv_disc *d = &s->disc;
-  const cv_refelem *r = &d->ref;
-  int n = d->n, q = r->q, P1 = d->p + 1;
-  long nq = (long)d->E * q;
+  int n = d->n, P1 = d->p + 1;
+  long nq = cv_disc_num_qpoints(d), idx = 0;
   double yv[64], dv[64];
   double *yb = yv, *db = dv, *big = NULL;
   if (n > 64) {
@@ -293,8 +321,8 @@ cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double
   }
   for (long e = 0; e < d->E; e++) {
     double h = d->xe[e + 1] - d->xe[e];
-    for (int k = 0; k < q; k++) {
-      long idx = e * q + k;
+    cv_rule R = cv_disc_rule(d, e), *r = &R;
+    for (int k = 0; k < r->q; k++, idx++) {
       if (x) x[idx] = d->xe[e] + 0.5 * (r->tau[k] + 1.0) * h;
       if (w) w[idx] = 0.5 * h * r->omega[k];
       if (y || dy) {
