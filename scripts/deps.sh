@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# scripts/deps.sh — install the Debian packages calcvar needs to build, test and plot.
+set -euo pipefail
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends \
+  build-essential meson ninja-build pkg-config \
+  libsuitesparse-dev libnlopt-dev libinih-dev libjansson-dev liblapack-dev \
+  libplplot-dev plplot-driver-cairo >/dev/null
