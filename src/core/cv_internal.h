@@ -158,7 +158,9 @@ struct cv_solver {
   double *y;   /* nodes*n */
   double action, gnorm, time;
   int iterations, morse, degenerate;
+  double t_assemble, t_factor; /* seconds in assembly / LDL^T factor+solve (for bench/) */
 };
+double cv_now(void);
 
 cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *y);
 

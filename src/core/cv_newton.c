@@ -128,6 +128,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   for (;;) {
     int neg;
     double dmin, dmax;
+    double tf = cv_now();
     st = cv_ldlt_factor(w.L, &neg, &dmin, &dmax, detail, sizeof detail);
     if (st == CVAR_OK && !(dmin > DEGENERATE_PIVOT)) st = CVAR_ESINGULAR;
     if (st) {
@@ -148,6 +149,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     s->morse = neg;
     for (int f = 0; f < nf; f++) w.delta[f] = -w.g[f];
     st = cv_ldlt_solve(w.L, w.delta);
+    s->t_factor += cv_now() - tf;
     if (st) {
       cv_set_msg(s->msg, sizeof s->msg, "CHOLMOD solve failed");
       goto cleanup;
@@ -174,7 +176,9 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
       for (long i = 0; i < d->ndof; i++) w.Yt[i] = Y[i];
       for (int f = 0; f < nf; f++) w.Yt[w.gof[f]] += alpha * w.delta[f];
+      double ta = cv_now();
       cv_status ast = cv_assemble(&as, w.Yt, &St, w.gt, w.colptr, Ax);
+      s->t_assemble += cv_now() - ta;
       if (ast == CVAR_ECALLBACK) {
         st = ast;
         cv_set_msg(s->msg, sizeof s->msg, "%s", where_failed(ast));

@@ -207,7 +207,7 @@ static void detect_singular_ends(const cv_problem *p, cv_disc *d, const double *
   cv_free(buf);
 }
 
-static double now(void) {
+double cv_now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
@@ -215,7 +215,7 @@ static double now(void) {
 
 cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   if (!s) return CVAR_EINVAL;
-  double t0 = now();
+  double t0 = cv_now();
   cv_status st;
   cv_free(s->y);
   s->y = NULL;
@@ -225,6 +225,7 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   s->morse = -1;
   s->degenerate = 0;
   s->action = s->gnorm = NAN;
+  s->t_assemble = s->t_factor = 0.0;
   if (!p || !p->F) {
     st = CVAR_EINVAL;
     cv_set_msg(s->msg, sizeof s->msg, p ? "no integrand set" : "problem is NULL");
@@ -249,7 +250,7 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   st = cv_newton_run(s, p, &s->disc, s->y);
 done:
   s->status = st;
-  s->time = now() - t0;
+  s->time = cv_now() - t0;
   return st;
 }
 
