@@ -12,7 +12,7 @@ cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc
   as->disc = d;
   size_t nl = (size_t)(d->p + 1) * n;
   as->buf = cv_malloc((3 + 4 * n + 3 * n * n) * m * sizeof *as->buf);
-  as->K = cv_malloc(nl * nl * sizeof *as->K);
+  as->K = cv_malloc((nl * nl + nl) * sizeof *as->K); /* element matrix + gradient */
   as->fl = cv_malloc(nl * sizeof *as->fl);
   if (!as->buf || !as->K || !as->fl) {
     cv_assembler_free(as);
@@ -91,12 +91,51 @@ static cv_status call_integrand(cv_assembler *as, int m, unsigned need) {
   as->cb_status = rc;
   if (rc < 0) return CVAR_ECALLBACK;
   if (rc > 0) return CVAR_ENONFINITE;
-  if (!all_finite(o.F, (size_t)m)) return CVAR_ENONFINITE;
-  if (o.Fy && (!all_finite(o.Fy, len1) || !all_finite(o.Fp, len1))) return CVAR_ENONFINITE;
-  if (o.Fyy && (!all_finite(o.Fyy, len2) || !all_finite(o.Fyp, len2) ||
-                !all_finite(o.Fpp, len2)))
-    return CVAR_ENONFINITE;
-  return CVAR_OK;
+  return CVAR_OK; /* finiteness is checked on the sums, see cv_assemble */
+}
+
+/* Element kernel for one unknown (n = 1), inlined with a constant number of basis
+ * functions P1 so loops unroll and the element gradient and matrix stay in registers.
+ * Same sums as the general loops in cv_assemble, (A-1)-(A-3). */
+static inline __attribute__((always_inline)) double
+element_scalar(const int P1, const cv_rule *r, int q, int idx0, double J, double rh,
+               const cv_partials *o, double *gl, double *K) {
+  double S = 0.0, gacc[CV_MAX_DEGREE + 1] = {0}, Kacc[(CV_MAX_DEGREE + 1) * (CV_MAX_DEGREE + 1)];
+  if (K)
+    for (int a = 0; a < P1 * P1; a++) Kacc[a] = 0.0;
+  for (int k = 0; k < q; k++) {
+    int idx = idx0 + k;
+    double wk = J * r->omega[k];
+    const double *Bk = r->B + k * P1, *Dk = r->D + k * P1;
+    S += wk * o->F[idx];
+    if (gl) {
+      double fy = wk * o->Fy[idx], fp = wk * rh * o->Fp[idx];
+      for (int l = 0; l < P1; l++) gacc[l] += fy * Bk[l] + fp * Dk[l];
+    }
+    if (K) {
+      double yy = wk * o->Fyy[idx], yp = wk * rh * o->Fyp[idx], pp = wk * rh * rh * o->Fpp[idx];
+      for (int l = 0; l < P1; l++) {
+        double cy = yy * Bk[l] + yp * Dk[l], cp = yp * Bk[l] + pp * Dk[l];
+        for (int rr = l; rr < P1; rr++) Kacc[l * P1 + rr] += cy * Bk[rr] + cp * Dk[rr];
+      }
+    }
+  }
+  if (gl)
+    for (int l = 0; l < P1; l++) gl[l] = gacc[l];
+  if (K)
+    for (int l = 0; l < P1; l++)
+      for (int rr = l; rr < P1; rr++) K[l * P1 + rr] = Kacc[l * P1 + rr];
+  return S;
+}
+
+static double element_scalar_dispatch(int P1, const cv_rule *r, int q, int idx0, double J,
+                                      double rh, const cv_partials *o, double *gl, double *K) {
+  switch (P1) {
+#define CASE(c) case c: return element_scalar(c, r, q, idx0, J, rh, o, gl, K);
+    CASE(2) CASE(3) CASE(4) CASE(5) CASE(6) CASE(7) CASE(8) CASE(9)
+#undef CASE
+  }
+  return NAN; /* unreachable: 1 <= p <= 8 */
 }
 
 /* S_h = sum_e sum_k (h_e/2) w_k F(x_ek, y_ek, y'_ek)                          (A-1)
@@ -109,7 +148,7 @@ cv_status cv_assemble(cv_assembler *as, const double *Y, double *S, double *g,
   const cv_disc *d = as->disc;
   int n = d->n, p = d->p, P1 = p + 1, nl = P1 * n;
   unsigned need = CVAR_NEED_F | (g ? CVAR_NEED_GRAD : 0u) | (Ax ? CVAR_NEED_HESS : 0u);
-  double Ssum = 0.0, *K = as->K;
+  double Ssum = 0.0, *K = as->K, *gl = as->K + nl * nl;
   int *flp = as->fl;
   cv_status st;
   if (g) memset(g, 0, (size_t)d->nfree * sizeof *g);
@@ -126,25 +165,38 @@ cv_status cv_assemble(cv_assembler *as, const double *Y, double *S, double *g,
     fill_points(as, Y, r, e0, ne);
     st = call_integrand(as, m, need);
     if (st) return st;
-    const double *F = as->out.F, *Fy = as->out.Fy, *Fp = as->out.Fp;
+    double *F = as->out.F;
+    const double *Fy = as->out.Fy, *Fp = as->out.Fp;
     const double *Fyy = as->out.Fyy, *Fyp = as->out.Fyp, *Fpp = as->out.Fpp;
     for (int el = 0; el < ne; el++) {
       int e = e0 + el;
       double h = d->xe[e + 1] - d->xe[e], J = 0.5 * h, rh = 2.0 / h;
-      for (int a = 0; a < nl; a++) flp[a] = cv_disc_fidx(d, (long)e * p * n + a);
+      /* Free indices of the element's unknowns: a shift of the global ones except on the
+       * two end elements (E-2); no integer division in the common case. */
+      if (e > 0 && e < d->E - 1) {
+        int base = e * p * n - n + d->nfree0;
+        for (int a = 0; a < nl; a++) flp[a] = base + a;
+      } else {
+        for (int a = 0; a < nl; a++) flp[a] = cv_disc_fidx(d, (long)e * p * n + a);
+      }
+      if (n == 1) {
+        cv_partials o = {F, (double *)Fy, (double *)Fp, (double *)Fyy, (double *)Fyp,
+                         (double *)Fpp};
+        Ssum += element_scalar_dispatch(P1, r, q, el * q, J, rh, &o, g ? gl : NULL,
+                                        Ax ? K : NULL);
+      } else {
       if (Ax) memset(K, 0, (size_t)nl * nl * sizeof *K);
+      if (g) memset(gl, 0, (size_t)nl * sizeof *gl);
       for (int k = 0; k < q; k++) {
         int idx = el * q + k;
         double wk = J * r->omega[k];
         const double *Bk = r->B + k * P1, *Dk = r->D + k * P1;
         Ssum += wk * F[idx];
         if (g) {
-          for (int l = 0; l < P1; l++)
-            for (int i = 0; i < n; i++) {
-              int fi = flp[l * n + i];
-              if (fi >= 0)
-                g[fi] += wk * (Fy[i * m + idx] * Bk[l] + Fp[i * m + idx] * Dk[l] * rh);
-            }
+          for (int i = 0; i < n; i++) {
+            double fy = wk * Fy[i * m + idx], fp = wk * rh * Fp[i * m + idx];
+            for (int l = 0; l < P1; l++) gl[l * n + i] += fy * Bk[l] + fp * Dk[l];
+          }
         }
         if (Ax) {
           for (int i = 0; i < n; i++)
@@ -162,6 +214,10 @@ cv_status cv_assemble(cv_assembler *as, const double *Y, double *S, double *g,
             }
         }
       }
+      }
+      if (g)
+        for (int a = 0; a < nl; a++)
+          if (flp[a] >= 0) g[flp[a]] += gl[a];
       if (Ax) {
         /* Scatter the upper triangle; column c holds rows c+1-len(c) .. c (E-2). */
         for (int bcol = 0; bcol < nl; bcol++) {
@@ -176,6 +232,12 @@ cv_status cv_assemble(cv_assembler *as, const double *Y, double *S, double *g,
       }
     }
   }
+  /* Every requested output enters S, g or H multiplied by a weight, and NaN or Inf
+   * survives that (0 * Inf is NaN), so checking the sums catches any non-finite output,
+   * including entries the callback forgot (pre-filled with NaN). */
   *S = Ssum;
-  return isfinite(Ssum) ? CVAR_OK : CVAR_ENONFINITE;
+  if (!isfinite(Ssum)) return CVAR_ENONFINITE;
+  if (g && !all_finite(g, (size_t)d->nfree)) return CVAR_ENONFINITE;
+  if (Ax && !all_finite(Ax, (size_t)colptr[d->nfree])) return CVAR_ENONFINITE;
+  return CVAR_OK;
 }
