@@ -13,6 +13,15 @@ void cv_disc_free(cv_disc *d) {
   memset(d, 0, sizeof *d);
 }
 
+void cv_disc_fill_nodes(const cv_disc *d, double *x) {
+  for (long e = 0; e < d->E; e++) {
+    double h = d->xe[e + 1] - d->xe[e];
+    x[e * d->p] = d->xe[e];
+    for (int l = 1; l < d->p; l++) x[e * d->p + l] = d->xe[e] + 0.5 * (d->ref.xi[l] + 1.0) * h;
+  }
+  x[d->nodes - 1] = d->xe[d->E];
+}
+
 double cv_disc_node_x(const cv_disc *d, long j) {
   if (j >= d->nodes - 1) return d->xe[d->E];
   long e = j / d->p;
@@ -63,9 +72,10 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
   /* Lumped weight of a node: the integral of its basis function, (h/2) w_l^GLL (N-3). */
   for (int e = 0; e < d->E; e++) {
     double h = d->xe[e + 1] - d->xe[e];
+    int interior = e > 0 && e < d->E - 1, base = e * d->p * n - n + d->nfree0;
     for (int l = 0; l <= d->p; l++)
       for (int i = 0; i < n; i++) {
-        int fi = cv_disc_fidx(d, (long)(e * d->p + l) * n + i);
+        int fi = interior ? base + l * n + i : cv_disc_fidx(d, (long)(e * d->p + l) * n + i);
         if (fi >= 0) d->mass[fi] += 0.5 * h * d->ref.wl[l];
       }
   }

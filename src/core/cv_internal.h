@@ -100,6 +100,8 @@ static inline int cv_disc_fidx(const cv_disc *d, long g) {
   return (int)(g - d->n + d->nfree0);
 }
 double cv_disc_node_x(const cv_disc *d, long j);
+/* All node abscissae, x[0 .. nodes-1]. */
+void cv_disc_fill_nodes(const cv_disc *d, double *x);
 
 /* ---- sparse symmetric LDL^T (cv_cholmod.c: the only file that includes CHOLMOD) ---- */
 typedef struct cv_ldlt cv_ldlt;

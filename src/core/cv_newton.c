@@ -46,16 +46,22 @@ static cv_status ws_init(newton_ws *w, const cv_disc *d) {
   w->delta = cv_malloc((nf ? nf : 1) * sizeof *w->delta);
   w->Yt = cv_malloc((size_t)d->ndof * sizeof *w->Yt);
   if (!w->gof || !w->colptr || !w->g || !w->gt || !w->delta || !w->Yt) return CVAR_ENOMEM;
-  for (long gdof = 0; gdof < d->ndof; gdof++) {
-    int f = cv_disc_fidx(d, gdof);
-    if (f >= 0) w->gof[f] = (int)gdof;
+  /* gof: interior free indices are a shift of the global ones (E-2); ends by table. */
+  int n = d->n, p = d->p;
+  for (int i = 0; i < n; i++) {
+    if (d->fix0[i] >= 0) w->gof[d->fix0[i]] = i;
+    if (d->fix1[i] >= 0) w->gof[d->fix1[i]] = (d->nodes - 1) * n + i;
   }
+  for (long f = d->nfree0, end = d->nfree0 + (long)(d->nodes - 2) * n; f < end; f++)
+    w->gof[f] = (int)(f - d->nfree0 + n);
   w->colptr[0] = 0;
-  for (size_t c = 0; c < nf; c++) {
-    long node = w->gof[c] / d->n;
-    long e = node == 0 ? 0 : (node - 1) / d->p;
-    long r0 = e == 0 ? 0 : cv_disc_fidx(d, e * d->p * d->n);
-    w->colptr[c + 1] = w->colptr[c] + ((long)c - r0 + 1);
+  for (long J = 0, e = 0; J < d->nodes; J++) {
+    if (J > 1 && (J - 1) % p == 0) e++; /* e = first element containing node J */
+    long r0 = e == 0 ? 0 : cv_disc_fidx(d, e * p * n);
+    for (int i = 0; i < n; i++) {
+      int c = cv_disc_fidx(d, J * n + i);
+      if (c >= 0) w->colptr[c + 1] = w->colptr[c] + ((long)c - r0 + 1);
+    }
   }
   w->L = cv_ldlt_new(d->nfree, w->colptr);
   return w->L ? CVAR_OK : CVAR_ENOMEM;

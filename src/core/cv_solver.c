@@ -161,16 +161,20 @@ static cv_status initial_values(cv_solver *s, const cv_problem *p, const cv_disc
     }
     cv_free(yb);
   } else {
+    double *xn = cv_malloc((size_t)d->nodes * sizeof *xn);
+    if (!xn) return CVAR_ENOMEM;
+    cv_disc_fill_nodes(d, xn);
     for (int i = 0; i < n; i++) {
       int fa = p->fixed[2 * i], fb = p->fixed[2 * i + 1];
       double ya = p->endval[2 * i], yb = p->endval[2 * i + 1];
       if (!fa) ya = fb ? yb : 0.0;
       if (!fb) yb = ya;
       for (long j = 0; j < d->nodes; j++) {
-        double t = (cv_disc_node_x(d, j) - d->a) / (d->b - d->a);
+        double t = (xn[j] - d->a) / (d->b - d->a);
         Y[j * n + i] = ya + (yb - ya) * t;
       }
     }
+    cv_free(xn);
   }
   for (int i = 0; i < n; i++) {
     if (p->fixed[2 * i]) Y[i] = p->endval[2 * i];
@@ -272,7 +276,7 @@ int cv_solver_get_degenerate(const cv_solver *s) { return s ? s->degenerate : 0;
 cv_status cv_solver_get_nodes(const cv_solver *s, double *x) {
   if (!s || !x) return CVAR_EINVAL;
   if (!s->have) return CVAR_ESTATE;
-  for (long j = 0; j < s->disc.nodes; j++) x[j] = cv_disc_node_x(&s->disc, j);
+  cv_disc_fill_nodes(&s->disc, x);
   return CVAR_OK;
 }
 
