@@ -163,6 +163,27 @@ cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
                                         const char *unknowns, const char *F,
                                         const char *parameters, char *err, size_t errlen);
 
+/** Pointwise constraint G(x, y) = 0 (no y'), at m points: G[k], and when asked for
+ * (need & CVAR_NEED_GRAD) Gy[i*m + k] = dG/dy_i, (need & CVAR_NEED_HESS)
+ * Gyy[(i*n + j)*m + k] = d2G/dy_i dy_j. Gy/Gyy are NULL when not asked for. Returns as
+ * cv_integrand_fn does. */
+typedef int (*cv_constraint_fn)(int m, const double *x, const double *y, unsigned need,
+                                double *G, double *Gy, double *Gyy, void *user);
+
+/** Add the pointwise constraint G(x, y(x)) = 0 for all x. It is imposed at every node
+ * that has a free unknown, with one multiplier per node: the discrete multiplier field
+ * lambda(x) of the Lagrangian F + lambda G (theory C-1). At an end where all unknowns are
+ * fixed, the constraint must already hold (cv_solve returns CVAR_EINVAL otherwise).
+ * *index (may be NULL) receives the constraint's number, 0, 1, ... */
+cv_status cv_problem_add_constraint(cv_problem *p, cv_constraint_fn G, void *user, int *index);
+/** Add the integral constraint  int_a^b K(x, y, y') dx = c, with one scalar multiplier
+ * mu (Lagrangian F + mu K, theory C-2). K has the integrand's signature and must supply
+ * the partials asked for. *index (may be NULL) receives its number, 0, 1, ... */
+cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, void *user, double c,
+                                  int *index);
+int cv_problem_get_num_constraints(const cv_problem *p);
+int cv_problem_get_num_integrals(const cv_problem *p);
+
 /** Outcome of cv_problem_check_derivatives. */
 typedef struct {
   double worst;      /**< worst relative difference |analytic - FD| / max(1, |analytic|) */
@@ -254,6 +275,13 @@ int cv_solver_get_morse_index(const cv_solver *s);
 int cv_solver_get_degenerate(const cv_solver *s);
 /** Number of free scalar unknowns of the discrete problem (size of the Hessian). */
 int cv_solver_get_num_free(const cv_solver *s);
+
+/** The multiplier field of pointwise constraint k at the nodes of the last solve,
+ * lambda[j], j < cv_solver_get_num_nodes(). At an end node whose unknowns are all fixed
+ * (no multiplier there) the value is extrapolated from the neighbouring nodes. */
+cv_status cv_solver_get_multiplier_field(const cv_solver *s, int k, double *lambda);
+/** The scalar multiplier of integral constraint k of the last solve. */
+cv_status cv_solver_get_multiplier(const cv_solver *s, int k, double *mu);
 
 /** Quadrature points of the last solve's mesh: count, then the points with weights and
  * the solution there. Each output may be NULL. x, w: length nq; y, dy: n*nq, laid out

@@ -74,9 +74,9 @@ static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int
 }
 
 /* Call the integrand for m points; NaN-fill first so forgotten outputs are caught. */
-static cv_status call_integrand(cv_assembler *as, int m, unsigned need) {
-  const cv_problem *p = as->prob;
-  size_t n = (size_t)p->n;
+static cv_status call_integrand(cv_assembler *as, cv_integrand_fn Fn, void *user, int m,
+                                unsigned need) {
+  size_t n = (size_t)as->disc->n;
   cv_partials o = {as->out.F, NULL, NULL, NULL, NULL, NULL};
   size_t len1 = n * m, len2 = n * n * m;
   if (need & CVAR_NEED_GRAD) o.Fy = as->out.Fy, o.Fp = as->out.Fp;
@@ -87,7 +87,7 @@ static cv_status call_integrand(cv_assembler *as, int m, unsigned need) {
   if (o.Fyy)
     for (size_t k = 0; k < len2; k++) o.Fyy[k] = o.Fyp[k] = o.Fpp[k] = NAN;
   as->nevals += m;
-  int rc = p->F(m, as->x, as->y, as->dy, need, &o, p->user);
+  int rc = Fn(m, as->x, as->y, as->dy, need, &o, user);
   as->cb_status = rc;
   if (rc < 0) return CVAR_ECALLBACK;
   if (rc > 0) return CVAR_ENONFINITE;
@@ -143,16 +143,14 @@ static double element_scalar_dispatch(int P1, const cv_rule *r, int q, int idx0,
  * d2S_h/dY_{l,i}dY_{r,j} = sum (h/2) w_k (F_yiyj phi_l phi_r
  *     + F_yiy'j phi_l phi_r' (2/h) + F_yjy'i phi_l' phi_r (2/h) + F_y'iy'j phi_l' phi_r' (2/h)^2)
  *                                                                              (A-3)  */
-cv_status cv_assemble(cv_assembler *as, const double *Y, double *S, double *g,
-                      const long *colptr, double *Ax) {
+cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y,
+                      double *S, double *g, const long *colptr, double *Ax, double hscale) {
   const cv_disc *d = as->disc;
   int n = d->n, p = d->p, P1 = p + 1, nl = P1 * n;
   unsigned need = CVAR_NEED_F | (g ? CVAR_NEED_GRAD : 0u) | (Ax ? CVAR_NEED_HESS : 0u);
   double Ssum = 0.0, *K = as->K, *gl = as->K + nl * nl;
   int *flp = as->fl;
   cv_status st;
-  if (g) memset(g, 0, (size_t)d->nfree * sizeof *g);
-  if (Ax) memset(Ax, 0, (size_t)colptr[d->nfree] * sizeof *Ax);
   for (int e0 = 0, ne; e0 < d->E; e0 += ne) {
     /* A batch: one singular-end element alone, or up to CV_BATCH points of regular ones. */
     cv_rule rule = cv_disc_rule(d, e0), *r = &rule;
@@ -163,7 +161,7 @@ cv_status cv_assemble(cv_assembler *as, const double *Y, double *S, double *g,
     if (ne < 1) ne = 1;
     int m = ne * q;
     fill_points(as, Y, r, e0, ne);
-    st = call_integrand(as, m, need);
+    st = call_integrand(as, Fn, user, m, need);
     if (st) return st;
     double *F = as->out.F;
     const double *Fy = as->out.Fy, *Fp = as->out.Fp;
@@ -174,8 +172,9 @@ cv_status cv_assemble(cv_assembler *as, const double *Y, double *S, double *g,
       /* Free indices of the element's unknowns: a shift of the global ones except on the
        * two end elements (E-2); no integer division in the common case. */
       if (e > 0 && e < d->E - 1) {
-        int base = e * p * n - n + d->nfree0;
-        for (int a = 0; a < nl; a++) flp[a] = base + a;
+        int base = cv_disc_elem_first(d, e), st = d->stride;
+        for (int l = 0; l < P1; l++)
+          for (int i = 0; i < n; i++) flp[l * n + i] = base + l * st + i;
       } else {
         for (int a = 0; a < nl; a++) flp[a] = cv_disc_fidx(d, (long)e * p * n + a);
       }
@@ -226,7 +225,7 @@ cv_status cv_assemble(cv_assembler *as, const double *Y, double *S, double *g,
           long c0 = colptr[fb], rs = fb + 1 - (colptr[fb + 1] - c0);
           for (int arow = 0; arow <= bcol; arow++) {
             int fa = flp[arow];
-            if (fa >= 0) Ax[c0 + fa - rs] += K[arow * nl + bcol];
+            if (fa >= 0) Ax[c0 + fa - rs] += hscale * K[arow * nl + bcol];
           }
         }
       }

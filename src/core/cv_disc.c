@@ -58,27 +58,47 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
     cv_disc_free(d);
     return CVAR_ENOMEM;
   }
-  int f = 0;
+  int f = 0, nc = p->nc;
+  d->nc = nc;
+  d->ni = p->ni;
+  d->stride = n + nc;
   for (int i = 0; i < n; i++) d->fix0[i] = p->fixed[2 * i] ? -1 : f++;
   d->nfree0 = f;
-  f += (d->nodes - 2) * n;
+  d->lam0 = (f > 0 && nc > 0) ? f : -1;
+  if (d->lam0 >= 0) f += nc;
+  d->off0 = f;
+  f += (d->nodes - 2) * d->stride;
+  int f1 = f;
   for (int i = 0; i < n; i++) d->fix1[i] = p->fixed[2 * i + 1] ? -1 : f++;
+  d->nfree1 = f - f1;
+  d->lamL = (d->nfree1 > 0 && nc > 0) ? f : -1;
+  if (d->lamL >= 0) f += nc;
+  d->nu0 = f;
+  f += d->ni;
   d->nfree = f;
   d->mass = cv_calloc((size_t)(f ? f : 1), sizeof *d->mass);
   if (!d->mass) {
     cv_disc_free(d);
     return CVAR_ENOMEM;
   }
-  /* Lumped weight of a node: the integral of its basis function, (h/2) w_l^GLL (N-3). */
+  /* Lumped weight of a node: the integral of its basis function, (h/2) w_l^GLL (N-3); a
+   * node's multipliers share it, integral multipliers get the interval length. */
   for (int e = 0; e < d->E; e++) {
     double h = d->xe[e + 1] - d->xe[e];
-    int interior = e > 0 && e < d->E - 1, base = e * d->p * n - n + d->nfree0;
-    for (int l = 0; l <= d->p; l++)
+    for (int l = 0; l <= d->p; l++) {
+      long node = (long)e * d->p + l;
+      double m = 0.5 * h * d->ref.wl[l];
       for (int i = 0; i < n; i++) {
-        int fi = interior ? base + l * n + i : cv_disc_fidx(d, (long)(e * d->p + l) * n + i);
-        if (fi >= 0) d->mass[fi] += 0.5 * h * d->ref.wl[l];
+        int fi = cv_disc_fidx(d, node * n + i);
+        if (fi >= 0) d->mass[fi] += m;
       }
+      for (int k = 0; k < nc; k++) {
+        int li = cv_disc_lidx(d, node, k);
+        if (li >= 0) d->mass[li] += m;
+      }
+    }
   }
+  for (int r = 0; r < d->ni; r++) d->mass[d->nu0 + r] = d->b - d->a;
   return CVAR_OK;
 }
 

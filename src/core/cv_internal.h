@@ -20,8 +20,24 @@ void cv_free(void *ptr);
 /* Fail the k-th allocation from now on (k >= 0); -1 disables. For tests only. */
 void cv_debug_fail_alloc_after(long k);
 
+typedef struct {
+  cv_constraint_fn G;
+  void *user;
+  void (*release)(void *);
+} cv_pconstraint;
+
+typedef struct {
+  cv_integrand_fn K;
+  void *user;
+  void (*release)(void *);
+  double c;
+} cv_iconstraint;
+
 struct cv_problem {
   int n;
+  int nc, ni;              /* pointwise and integral constraints */
+  cv_pconstraint *pc;
+  cv_iconstraint *ic;
   double a, b;
   cv_integrand_fn F;
   void *user;
@@ -75,30 +91,45 @@ cv_status cv_mesh_build(const cv_meshspec *m, double a, double b, int *E, double
                         char *msg, size_t len);
 
 /* ---- discretisation of one solve (cv_disc.c) ---- */
+/* Unknowns of the discrete problem, node-major (theory E-2, C-3): at each node its free
+ * components of y, then (with pointwise constraints, at nodes having a free component) its
+ * nc multipliers; after the last node the ni integral multipliers. */
 typedef struct {
   int n, p, E, nodes, ndof, nfree;
+  int nc, ni, stride, off0;   /* stride = n + nc; off0 = unknowns at node 0 */
+  int nfree0, nfree1;         /* free y components at node 0 / at the last node */
   double a, b;
   double *xe;          /* element boundaries, E+1 */
   cv_refelem ref;
-  int *fix0, *fix1;    /* free index of each component at node 0 / last, or -1 */
-  int nfree0;          /* free components at node 0 */
-  double *mass;        /* lumped nodal weight of each free dof (theory N-3) */
+  int *fix0, *fix1;    /* index of each y component at node 0 / last, or -1 */
+  int lam0, lamL, nu0; /* first multiplier at node 0 / last node (-1: none), integrals */
+  double *mass;        /* lumped nodal weight of each unknown (theory N-3) */
   int sing_a, sing_b;  /* integrand singular at that end: its element uses rule Q-2 */
 } cv_disc;
 
-/* The rule of element e (Gauss, or the singular-end rule on a flagged end element). */
-cv_rule cv_disc_rule(const cv_disc *d, long e);
-/* Total number of quadrature points over the mesh. */
-long cv_disc_num_qpoints(const cv_disc *d);
-
-/* free index of global dof g = node*n + i, or -1 when fixed */
+/* index of y dof g = node*n + i, or -1 when fixed */
 static inline int cv_disc_fidx(const cv_disc *d, long g) {
   long node = g / d->n;
   int i = (int)(g - node * d->n);
   if (node == 0) return d->fix0[i];
   if (node == d->nodes - 1) return d->fix1[i];
-  return (int)(g - d->n + d->nfree0);
+  return (int)(d->off0 + (node - 1) * d->stride + i);
 }
+/* index of the multiplier of pointwise constraint k at a node, or -1 */
+static inline int cv_disc_lidx(const cv_disc *d, long node, int k) {
+  if (node == 0) return d->lam0 < 0 ? -1 : d->lam0 + k;
+  if (node == d->nodes - 1) return d->lamL < 0 ? -1 : d->lamL + k;
+  return (int)(d->off0 + (node - 1) * d->stride + d->n + k);
+}
+/* first unknown of element e (its first node's first unknown) */
+static inline int cv_disc_elem_first(const cv_disc *d, long e) {
+  return e == 0 ? 0 : (int)(d->off0 + (e * d->p - 1) * d->stride);
+}
+
+/* The rule of element e (Gauss, or the singular-end rule on a flagged end element). */
+cv_rule cv_disc_rule(const cv_disc *d, long e);
+/* Total number of quadrature points over the mesh. */
+long cv_disc_num_qpoints(const cv_disc *d);
 double cv_disc_node_x(const cv_disc *d, long j);
 /* All node abscissae, x[0 .. nodes-1]. */
 void cv_disc_fill_nodes(const cv_disc *d, double *x);
@@ -132,11 +163,32 @@ typedef struct {
 
 cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc *d);
 void cv_assembler_free(cv_assembler *as);
-/* S_h, gradient over free dofs (g may be NULL), and Hessian values into Ax (may be NULL)
- * with the column layout colptr, at nodal values y (length nodes*n). Returns CVAR_OK,
- * CVAR_ENONFINITE (non-finite output or >0 from the callback) or CVAR_ECALLBACK. */
-cv_status cv_assemble(cv_assembler *as, const double *y, double *S, double *g,
-                      const long *colptr, double *Ax);
+/* Set *S to the discrete integral of Fn (theory A-1), add its gradient (A-2) to g (rows of the
+ * y unknowns; may be NULL) and hscale times its Hessian (A-3) to Ax (may be NULL; column
+ * layout colptr), at nodal values Y (length nodes*n). Nothing is zeroed here. Returns
+ * CVAR_OK, CVAR_ENONFINITE (non-finite output or > 0 from the callback), CVAR_ECALLBACK. */
+cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y,
+                      double *S, double *g, const long *colptr, double *Ax, double hscale);
+
+/* ---- the Lagrangian system with constraints (cv_kkt.c) ---- */
+typedef struct {
+  const cv_problem *prob;
+  const cv_disc *d;
+  cv_assembler as;
+  const long *colptr;
+  double *xn;    /* node abscissae (pointwise constraints) */
+  double *cbuf;  /* batch buffers of constraint calls */
+  double *gK;    /* gradient of one integral constraint */
+} cv_kkt;
+cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const long *colptr);
+void cv_kkt_free(cv_kkt *k);
+/* Reject pointwise constraints that fail at an end whose unknowns are all fixed. */
+cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len);
+/* Least-squares starting multipliers from the stationarity condition at Y (C-5). */
+cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M);
+/* M: multipliers, lam[node*nc + k] then nu[r]. Ax and dreg may be NULL. */
+cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, double *G,
+                      double *Ax, double *dreg);
 
 /* ---- Newton (cv_newton.c) ---- */
 typedef struct {
@@ -158,13 +210,14 @@ struct cv_solver {
   int n, have;
   cv_disc disc;
   double *y;   /* nodes*n */
+  double *mult; /* nodes*nc multiplier field, then ni integral multipliers */
   double action, gnorm, time;
   int iterations, morse, degenerate;
   double t_assemble, t_factor; /* seconds in assembly / LDL^T factor+solve (for bench/) */
 };
 double cv_now(void);
 
-cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *y);
+cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *y, double *M);
 
 void cv_disc_free(cv_disc *d);
 cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,

@@ -8,4 +8,9 @@
  * release(user). On failure release(user) is called before returning. */
 cv_status cv_problem_set_integrand_owned(cv_problem *p, cv_integrand_fn F, void *user,
                                          void (*release)(void *));
+/* Constraints whose user data the problem owns, as above. */
+cv_status cv_problem_add_constraint_owned(cv_problem *p, cv_constraint_fn G, void *user,
+                                          void (*release)(void *), int *index);
+cv_status cv_problem_add_integral_owned(cv_problem *p, cv_integrand_fn K, void *user,
+                                        void (*release)(void *), double c, int *index);
 #endif

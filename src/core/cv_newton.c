@@ -1,5 +1,5 @@
-/* src/core/cv_newton.c — Newton's method on the discrete Euler-Lagrange system with a line
- * search, theory (N-1)-(N-5).
+/* src/core/cv_newton.c — Newton's method on the discrete Euler-Lagrange (or, with
+ * constraints, Lagrangian) system with a line search, theory (N-1)-(N-5), (C-4).
  * SPDX-License-Identifier: MIT */
 #include <float.h>
 #include <math.h>
@@ -14,13 +14,14 @@
 #define DEGENERATE_PIVOT 1e-11
 #define MAX_BACKTRACK 40
 #define ARMIJO 1e-4
+#define REFINE_STEPS 2
 
 typedef struct {
   const cv_disc *d;
-  int *gof;      /* global dof of each free unknown */
+  int *gof;      /* y dof of each unknown, or -1 - (index into the multipliers) */
   long *colptr;
   cv_ldlt *L;
-  double *g, *gt, *delta, *Yt;
+  double *g, *gt, *delta, *Yt, *Mt, *dreg, *corr;
 } newton_ws;
 
 static void ws_free(newton_ws *w) {
@@ -31,37 +32,47 @@ static void ws_free(newton_ws *w) {
   cv_free(w->gt);
   cv_free(w->delta);
   cv_free(w->Yt);
+  cv_free(w->Mt);
+  cv_free(w->dreg);
+  cv_free(w->corr);
 }
 
-/* Column c of the upper triangle holds the rows from the first free unknown of the first
- * element containing c's node up to c (block-banded pattern, theory E-2). */
-static cv_status ws_init(newton_ws *w, const cv_disc *d) {
-  size_t nf = (size_t)d->nfree;
+/* Column c of the upper triangle holds the rows from the first unknown of the first
+ * element containing c's node up to c (block-banded pattern, theory E-2); an integral
+ * multiplier's column is dense (C-3). */
+static cv_status ws_init(newton_ws *w, const cv_disc *d, size_t nmult) {
+  size_t nf = (size_t)d->nfree, one = nf ? nf : 1;
   memset(w, 0, sizeof *w);
   w->d = d;
-  w->gof = cv_malloc((nf ? nf : 1) * sizeof *w->gof);
+  w->gof = cv_malloc(one * sizeof *w->gof);
   w->colptr = cv_malloc((nf + 1) * sizeof *w->colptr);
-  w->g = cv_malloc((nf ? nf : 1) * sizeof *w->g);
-  w->gt = cv_malloc((nf ? nf : 1) * sizeof *w->gt);
-  w->delta = cv_malloc((nf ? nf : 1) * sizeof *w->delta);
+  w->g = cv_malloc(one * sizeof *w->g);
+  w->gt = cv_malloc(one * sizeof *w->gt);
+  w->delta = cv_malloc(one * sizeof *w->delta);
+  w->dreg = cv_malloc(one * sizeof *w->dreg);
+  w->corr = cv_malloc(one * sizeof *w->corr);
   w->Yt = cv_malloc((size_t)d->ndof * sizeof *w->Yt);
-  if (!w->gof || !w->colptr || !w->g || !w->gt || !w->delta || !w->Yt) return CVAR_ENOMEM;
-  /* gof: interior free indices are a shift of the global ones (E-2); ends by table. */
-  int n = d->n, p = d->p;
-  for (int i = 0; i < n; i++) {
-    if (d->fix0[i] >= 0) w->gof[d->fix0[i]] = i;
-    if (d->fix1[i] >= 0) w->gof[d->fix1[i]] = (d->nodes - 1) * n + i;
-  }
-  for (long f = d->nfree0, end = d->nfree0 + (long)(d->nodes - 2) * n; f < end; f++)
-    w->gof[f] = (int)(f - d->nfree0 + n);
+  w->Mt = cv_malloc((nmult ? nmult : 1) * sizeof *w->Mt);
+  if (!w->gof || !w->colptr || !w->g || !w->gt || !w->delta || !w->Yt || !w->Mt ||
+      !w->dreg || !w->corr)
+    return CVAR_ENOMEM;
+  int n = d->n, p = d->p, nc = d->nc;
   w->colptr[0] = 0;
   for (long J = 0, e = 0; J < d->nodes; J++) {
     if (J > 1 && (J - 1) % p == 0) e++; /* e = first element containing node J */
-    long r0 = e == 0 ? 0 : cv_disc_fidx(d, e * p * n);
-    for (int i = 0; i < n; i++) {
-      int c = cv_disc_fidx(d, J * n + i);
-      if (c >= 0) w->colptr[c + 1] = w->colptr[c] + ((long)c - r0 + 1);
+    long r0 = cv_disc_elem_first(d, e);
+    /* the node's unknowns in increasing order: y components, then multipliers */
+    for (int t = 0; t < n + nc; t++) {
+      int c = t < n ? cv_disc_fidx(d, J * n + t) : cv_disc_lidx(d, J, t - n);
+      if (c < 0) continue;
+      w->gof[c] = t < n ? (int)(J * n + t) : -1 - (int)(J * nc + t - n);
+      w->colptr[c + 1] = w->colptr[c] + ((long)c - r0 + 1);
     }
+  }
+  for (int r = 0; r < d->ni; r++) {
+    int c = d->nu0 + r;
+    w->gof[c] = -1 - (int)((long)d->nodes * nc + r);
+    w->colptr[c + 1] = w->colptr[c] + c + 1;
   }
   w->L = cv_ldlt_new(d->nfree, w->colptr);
   return w->L ? CVAR_OK : CVAR_ENOMEM;
@@ -91,11 +102,37 @@ static const char *where_failed(cv_status st) {
                               : "the integrand (or a partial) is not finite";
 }
 
-cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y) {
+/* x <- K^{-1} x for the unregularised K = Kd + diag(dreg) from the factor of Kd, the
+ * regularised (quasi-definite) matrix, by iterative refinement (C-4):
+ * x_{k+1} = x_k + Kd^{-1} (b - K x_k) = x_k - Kd^{-1} (dreg .* x_k). */
+static cv_status solve_refined(newton_ws *w, int nf, int regularised) {
+  cv_status st = cv_ldlt_solve(w->L, w->delta);
+  for (int it = 0; it < REFINE_STEPS && regularised && !st; it++) {
+    for (int f = 0; f < nf; f++) w->corr[f] = -w->dreg[f] * w->delta[f];
+    st = cv_ldlt_solve(w->L, w->corr);
+    for (int f = 0; f < nf && !st; f++) w->delta[f] += w->corr[f];
+  }
+  return st;
+}
+
+static void apply_step(newton_ws *w, const double *Y, const double *M, size_t nmult,
+                       double alpha) {
+  const cv_disc *d = w->d;
+  memcpy(w->Yt, Y, (size_t)d->ndof * sizeof *Y);
+  if (nmult) memcpy(w->Mt, M, nmult * sizeof *M);
+  for (int f = 0; f < d->nfree; f++) {
+    int gi = w->gof[f];
+    if (gi >= 0) w->Yt[gi] += alpha * w->delta[f];
+    else w->Mt[-1 - gi] += alpha * w->delta[f];
+  }
+}
+
+cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M) {
   newton_ws w;
-  cv_assembler as;
+  cv_kkt kkt;
   cv_status st;
-  int nf = d->nfree;
+  int nf = d->nfree, ncon = 0;
+  size_t nmult = (size_t)d->nodes * d->nc + d->ni;
   double S = 0.0, scale = 0.0;
   char detail[200] = "";
 
@@ -104,12 +141,25 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   s->degenerate = 0;
   s->gnorm = NAN;
   s->action = NAN;
-  memset(&as, 0, sizeof as);
-  st = ws_init(&w, d);
-  if (!st) st = cv_assembler_init(&as, p, d);
+  memset(&kkt, 0, sizeof kkt);
+  st = ws_init(&w, d, nmult);
+  if (!st) st = cv_kkt_init(&kkt, p, d, w.colptr);
   if (st) {
     cv_set_msg(s->msg, sizeof s->msg, "out of memory setting up %d unknowns", nf);
     goto cleanup;
+  }
+  for (int f = 0; f < nf; f++) ncon += w.gof[f] < 0;
+  int constrained = ncon > 0;
+  if (d->nc > 0) {
+    st = cv_kkt_check_ends(&kkt, Y, s->msg, sizeof s->msg);
+    if (st) goto cleanup;
+  }
+  if (constrained) {
+    st = cv_kkt_init_multipliers(&kkt, Y, M);
+    if (st) {
+      cv_set_msg(s->msg, sizeof s->msg, "%s at the initial guess", where_failed(st));
+      goto cleanup;
+    }
   }
   /* Absolute floor of the step tolerance: atol times the size of the solution (STYLE 8). */
   for (long i = 0; i < d->ndof; i++)
@@ -117,7 +167,9 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   if (scale == 0.0) scale = 1.0;
   double atol = s->atol * scale, *Ax = cv_ldlt_values(w.L);
 
-  st = cv_assemble(&as, Y, &S, w.g, w.colptr, Ax);
+  double ta = cv_now();
+  st = cv_kkt_eval(&kkt, Y, M, &S, w.g, Ax, w.dreg);
+  s->t_assemble += cv_now() - ta;
   if (st) {
     s->action = NAN;
     cv_set_msg(s->msg, sizeof s->msg, "%s at the initial guess; give a [guess] inside the "
@@ -140,65 +192,68 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     if (st) {
       if (st == CVAR_ESINGULAR) {
         s->degenerate = 1;
-        s->morse = neg;
+        s->morse = neg - ncon;
         cv_set_msg(s->msg, sizeof s->msg,
-                   "the Hessian is singular (pivot ratio %.1e at iteration %d): the action is "
-                   "flat along some direction, as for an integrand invariant under "
-                   "reparametrisation such as arc length sqrt(x'^2 + y'^2); use the energy "
-                   "form x'^2 + y'^2 instead",
+                   constrained
+                       ? "the Hessian of the Lagrangian is singular (pivot ratio %.1e at "
+                         "iteration %d): the constraints may be dependent or the action flat "
+                         "along them"
+                       : "the Hessian is singular (pivot ratio %.1e at iteration %d): the "
+                         "action is flat along some direction, as for an integrand invariant "
+                         "under reparametrisation such as arc length sqrt(x'^2 + y'^2); use "
+                         "the energy form x'^2 + y'^2 instead",
                    dmin, s->iterations);
       } else {
         cv_set_msg(s->msg, sizeof s->msg, "%s", detail);
       }
       goto cleanup;
     }
-    s->morse = neg;
+    /* Each constraint row adds one negative pivot to a quasi-definite KKT matrix (N-1). */
+    s->morse = neg - ncon;
     for (int f = 0; f < nf; f++) w.delta[f] = -w.g[f];
-    st = cv_ldlt_solve(w.L, w.delta);
+    st = solve_refined(&w, nf, constrained);
     s->t_factor += cv_now() - tf;
     if (st) {
       cv_set_msg(s->msg, sizeof s->msg, "CHOLMOD solve failed");
       goto cleanup;
     }
     s->iterations++;
-    /* Weighted RMS norm of the step, weights 1/(rtol |y| + atol) (N-4). */
+    /* Weighted RMS norm of the step in y, weights 1/(rtol |y| + atol) (N-4). */
     double wn = 0.0, slope = 0.0;
+    int ny = 0;
     for (int f = 0; f < nf; f++) {
+      slope += w.g[f] * w.delta[f];
+      if (w.gof[f] < 0) continue;
       double v = w.delta[f] / (s->rtol * fabs(Y[w.gof[f]]) + atol);
       wn += v * v;
-      slope += w.g[f] * w.delta[f];
+      ny++;
     }
-    wn = sqrt(wn / nf);
+    wn = sqrt(wn / (ny ? ny : 1));
     if (!isfinite(wn)) {
       st = CVAR_ENONFINITE;
       cv_set_msg(s->msg, sizeof s->msg, "the Newton step is not finite");
       goto cleanup;
     }
-    /* Line search: on S where the Hessian is positive definite (the step descends S),
-     * else on the scaled residual merit phi = |g/m|^2 / 2, for which the Newton step is
-     * always a descent direction (N-2). */
+    /* Line search: on S where the Hessian is positive definite and nothing is constrained
+     * (the step descends S), else on the scaled residual merit phi = |g/m|^2 / 2, for
+     * which the Newton step is always a descent direction (N-2). */
     double phi = residual_merit(d, w.g), alpha = 1.0, St = 0.0;
-    int accepted = 0;
+    int accepted = 0, use_S = neg == 0 && !constrained && slope < 0;
     for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
-      for (long i = 0; i < d->ndof; i++) w.Yt[i] = Y[i];
-      for (int f = 0; f < nf; f++) w.Yt[w.gof[f]] += alpha * w.delta[f];
-      double ta = cv_now();
-      cv_status ast = cv_assemble(&as, w.Yt, &St, w.gt, w.colptr, Ax);
+      apply_step(&w, Y, M, nmult, alpha);
+      ta = cv_now();
+      cv_status ast = cv_kkt_eval(&kkt, w.Yt, w.Mt, &St, w.gt, Ax, w.dreg);
       s->t_assemble += cv_now() - ta;
-      if (ast == CVAR_ECALLBACK) {
+      if (ast == CVAR_ECALLBACK || ast == CVAR_ENOMEM) {
         st = ast;
-        cv_set_msg(s->msg, sizeof s->msg, "%s", where_failed(ast));
-        goto cleanup;
-      }
-      if (ast == CVAR_ENOMEM) {
-        st = ast;
-        cv_set_msg(s->msg, sizeof s->msg, "out of memory");
+        cv_set_msg(s->msg, sizeof s->msg, "%s",
+                   ast == CVAR_ENOMEM ? "out of memory" : where_failed(ast));
         goto cleanup;
       }
       if (ast == CVAR_OK) {
         double phit = residual_merit(d, w.gt);
         int ok_res = phit <= (1.0 - 2.0 * ARMIJO * alpha) * phi;
-        int ok_S = neg == 0 && slope < 0 && St <= S + ARMIJO * alpha * slope;
+        int ok_S = use_S && St <= S + ARMIJO * alpha * slope;
         /* Near the solution S changes by less than its round-off; a step within the
          * tolerance is then taken in full. */
         if (ok_res || ok_S || wn <= 1.0) {
@@ -221,7 +276,8 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     double *tmp = w.g;
     w.g = w.gt;
     w.gt = tmp;
-    for (long i = 0; i < d->ndof; i++) Y[i] = w.Yt[i];
+    memcpy(Y, w.Yt, (size_t)d->ndof * sizeof *Y);
+    if (nmult) memcpy(M, w.Mt, nmult * sizeof *M);
     S = St;
     s->action = S;
     s->gnorm = residual_norm(d, w.g);
@@ -250,7 +306,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     }
   }
 cleanup:
-  cv_assembler_free(&as);
+  cv_kkt_free(&kkt);
   ws_free(&w);
   return st;
 }

@@ -44,6 +44,12 @@ static void release_integrand(cv_problem *p) {
 void cv_problem_free(cv_problem *p) {
   if (!p) return;
   release_integrand(p);
+  for (int k = 0; k < p->nc; k++)
+    if (p->pc[k].release) p->pc[k].release(p->pc[k].user);
+  for (int k = 0; k < p->ni; k++)
+    if (p->ic[k].release) p->ic[k].release(p->ic[k].user);
+  cv_free(p->pc);
+  cv_free(p->ic);
   cv_free(p->fixed);
   cv_free(p->endval);
   cv_free(p);
@@ -101,3 +107,57 @@ void cv_problem_get_interval(const cv_problem *p, double *a, double *b) {
   if (a) *a = p->a;
   if (b) *b = p->b;
 }
+
+cv_status cv_problem_add_constraint_owned(cv_problem *p, cv_constraint_fn G, void *user,
+                                          void (*release)(void *), int *index) {
+  cv_pconstraint *grown;
+  if (!p || !G) {
+    if (release) release(user);
+    return CVAR_EINVAL;
+  }
+  grown = cv_malloc((size_t)(p->nc + 1) * sizeof *grown);
+  if (!grown) {
+    if (release) release(user);
+    return CVAR_ENOMEM;
+  }
+  for (int k = 0; k < p->nc; k++) grown[k] = p->pc[k];
+  grown[p->nc] = (cv_pconstraint){G, user, release};
+  cv_free(p->pc);
+  p->pc = grown;
+  if (index) *index = p->nc;
+  p->nc++;
+  return CVAR_OK;
+}
+
+cv_status cv_problem_add_constraint(cv_problem *p, cv_constraint_fn G, void *user, int *index) {
+  return cv_problem_add_constraint_owned(p, G, user, NULL, index);
+}
+
+cv_status cv_problem_add_integral_owned(cv_problem *p, cv_integrand_fn K, void *user,
+                                        void (*release)(void *), double c, int *index) {
+  cv_iconstraint *grown;
+  if (!p || !K || !isfinite(c)) {
+    if (release) release(user);
+    return CVAR_EINVAL;
+  }
+  grown = cv_malloc((size_t)(p->ni + 1) * sizeof *grown);
+  if (!grown) {
+    if (release) release(user);
+    return CVAR_ENOMEM;
+  }
+  for (int k = 0; k < p->ni; k++) grown[k] = p->ic[k];
+  grown[p->ni] = (cv_iconstraint){K, user, release, c};
+  cv_free(p->ic);
+  p->ic = grown;
+  if (index) *index = p->ni;
+  p->ni++;
+  return CVAR_OK;
+}
+
+cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, void *user, double c,
+                                  int *index) {
+  return cv_problem_add_integral_owned(p, K, user, NULL, c, index);
+}
+
+int cv_problem_get_num_constraints(const cv_problem *p) { return p ? p->nc : 0; }
+int cv_problem_get_num_integrals(const cv_problem *p) { return p ? p->ni : 0; }

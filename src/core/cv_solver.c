@@ -29,6 +29,7 @@ void cv_solver_free(cv_solver *s) {
   cv_free(s->mesh.breaks);
   cv_free(s->start);
   cv_free(s->y);
+  cv_free(s->mult);
   cv_disc_free(&s->disc);
   cv_free(s);
 }
@@ -222,7 +223,8 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   double t0 = cv_now();
   cv_status st;
   cv_free(s->y);
-  s->y = NULL;
+  cv_free(s->mult);
+  s->y = s->mult = NULL;
   cv_disc_free(&s->disc);
   s->have = 0;
   s->iterations = 0;
@@ -242,7 +244,8 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
     goto done;
   }
   s->y = cv_malloc((size_t)s->disc.ndof * sizeof *s->y);
-  if (!s->y) {
+  s->mult = cv_calloc((size_t)s->disc.nodes * p->nc + p->ni + 1, sizeof *s->mult);
+  if (!s->y || !s->mult) {
     st = CVAR_ENOMEM;
     cv_set_msg(s->msg, sizeof s->msg, "out of memory for %d nodal values", s->disc.ndof);
     goto done;
@@ -251,7 +254,7 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   if (st) goto done;
   s->have = 1;
   detect_singular_ends(p, &s->disc, s->y);
-  st = cv_newton_run(s, p, &s->disc, s->y);
+  st = cv_newton_run(s, p, &s->disc, s->y, s->mult);
 done:
   s->status = st;
   s->time = cv_now() - t0;
@@ -371,5 +374,42 @@ cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y, 
     }
   }
   cv_free(buf);
+  return CVAR_OK;
+}
+
+cv_status cv_solver_get_multiplier_field(const cv_solver *s, int k, double *lambda) {
+  if (!s || !lambda) return CVAR_EINVAL;
+  if (!s->have) return CVAR_ESTATE;
+  const cv_disc *d = &s->disc;
+  if (k < 0 || k >= d->nc) return CVAR_EINVAL;
+  long N = d->nodes;
+  for (long j = 0; j < N; j++) lambda[j] = s->mult[j * d->nc + k];
+  /* An end node whose unknowns are all fixed has no multiplier: extrapolate with the
+   * polynomial through the next K = max(2, p) nodes (error O(h^K) for a smooth field). */
+  for (int end = 0; end < 2; end++) {
+    if ((end ? d->lamL : d->lam0) >= 0) continue;
+    int K = d->p > 2 ? d->p : 2;
+    if (K > N - 1) K = (int)N - 1;
+    long j0 = end ? N - 1 : 0, dir = end ? -1 : 1;
+    double x0 = cv_disc_node_x(d, j0), v = 0.0;
+    for (int a = 1; a <= K; a++) {
+      double xa = cv_disc_node_x(d, j0 + dir * a), wgt = 1.0;
+      for (int b = 1; b <= K; b++)
+        if (b != a) {
+          double xb = cv_disc_node_x(d, j0 + dir * b);
+          wgt *= (x0 - xb) / (xa - xb);
+        }
+      v += wgt * lambda[j0 + dir * a];
+    }
+    lambda[j0] = v;
+  }
+  return CVAR_OK;
+}
+
+cv_status cv_solver_get_multiplier(const cv_solver *s, int k, double *mu) {
+  if (!s || !mu) return CVAR_EINVAL;
+  if (!s->have) return CVAR_ESTATE;
+  if (k < 0 || k >= s->disc.ni) return CVAR_EINVAL;
+  *mu = s->mult[(size_t)s->disc.nodes * s->disc.nc + k];
   return CVAR_OK;
 }

@@ -1,0 +1,228 @@
+/* src/core/cv_kkt.c — the stationarity system of the discrete Lagrangian: the action plus
+ * pointwise constraints at the nodes and integral constraints, with its gradient and
+ * (quasi-definite) Hessian, theory (C-1)-(C-4).
+ * SPDX-License-Identifier: MIT */
+#include <math.h>
+#include <string.h>
+
+#include "cv_internal.h"
+
+cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const long *colptr) {
+  size_t n = (size_t)d->n, B = CV_BATCH;
+  memset(k, 0, sizeof *k);
+  k->prob = p;
+  k->d = d;
+  k->colptr = colptr;
+  cv_status st = cv_assembler_init(&k->as, p, d);
+  if (st) return st;
+  if (p->nc > 0) {
+    k->xn = cv_malloc((size_t)d->nodes * sizeof *k->xn);
+    k->cbuf = cv_malloc((2 + 2 * n + n * n) * B * sizeof *k->cbuf);
+    if (!k->xn || !k->cbuf) return CVAR_ENOMEM;
+    cv_disc_fill_nodes(d, k->xn);
+  }
+  if (p->ni > 0) {
+    k->gK = cv_malloc((size_t)d->nfree * sizeof *k->gK);
+    if (!k->gK) return CVAR_ENOMEM;
+  }
+  return CVAR_OK;
+}
+
+void cv_kkt_free(cv_kkt *k) {
+  cv_assembler_free(&k->as);
+  cv_free(k->xn);
+  cv_free(k->cbuf);
+  cv_free(k->gK);
+}
+
+/* Position of entry (r, c), r <= c, in the upper-triangle column layout (E-2). */
+static inline long pos(const long *colptr, long r, long c) {
+  return colptr[c] + r - (c + 1 - (colptr[c + 1] - colptr[c]));
+}
+
+/* Evaluate pointwise constraint kc at nodes j0 .. j0+m-1 into the batch buffers. */
+static cv_status eval_constraint(cv_kkt *k, int kc, const double *Y, long j0, int m,
+                                 unsigned need, double **G, double **Gy, double **Gyy) {
+  const cv_disc *d = k->d;
+  int n = d->n;
+  double *x = k->cbuf, *y = x + CV_BATCH, *g = y + (size_t)n * CV_BATCH;
+  double *gy = g + CV_BATCH, *gyy = gy + (size_t)n * CV_BATCH;
+  for (int t = 0; t < m; t++) {
+    x[t] = k->xn[j0 + t];
+    for (int i = 0; i < n; i++) y[i * m + t] = Y[(j0 + t) * n + i];
+  }
+  const cv_pconstraint *c = &k->prob->pc[kc];
+  int rc = c->G(m, x, y, need, g, (need & CVAR_NEED_GRAD) ? gy : NULL,
+                (need & CVAR_NEED_HESS) ? gyy : NULL, c->user);
+  if (rc < 0) return CVAR_ECALLBACK;
+  if (rc > 0) return CVAR_ENONFINITE;
+  *G = g;
+  *Gy = gy;
+  *Gyy = gyy;
+  return CVAR_OK;
+}
+
+cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len) {
+  const cv_disc *d = k->d;
+  int n = d->n;
+  for (int end = 0; end < 2; end++) {
+    long node = end ? d->nodes - 1 : 0;
+    if (cv_disc_lidx(d, node, 0) >= 0) continue; /* has multipliers: imposed by Newton */
+    for (int kc = 0; kc < d->nc; kc++) {
+      double *G, *Gy, *Gyy;
+      cv_status st = eval_constraint(k, kc, Y, node, 1, CVAR_NEED_F | CVAR_NEED_GRAD, &G, &Gy,
+                                     &Gyy);
+      /* Scale of G near the end values: |grad G| |y| (or 1), so the test is relative. */
+      double sc = 0.0;
+      for (int i = 0; i < n && !st; i++) sc += fabs(Gy[i]) * fabs(Y[node * n + i]);
+      if (st || !(fabs(G[0]) <= 1e-9 * fmax(1.0, sc))) {
+        cv_set_msg(msg, len,
+                   "pointwise constraint %d does not hold at the fixed end x = %g (G = %.3g); "
+                   "choose end values on the constraint",
+                   kc, k->xn[node], st ? NAN : G[0]);
+        return CVAR_EINVAL;
+      }
+    }
+  }
+  return CVAR_OK;
+}
+
+/* Gradient and Hessian of the discrete Lagrangian
+ *   L_h = S_h(Y) + sum_j m_j sum_k lam_jk G_k(x_j, Y_j) + sum_r nu_r (I_r(Y) - c_r)
+ * with respect to all unknowns (C-3); *S is S_h alone. The multiplier rows' diagonal gets
+ * -delta (quasi-definite regularisation, C-4), also written to dreg (length nfree, zero on
+ * the other rows) so that the solve can refine it away. */
+cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, double *G,
+                      double *Ax, double *dreg) {
+  const cv_disc *d = k->d;
+  const cv_problem *p = k->prob;
+  const long *cp = k->colptr;
+  int n = d->n, nc = d->nc, nf = d->nfree;
+  cv_status st;
+  memset(G, 0, (size_t)nf * sizeof *G);
+  if (Ax) memset(Ax, 0, (size_t)cp[nf] * sizeof *Ax);
+  if (dreg) memset(dreg, 0, (size_t)nf * sizeof *dreg);
+  st = cv_assemble(&k->as, p->F, p->user, Y, S, G, cp, Ax, 1.0);
+  if (st) return st;
+  double hmax = 0.0; /* largest diagonal entry of the action's Hessian, for delta */
+  if (Ax)
+    for (int c = 0; c < nf; c++) hmax = fmax(hmax, fabs(Ax[cp[c + 1] - 1]));
+  if (!(hmax > 0)) hmax = 1.0;
+
+  /* Integral constraints (C-2): row nu0+r holds I_r - c_r, column its gradient. */
+  for (int r = 0; r < d->ni; r++) {
+    const cv_iconstraint *ic = &p->ic[r];
+    double I, nu = M[(size_t)d->nodes * nc + r];
+    int row = d->nu0 + r;
+    memset(k->gK, 0, (size_t)nf * sizeof *k->gK);
+    st = cv_assemble(&k->as, ic->K, ic->user, Y, &I, k->gK, cp, Ax, nu);
+    if (st) return st;
+    G[row] = I - ic->c;
+    double gg = 0.0;
+    for (int f = 0; f < d->nu0; f++) {
+      G[f] += nu * k->gK[f];
+      gg += k->gK[f] * k->gK[f];
+      if (Ax) Ax[pos(cp, f, row)] = k->gK[f];
+    }
+    if (Ax) {
+      double delta = 1e-12 * gg / hmax;
+      Ax[pos(cp, row, row)] = -delta;
+      if (dreg) dreg[row] = delta;
+    }
+  }
+
+  /* Pointwise constraints at the nodes (C-1): row lam_jk holds m_j G_k(x_j, Y_j). */
+  unsigned need = CVAR_NEED_F | CVAR_NEED_GRAD | (Ax ? CVAR_NEED_HESS : 0u);
+  for (long j0 = 0; j0 < d->nodes && nc > 0; j0 += CV_BATCH) {
+    int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
+    for (int kc = 0; kc < nc; kc++) {
+      double *g, *gy, *gyy;
+      st = eval_constraint(k, kc, Y, j0, m, need, &g, &gy, &gyy);
+      if (st) return st;
+      for (int t = 0; t < m; t++) {
+        long node = j0 + t;
+        int row = cv_disc_lidx(d, node, kc);
+        if (row < 0) continue;
+        double mj = d->mass[row], lam = M[node * nc + kc], gg = 0.0;
+        if (!isfinite(g[t])) return CVAR_ENONFINITE;
+        G[row] = mj * g[t];
+        for (int i = 0; i < n; i++) {
+          int fi = cv_disc_fidx(d, node * n + i);
+          if (!isfinite(gy[i * m + t])) return CVAR_ENONFINITE;
+          if (fi < 0) continue;
+          G[fi] += mj * lam * gy[i * m + t];
+          gg += mj * mj * gy[i * m + t] * gy[i * m + t];
+          if (!Ax) continue;
+          Ax[pos(cp, fi, row)] = mj * gy[i * m + t];
+          for (int i2 = i; i2 < n; i2++) { /* upper triangle: fi <= fi2 */
+            int fi2 = cv_disc_fidx(d, node * n + i2);
+            double h2 = gyy[(i * n + i2) * m + t];
+            if (!isfinite(h2)) return CVAR_ENONFINITE;
+            if (fi2 >= 0) Ax[pos(cp, fi, fi2)] += mj * lam * h2;
+          }
+        }
+        if (Ax) {
+          double delta = 1e-12 * gg / hmax;
+          Ax[pos(cp, row, row)] = -delta;
+          if (dreg) dreg[row] = delta;
+        }
+      }
+    }
+  }
+  return CVAR_OK;
+}
+
+/* Starting multipliers by least squares from the stationarity condition at Y (C-5):
+ * mu_r = -<g, grad I_r> / <grad I_r, grad I_r> in the inner product weighted by 1/m_f^2
+ * (the scaled residual of N-3), then at each node lam_jk = -<g_j, grad G_k> / (m_j |grad
+ * G_k|^2) over its free components, each with g updated by the previous ones. Starting
+ * from zero multipliers leaves the Hessian of F alone, which for a chain or an area
+ * functional is indefinite or zero. */
+cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M) {
+  const cv_disc *d = k->d;
+  const cv_problem *p = k->prob;
+  int n = d->n, nc = d->nc, nf = d->nfree;
+  double S, *g = cv_calloc((size_t)(nf ? nf : 1), sizeof *g);
+  if (!g) return CVAR_ENOMEM;
+  cv_status st = cv_assemble(&k->as, p->F, p->user, Y, &S, g, k->colptr, NULL, 0.0);
+  for (int r = 0; r < d->ni && !st; r++) {
+    double I, num = 0.0, den = 0.0;
+    memset(k->gK, 0, (size_t)nf * sizeof *k->gK);
+    st = cv_assemble(&k->as, p->ic[r].K, p->ic[r].user, Y, &I, k->gK, k->colptr, NULL, 0.0);
+    for (int f = 0; f < d->nu0 && !st; f++) {
+      double w = 1.0 / (d->mass[f] * d->mass[f]);
+      num += w * g[f] * k->gK[f];
+      den += w * k->gK[f] * k->gK[f];
+    }
+    double mu = den > 0 ? -num / den : 0.0;
+    M[(size_t)d->nodes * nc + r] = mu;
+    for (int f = 0; f < d->nu0; f++) g[f] += mu * k->gK[f];
+  }
+  for (long j0 = 0; j0 < d->nodes && nc > 0 && !st; j0 += CV_BATCH) {
+    int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
+    for (int kc = 0; kc < nc && !st; kc++) {
+      double *G, *gy, *gyy;
+      st = eval_constraint(k, kc, Y, j0, m, CVAR_NEED_F | CVAR_NEED_GRAD, &G, &gy, &gyy);
+      for (int t = 0; t < m && !st; t++) {
+        long node = j0 + t;
+        int row = cv_disc_lidx(d, node, kc);
+        if (row < 0) continue;
+        double num = 0.0, den = 0.0, mj = d->mass[row];
+        for (int i = 0; i < n; i++) {
+          int fi = cv_disc_fidx(d, node * n + i);
+          if (fi < 0) continue;
+          num += g[fi] * gy[i * m + t];
+          den += gy[i * m + t] * gy[i * m + t];
+        }
+        double lam = den > 0 && isfinite(num) ? -num / (mj * den) : 0.0;
+        M[node * nc + kc] = lam;
+        for (int i = 0; i < n; i++) {
+          int fi = cv_disc_fidx(d, node * n + i);
+          if (fi >= 0) g[fi] += mj * lam * gy[i * m + t];
+        }
+      }
+    }
+  }
+  cv_free(g);
+  return st;
+}
