@@ -1,0 +1,247 @@
+/* src/expr/cv_integrand_expr.c — cv_problem_set_integrand_expr: an integrand given as a
+ * formula string, compiled with exact symbolic partials. SPDX-License-Identifier: MIT */
+#include <ctype.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "calcvar.h"
+#include "core/cv_internal_owned.h"
+#include "expr/ex_integrand.h"
+
+/* Names known while parsing: the variable (slot 0), the unknowns (slots 1..n, primed
+ * n+1..2n) and the parameters defined so far (numbers). */
+typedef struct {
+  const char *var;
+  int n;
+  char **unk;
+  int np;          /* parameters usable now */
+  char **pname;
+  double *pval;
+  int const_only;  /* parsing a parameter: only numbers, pi and earlier parameters */
+} names;
+
+static void msg(char *err, size_t errlen, const char *fmt, ...) {
+  if (!err || !errlen) return;
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(err, errlen, fmt, ap);
+  va_end(ap);
+}
+
+static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *err,
+                     size_t errlen) {
+  const names *c = user;
+  for (int i = 0; i < c->np; i++)
+    if (strcmp(name, c->pname[i]) == 0) {
+      if (primes) {
+        msg(err, errlen, "a prime is only allowed on an unknown ('%s' is a parameter)", name);
+        return -1;
+      }
+      return ex_num(d, c->pval[i]);
+    }
+  int slot = -1;
+  if (strcmp(name, c->var) == 0) {
+    if (primes) {
+      msg(err, errlen, "a prime is only allowed on an unknown ('%s' is the variable)", name);
+      return -1;
+    }
+    slot = 0;
+  }
+  for (int i = 0; i < c->n && slot < 0; i++)
+    if (strcmp(name, c->unk[i]) == 0) slot = 1 + i + (primes ? c->n : 0);
+  if (slot < 0) {
+    msg(err, errlen, "unknown name '%s'", name);
+    return -1;
+  }
+  if (c->const_only) {
+    msg(err, errlen, "'%s' is not a constant (a parameter may use numbers, pi and earlier "
+        "parameters)", name);
+    return -1;
+  }
+  ex_id e = ex_slot(d, slot);
+  if (e < 0) msg(err, errlen, "out of memory");
+  return e;
+}
+
+/* Split s at commas outside parentheses into a NULL-terminated array of trimmed copies,
+ * released with free_list. Returns NULL on allocation failure. */
+static char **split(const char *s, int *count) {
+  size_t len = strlen(s);
+  int parts = 1, depth = 0;
+  for (size_t i = 0; i < len; i++) {
+    if (s[i] == '(') depth++;
+    else if (s[i] == ')') depth--;
+    else if (s[i] == ',' && depth == 0) parts++;
+  }
+  char **list = calloc((size_t)parts + 1, sizeof *list);
+  if (!list) return NULL;
+  size_t start = 0;
+  int k = 0;
+  depth = 0;
+  for (size_t i = 0; i <= len; i++) {
+    if (i < len && s[i] == '(') depth++;
+    else if (i < len && s[i] == ')') depth--;
+    if (i == len || (s[i] == ',' && depth == 0)) {
+      size_t a = start, b = i;
+      while (a < b && isspace((unsigned char)s[a])) a++;
+      while (b > a && isspace((unsigned char)s[b - 1])) b--;
+      list[k] = malloc(b - a + 1);
+      if (!list[k]) {
+        for (int j = 0; j < k; j++) free(list[j]);
+        free(list);
+        return NULL;
+      }
+      memcpy(list[k], s + a, b - a);
+      list[k][b - a] = 0;
+      k++;
+      start = i + 1;
+    }
+  }
+  *count = k;
+  return list;
+}
+
+static void free_list(char **list) {
+  if (!list) return;
+  for (int i = 0; list[i]; i++) free(list[i]);
+  free(list);
+}
+
+static const char *const reserved[] = {"pi", "sin", "cos", "tan", "asin", "acos", "atan",
+                                       "sinh", "cosh", "tanh", "asinh", "acosh", "atanh",
+                                       "exp", "log", "sqrt", "abs", "atan2", "pow", "min",
+                                       "max", "if"};
+
+/* A usable name: an identifier that is neither a function nor pi. Returns the reason
+ * it is not, or NULL. */
+static const char *bad_name(const char *s) {
+  if (!s[0]) return "is empty";
+  if (!(isalpha((unsigned char)s[0]) || s[0] == '_')) return "does not start with a letter";
+  for (const char *q = s; *q; q++)
+    if (!(isalnum((unsigned char)*q) || *q == '_')) return "is not a name (letters, digits, _)";
+  for (size_t i = 0; i < sizeof reserved / sizeof reserved[0]; i++)
+    if (strcmp(s, reserved[i]) == 0) return "is reserved (a function or pi)";
+  return NULL;
+}
+
+cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
+                                        const char *unknowns, const char *F,
+                                        const char *parameters, char *err, size_t errlen) {
+  if (err && errlen) err[0] = 0;
+  if (!p || !unknowns || !F) {
+    msg(err, errlen, "problem, unknowns and integrand must not be NULL");
+    return CVAR_EINVAL;
+  }
+  cv_status st = CVAR_EINVAL;
+  names c = {variable ? variable : "x", 0, NULL, 0, NULL, NULL, 0};
+  char **plist = NULL;
+  ex_dag *d = NULL;
+  int np = 0;
+  const char *why;
+  char perr[300];
+
+  if ((why = bad_name(c.var))) {
+    msg(err, errlen, "variable: '%s' %s", c.var, why);
+    goto cleanup;
+  }
+  c.unk = split(unknowns, &c.n);
+  if (!c.unk) goto nomem;
+  if (c.n != cv_problem_get_num_unknowns(p)) {
+    msg(err, errlen, "unknowns: %d name%s given, but the problem has %d unknown%s", c.n,
+        c.n == 1 ? "" : "s", cv_problem_get_num_unknowns(p),
+        cv_problem_get_num_unknowns(p) == 1 ? "" : "s");
+    goto cleanup;
+  }
+  for (int i = 0; i < c.n; i++) {
+    if ((why = bad_name(c.unk[i]))) {
+      msg(err, errlen, "unknowns: '%s' %s", c.unk[i], why);
+      goto cleanup;
+    }
+    if (strcmp(c.unk[i], c.var) == 0) {
+      msg(err, errlen, "unknowns: '%s' is also the variable", c.unk[i]);
+      goto cleanup;
+    }
+    for (int j = 0; j < i; j++)
+      if (strcmp(c.unk[i], c.unk[j]) == 0) {
+        msg(err, errlen, "unknowns: '%s' is listed twice", c.unk[i]);
+        goto cleanup;
+      }
+  }
+  d = ex_dag_new();
+  if (!d) goto nomem;
+  if (parameters && parameters[0]) {
+    plist = split(parameters, &np);
+    if (!plist) goto nomem;
+    c.pname = calloc((size_t)np, sizeof *c.pname);
+    c.pval = calloc((size_t)np, sizeof *c.pval);
+    if (!c.pname || !c.pval) goto nomem;
+    for (int i = 0; i < np; i++) {
+      char *eq = strchr(plist[i], '=');
+      if (!eq) {
+        msg(err, errlen, "parameters: '%s' is not of the form name = value", plist[i]);
+        goto cleanup;
+      }
+      char *name = plist[i], *end = eq;
+      *eq = 0;
+      while (end > name && isspace((unsigned char)end[-1])) *--end = 0;
+      if ((why = bad_name(name))) {
+        msg(err, errlen, "parameters: '%s' %s", name, why);
+        goto cleanup;
+      }
+      int clash = strcmp(name, c.var) == 0;
+      for (int j = 0; j < c.n; j++) clash |= strcmp(name, c.unk[j]) == 0;
+      for (int j = 0; j < i; j++) clash |= strcmp(name, c.pname[j]) == 0;
+      if (clash) {
+        msg(err, errlen, "parameters: the name '%s' is already used", name);
+        goto cleanup;
+      }
+      c.const_only = 1;
+      c.np = i;
+      const char *value = eq + 1; /* columns count from the value's first character */
+      while (isspace((unsigned char)*value)) value++;
+      ex_id e = ex_parse(d, value, resolve, &c, 0, perr, sizeof perr);
+      double v;
+      if (e < 0) {
+        msg(err, errlen, "parameter '%s': %s", name, perr);
+        goto cleanup;
+      }
+      if (ex_eval_const(d, e, &v) != 0 || !isfinite(v)) {
+        msg(err, errlen, "parameter '%s': the value is not a finite number", name);
+        goto cleanup;
+      }
+      c.pname[i] = name;
+      c.pval[i] = v;
+    }
+  }
+  c.const_only = 0;
+  c.np = np;
+  ex_id f = ex_parse(d, F, resolve, &c, 0, perr, sizeof perr);
+  if (f < 0) {
+    msg(err, errlen, "integrand: %s", perr);
+    goto cleanup;
+  }
+  ex_integrand *g = ex_integrand_new(d, c.n, f, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS,
+                                     perr, sizeof perr);
+  if (!g) {
+    msg(err, errlen, "integrand: %s", perr);
+    st = CVAR_ENOMEM;
+    goto cleanup;
+  }
+  /* The problem owns g from here on, also when the call fails (it releases it). */
+  st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
+  if (st != CVAR_OK) msg(err, errlen, "%s", cv_strerror(st));
+  goto cleanup;
+nomem:
+  msg(err, errlen, "out of memory");
+  st = CVAR_ENOMEM;
+cleanup:
+  ex_dag_free(d);
+  free_list(c.unk);
+  free_list(plist);
+  free(c.pname);
+  free(c.pval);
+  return st;
+}

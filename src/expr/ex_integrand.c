@@ -1,0 +1,170 @@
+/* src/expr/ex_integrand.c — partials of F(x, y, y') compiled to tapes, evaluated through
+ * the core's integrand callback. SPDX-License-Identifier: MIT */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "expr/ex_integrand.h"
+
+struct ex_integrand {
+  int n;
+  unsigned max_need;
+  ex_tape *tape[3]; /* level 0: F; 1: F, Fy, Fp; 2: also Fyy (upper), Fyp, Fpp (upper) */
+  int nout[3];
+  int depends_on_dy; /* F reads some y'_i: not usable as a constraint G(x, y) */
+  double *work;     /* registers of the largest tape, one batch */
+  double *scratch;  /* one batch per output, for groups the caller did not ask for */
+  const double **in;
+  double **outp;
+};
+
+static void set_err(char *err, size_t errlen, const char *msg) {
+  if (err && errlen) snprintf(err, errlen, "%s", msg);
+}
+
+/* Upper-triangle index of (i, j), i <= j, in row-major order. */
+static int tri(int n, int i, int j) { return i * n - i * (i - 1) / 2 + (j - i); }
+
+ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, char *err,
+                               size_t errlen) {
+  if (!d || n < 1 || F < 0 || F >= ex_dag_num_nodes(d) || n > 1000) {
+    set_err(err, errlen, "invalid argument to ex_integrand_new");
+    return NULL;
+  }
+  int ntri = n * (n + 1) / 2;
+  int level = max_need & CVAR_NEED_HESS ? 2 : max_need & CVAR_NEED_GRAD ? 1 : 0;
+  int nout = level == 2 ? 1 + 2 * n + 2 * ntri + n * n : level == 1 ? 1 + 2 * n : 1;
+  ex_integrand *g = calloc(1, sizeof *g);
+  ex_id *outs = malloc((size_t)nout * sizeof *outs);
+  if (!g || !outs) goto nomem;
+  g->n = n;
+  g->max_need = max_need | CVAR_NEED_F;
+  for (int i = 0; i < n; i++) g->depends_on_dy |= ex_depends_on(d, F, 1 + n + i);
+  outs[0] = F;
+  if (level >= 1) {
+    for (int i = 0; i < n; i++) {
+      outs[1 + i] = ex_diff(d, F, 1 + i);
+      outs[1 + n + i] = ex_diff(d, F, 1 + n + i);
+      if (outs[1 + i] < 0 || outs[1 + n + i] < 0) goto nomem;
+    }
+  }
+  if (level == 2) {
+    ex_id *yy = outs + 1 + 2 * n, *yp = yy + ntri, *pp = yp + n * n;
+    for (int i = 0; i < n; i++) {
+      ex_id Fy = outs[1 + i], Fp = outs[1 + n + i];
+      for (int j = 0; j < n; j++) {
+        if (j >= i) {
+          yy[tri(n, i, j)] = ex_diff(d, Fy, 1 + j);
+          pp[tri(n, i, j)] = ex_diff(d, Fp, 1 + n + j);
+          if (yy[tri(n, i, j)] < 0 || pp[tri(n, i, j)] < 0) goto nomem;
+        }
+        yp[i * n + j] = ex_diff(d, Fy, 1 + n + j); /* d2F / dy_i dy'_j */
+        if (yp[i * n + j] < 0) goto nomem;
+      }
+    }
+  }
+  g->nout[0] = 1;
+  g->nout[1] = 1 + 2 * n;
+  g->nout[2] = nout;
+  size_t work = 0;
+  for (int l = 0; l <= level; l++) {
+    g->tape[l] = ex_tape_new(d, 2 * n + 1, g->nout[l], outs);
+    if (!g->tape[l]) goto nomem;
+    size_t w = ex_tape_work_size(g->tape[l], EX_INTEGRAND_BATCH);
+    if (w > work) work = w;
+  }
+  g->work = malloc((work ? work : 1) * sizeof *g->work);
+  g->scratch = malloc((size_t)nout * EX_INTEGRAND_BATCH * sizeof *g->scratch);
+  g->in = malloc((size_t)(2 * n + 1) * sizeof *g->in);
+  g->outp = malloc((size_t)nout * sizeof *g->outp);
+  if (!g->work || !g->scratch || !g->in || !g->outp) goto nomem;
+  free(outs);
+  return g;
+nomem:
+  set_err(err, errlen, "out of memory while compiling the expression");
+  free(outs);
+  ex_integrand_free(g);
+  return NULL;
+}
+
+void ex_integrand_free(ex_integrand *g) {
+  if (!g) return;
+  for (int l = 0; l < 3; l++) ex_tape_free(g->tape[l]);
+  free(g->work);
+  free(g->scratch);
+  free(g->in);
+  free(g->outp);
+  free(g);
+}
+
+void ex_integrand_release(void *g) { ex_integrand_free(g); }
+
+int ex_integrand_num_unknowns(const ex_integrand *g) { return g ? g->n : 0; }
+unsigned ex_integrand_max_need(const ex_integrand *g) { return g ? g->max_need : 0; }
+
+/* Output pointer for output o of a batch starting at point k0: the caller's buffer when
+ * the group was asked for, else this output's scratch batch. */
+static double *dest(ex_integrand *g, double *buf, size_t offset, int o) {
+  return buf ? buf + offset : g->scratch + (size_t)o * EX_INTEGRAND_BATCH;
+}
+
+/* Evaluate the smallest tape covering `need` into the given buffers (NULL: not wanted). */
+static int eval_into(ex_integrand *g, int m, const double *x, const double *y,
+                     const double *dy, unsigned need, double *F, double *Fy, double *Fp,
+                     double *Fyy, double *Fyp, double *Fpp) {
+  int level = need & CVAR_NEED_HESS ? 2 : need & CVAR_NEED_GRAD ? 1 : 0;
+  if (!g->tape[level]) return -1;
+  int n = g->n;
+  size_t M = (size_t)m;
+  for (int k0 = 0; k0 < m; k0 += EX_INTEGRAND_BATCH) {
+    int mm = m - k0 < EX_INTEGRAND_BATCH ? m - k0 : EX_INTEGRAND_BATCH;
+    g->in[0] = x + k0;
+    for (int i = 0; i < n; i++) {
+      g->in[1 + i] = y + i * M + k0;
+      g->in[1 + n + i] = dy ? dy + i * M + k0 : NULL; /* NULL: a constraint G(x, y) */
+    }
+    g->outp[0] = dest(g, F, (size_t)k0, 0);
+    if (level >= 1) {
+      for (int i = 0; i < n; i++) {
+        g->outp[1 + i] = dest(g, Fy, i * M + k0, 1 + i);
+        g->outp[1 + n + i] = dest(g, Fp, i * M + k0, 1 + n + i);
+      }
+    }
+    if (level == 2) {
+      int o = 1 + 2 * n;
+      for (int i = 0; i < n; i++)
+        for (int j = i; j < n; j++, o++) g->outp[o] = dest(g, Fyy, (i * n + j) * M + k0, o);
+      for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++, o++) g->outp[o] = dest(g, Fyp, (i * n + j) * M + k0, o);
+      for (int i = 0; i < n; i++)
+        for (int j = i; j < n; j++, o++) g->outp[o] = dest(g, Fpp, (i * n + j) * M + k0, o);
+    }
+    ex_tape_eval(g->tape[level], mm, g->in, g->outp, g->work);
+  }
+  /* Symmetric blocks: the lower triangle is a copy of the upper. */
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < i; j++) {
+      if (Fyy) memcpy(Fyy + (i * n + j) * M, Fyy + (j * n + i) * M, M * sizeof *Fyy);
+      if (Fpp) memcpy(Fpp + (i * n + j) * M, Fpp + (j * n + i) * M, M * sizeof *Fpp);
+    }
+  return 0;
+}
+
+int ex_integrand_eval(int m, const double *x, const double *y, const double *dy,
+                      unsigned need, cv_partials *out, void *user) {
+  ex_integrand *g = user;
+  if (!g || !out || m < 1) return -1;
+  int grad = (need & CVAR_NEED_GRAD) != 0, hess = (need & CVAR_NEED_HESS) != 0;
+  return eval_into(g, m, x, y, dy, need, need & CVAR_NEED_F ? out->F : NULL,
+                   grad ? out->Fy : NULL, grad ? out->Fp : NULL, hess ? out->Fyy : NULL,
+                   hess ? out->Fyp : NULL, hess ? out->Fpp : NULL);
+}
+
+int ex_integrand_eval_constraint(int m, const double *x, const double *y, unsigned need,
+                                 double *G, double *Gy, double *Gyy, void *user) {
+  ex_integrand *g = user;
+  if (!g || m < 1 || g->depends_on_dy) return -1;
+  return eval_into(g, m, x, y, NULL, need, need & CVAR_NEED_F ? G : NULL,
+                   need & CVAR_NEED_GRAD ? Gy : NULL, NULL, need & CVAR_NEED_HESS ? Gyy : NULL,
+                   NULL, NULL);
+}

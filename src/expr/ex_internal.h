@@ -1,0 +1,47 @@
+/* src/expr/ex_internal.h — private layout of the expression DAG, shared by src/expr/ only.
+ * SPDX-License-Identifier: MIT */
+#ifndef CV_EX_INTERNAL_H
+#define CV_EX_INTERNAL_H
+
+#include <stdint.h>
+
+#include "expr/expr.h"
+
+/* pi to more digits than a double holds (M_PI is not ISO C). */
+#define EX_PI 3.14159265358979323846
+
+/* One node. Children always have smaller ids than their parent (a node is created after
+ * its operands), so increasing id order is a topological order: every pass over a DAG
+ * (derivative, substitution, evaluation, compilation) is a loop, never a deep recursion. */
+typedef struct {
+  ex_op op;
+  ex_id a, b, c; /* operands, -1 when absent; for EX_SLOT, a is the slot number */
+  double v;      /* EX_NUM: the value */
+  uint64_t dep;  /* bit (s & 63) set when the node depends on slot s: 0 means constant */
+} ex_node;
+
+struct ex_dag {
+  ex_node *nodes;
+  int n, cap;
+  int *table; /* open-addressing hash of node ids, -1 = empty */
+  size_t tcap;
+  int max_slot; /* largest slot used, so `dep` is exact when max_slot < 64 */
+};
+
+/* Number of operands of an operation (0..3). */
+int ex_op_arity(ex_op op);
+/* Name of a function as written in the grammar ("sin"), or NULL for operators. */
+const char *ex_op_name(ex_op op);
+/* Value of op applied to numbers (the pointwise semantics shared by constant folding and
+ * ex_eval; the tape implements the same). */
+double ex_apply(ex_op op, double a, double b, double c);
+/* Intern a node exactly as given (no simplification): the hash-consing primitive. */
+ex_id ex_intern(ex_dag *d, ex_op op, ex_id a, ex_id b, ex_id c, double v);
+/* Simplifying constructor dispatching on op (numbers and slots excluded). */
+ex_id ex_make(ex_dag *d, ex_op op, ex_id a, ex_id b, ex_id c);
+/* Mark (mark[id] = 1) the nodes reachable from e; mark must hold d->n zeros. When
+ * skip_conditions, the conditions of `if` and comparison operands are not entered (they
+ * have zero derivative). */
+void ex_mark_reachable(const ex_dag *d, ex_id e, unsigned char *mark, int skip_conditions);
+
+#endif /* CV_EX_INTERNAL_H */

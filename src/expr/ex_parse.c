@@ -1,0 +1,322 @@
+/* src/expr/ex_parse.c — recursive-descent parser of the scene expression grammar
+ * (SCENES.md "Expressions") into the DAG, with bounded nesting. SPDX-License-Identifier: MIT
+ *
+ *   cond    = sum [ ("<" | "<=" | ">" | ">=") sum ]      (first argument of if only)
+ *   sum     = term { ("+" | "-") term }
+ *   term    = unary { ("*" | "/") unary }
+ *   unary   = "-" unary | power
+ *   power   = primary [ "^" unary ]                     (right-assoc.; -x^2 = -(x^2))
+ *   primary = number | "pi" | name {"'"} | func "(" args ")" | "(" sum ")"
+ */
+#include <ctype.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "expr/ex_internal.h"
+
+/* Nesting bound: each level costs a handful of small stack frames, so 200 levels is far
+ * below any stack limit, and far above what a readable formula uses. */
+#define MAX_DEPTH 200
+#define MAX_NAME 128
+
+typedef struct {
+  ex_dag *d;
+  const char *s;
+  size_t pos;
+  ex_resolve_fn resolve;
+  void *user;
+  int allow_second;
+  char *err;
+  size_t errlen;
+  int depth;
+  int failed;
+} parser;
+
+static ex_id fail(parser *p, size_t at, const char *fmt, ...) {
+  if (p->failed) return -1; /* keep the first (innermost) message */
+  p->failed = 1;
+  if (p->err && p->errlen) {
+    int k = snprintf(p->err, p->errlen, "column %zu: ", at + 1);
+    if (k >= 0 && (size_t)k < p->errlen) {
+      va_list ap;
+      va_start(ap, fmt);
+      vsnprintf(p->err + k, p->errlen - (size_t)k, fmt, ap);
+      va_end(ap);
+    }
+  }
+  return -1;
+}
+
+/* A node from a constructor: -1 there means memory ran out. */
+static ex_id built(parser *p, ex_id e) {
+  return e >= 0 ? e : fail(p, p->pos, "out of memory");
+}
+
+static void skip_ws(parser *p) {
+  while (p->s[p->pos] && isspace((unsigned char)p->s[p->pos])) p->pos++;
+}
+
+static int is_name_start(int c) { return isalpha(c) || c == '_'; }
+static int is_name_char(int c) { return isalnum(c) || c == '_'; }
+
+/* What the parser found at pos, for messages. */
+static const char *found(parser *p, char *buf, size_t len) {
+  unsigned char c = (unsigned char)p->s[p->pos];
+  if (!c) return "the end of the expression";
+  if (isprint(c)) snprintf(buf, len, "'%c'", c);
+  else snprintf(buf, len, "byte 0x%02x", c);
+  return buf;
+}
+
+static ex_id parse_sum(parser *p);
+static ex_id parse_unary(parser *p);
+
+static ex_id parse_number(parser *p) {
+  size_t start = p->pos;
+  const char *s = p->s;
+  size_t i = start, digits = 0;
+  while (isdigit((unsigned char)s[i])) i++, digits++;
+  if (s[i] == '.') {
+    i++;
+    while (isdigit((unsigned char)s[i])) i++, digits++;
+  }
+  if (!digits) return fail(p, start, "malformed number");
+  if (s[i] == 'e' || s[i] == 'E') {
+    size_t j = i + 1;
+    if (s[j] == '+' || s[j] == '-') j++;
+    if (!isdigit((unsigned char)s[j])) return fail(p, i, "malformed exponent in number");
+    while (isdigit((unsigned char)s[j])) j++;
+    i = j;
+  }
+  if (is_name_start((unsigned char)s[i]) || s[i] == '.')
+    return fail(p, i, "unexpected '%c' right after a number (write '*' to multiply)", s[i]);
+  char buf[512];
+  if (i - start >= sizeof buf) return fail(p, start, "number too long");
+  memcpy(buf, s + start, i - start);
+  buf[i - start] = 0;
+  double v = strtod(buf, NULL);
+  if (!isfinite(v)) return fail(p, start, "number '%s' is out of range", buf);
+  p->pos = i;
+  return built(p, ex_num(p->d, v));
+}
+
+typedef struct {
+  const char *name;
+  ex_op op;
+  int nargs;
+} func;
+
+static const func funcs[] = {
+    {"sin", EX_SIN, 1},     {"cos", EX_COS, 1},     {"tan", EX_TAN, 1},
+    {"asin", EX_ASIN, 1},   {"acos", EX_ACOS, 1},   {"atan", EX_ATAN, 1},
+    {"sinh", EX_SINH, 1},   {"cosh", EX_COSH, 1},   {"tanh", EX_TANH, 1},
+    {"asinh", EX_ASINH, 1}, {"acosh", EX_ACOSH, 1}, {"atanh", EX_ATANH, 1},
+    {"exp", EX_EXP, 1},     {"log", EX_LOG, 1},     {"sqrt", EX_SQRT, 1},
+    {"abs", EX_ABS, 1},     {"atan2", EX_ATAN2, 2}, {"pow", EX_POW, 2},
+    {"min", EX_MIN, 2},     {"max", EX_MAX, 2},     {"if", EX_IF, 3}};
+
+static const func *find_func(const char *name) {
+  for (size_t i = 0; i < sizeof funcs / sizeof funcs[0]; i++)
+    if (strcmp(funcs[i].name, name) == 0) return &funcs[i];
+  return NULL;
+}
+
+/* sum [relop sum]: a condition's value is 1 or 0; a bare sum counts as true when != 0. */
+static ex_id parse_cond(parser *p) {
+  ex_id a = parse_sum(p);
+  if (a < 0) return -1;
+  skip_ws(p);
+  const char *s = p->s + p->pos;
+  ex_op op;
+  size_t len = 1;
+  if (s[0] == '<') op = s[1] == '=' ? (len = 2, EX_LE) : EX_LT;
+  else if (s[0] == '>') op = s[1] == '=' ? (len = 2, EX_GE) : EX_GT;
+  else return a;
+  p->pos += len;
+  ex_id b = parse_sum(p);
+  if (b < 0) return -1;
+  return built(p, ex_binary(p->d, op, a, b));
+}
+
+static ex_id parse_call(parser *p, const func *f, size_t at) {
+  ex_id args[3];
+  int n = 0;
+  p->pos++; /* '(' */
+  for (;;) {
+    if (n == 3) return fail(p, at, "'%s' takes %d argument%s", f->name, f->nargs,
+                            f->nargs == 1 ? "" : "s");
+    args[n] = (f->op == EX_IF && n == 0) ? parse_cond(p) : parse_sum(p);
+    if (args[n] < 0) return -1;
+    n++;
+    skip_ws(p);
+    if (p->s[p->pos] == ',') {
+      p->pos++;
+      continue;
+    }
+    if (p->s[p->pos] == ')') {
+      p->pos++;
+      break;
+    }
+    char buf[16];
+    return fail(p, p->pos, "expected ',' or ')' in the arguments of '%s' but found %s",
+                f->name, found(p, buf, sizeof buf));
+  }
+  if (n != f->nargs)
+    return fail(p, at, "'%s' takes %d argument%s, not %d", f->name, f->nargs,
+                f->nargs == 1 ? "" : "s", n);
+  switch (f->nargs) {
+  case 1: return built(p, ex_unary(p->d, f->op, args[0]));
+  case 2: return built(p, ex_binary(p->d, f->op, args[0], args[1]));
+  default: return built(p, ex_if(p->d, args[0], args[1], args[2]));
+  }
+}
+
+static ex_id parse_name(parser *p) {
+  size_t at = p->pos, i = at;
+  while (is_name_char((unsigned char)p->s[i])) i++;
+  if (i - at >= MAX_NAME) return fail(p, at, "name too long (at most %d characters)", MAX_NAME - 1);
+  char name[MAX_NAME];
+  memcpy(name, p->s + at, i - at);
+  name[i - at] = 0;
+  int primes = 0;
+  while (p->s[i] == '\'') i++, primes++;
+  p->pos = i;
+  skip_ws(p);
+  const func *f = find_func(name);
+  if (p->s[p->pos] == '(' && !primes) {
+    if (!f) return fail(p, at, "unknown function '%s'", name);
+    return parse_call(p, f, at);
+  }
+  if (primes > 2 || (primes == 2 && !p->allow_second))
+    return fail(p, at, "%s%.*s: only the first derivative %s' may be written here", name,
+                primes, "''''''''''''''''", name);
+  if (strcmp(name, "pi") == 0) {
+    if (primes) return fail(p, at + 2, "a prime is only allowed on an unknown, not on 'pi'");
+    return built(p, ex_num(p->d, EX_PI));
+  }
+  if (f) return fail(p, at, "'%s' is a function: write %s(...)", name, name);
+  char msg[256] = "";
+  ex_id e = p->resolve ? p->resolve(p->d, name, primes, p->user, msg, sizeof msg) : -1;
+  if (e < 0) {
+    if (msg[0]) return fail(p, at, "%s", msg);
+    return fail(p, at, "unknown name '%s'", name);
+  }
+  return e;
+}
+
+static ex_id parse_primary(parser *p) {
+  skip_ws(p);
+  size_t at = p->pos;
+  char c = p->s[at];
+  ex_id e;
+  if (isdigit((unsigned char)c) || c == '.') {
+    e = parse_number(p);
+  } else if (is_name_start((unsigned char)c)) {
+    return parse_name(p); /* primes handled there */
+  } else if (c == '(') {
+    p->pos++;
+    e = parse_sum(p);
+    if (e < 0) return -1;
+    skip_ws(p);
+    if (p->s[p->pos] != ')') {
+      char buf[16];
+      if (p->s[p->pos] == '<' || p->s[p->pos] == '>')
+        return fail(p, p->pos, "a comparison is only allowed as the condition of if(...)");
+      return fail(p, p->pos, "missing ')' to close the '(' at column %zu (found %s)", at + 1,
+                  found(p, buf, sizeof buf));
+    }
+    p->pos++;
+  } else if (c == ')') {
+    return fail(p, at, "unexpected ')' where a number, name or '(' was expected");
+  } else {
+    char buf[16];
+    return fail(p, at, "expected a number, name or '(' but found %s", found(p, buf, sizeof buf));
+  }
+  if (e >= 0 && p->s[p->pos] == '\'')
+    return fail(p, p->pos, "a prime is only allowed right after the name of an unknown");
+  return e;
+}
+
+static ex_id parse_power(parser *p) {
+  ex_id base = parse_primary(p);
+  if (base < 0) return -1;
+  skip_ws(p);
+  if (p->s[p->pos] != '^') return base;
+  p->pos++;
+  ex_id ex = parse_unary(p); /* right-associative, and allows x^-2 */
+  if (ex < 0) return -1;
+  return built(p, ex_binary(p->d, EX_POW, base, ex));
+}
+
+static ex_id parse_unary(parser *p) {
+  skip_ws(p);
+  if (++p->depth > MAX_DEPTH) {
+    p->depth--;
+    return fail(p, p->pos, "expression nested too deeply (more than %d levels)", MAX_DEPTH);
+  }
+  ex_id e;
+  if (p->s[p->pos] == '-') {
+    p->pos++;
+    e = parse_unary(p);
+    if (e >= 0) e = built(p, ex_unary(p->d, EX_NEG, e));
+  } else {
+    e = parse_power(p);
+  }
+  p->depth--;
+  return e;
+}
+
+static ex_id parse_term(parser *p) {
+  ex_id a = parse_unary(p);
+  while (a >= 0) {
+    skip_ws(p);
+    char c = p->s[p->pos];
+    if (c != '*' && c != '/') break;
+    p->pos++;
+    ex_id b = parse_unary(p);
+    if (b < 0) return -1;
+    a = built(p, ex_binary(p->d, c == '*' ? EX_MUL : EX_DIV, a, b));
+  }
+  return a;
+}
+
+static ex_id parse_sum(parser *p) {
+  ex_id a = parse_term(p);
+  while (a >= 0) {
+    skip_ws(p);
+    char c = p->s[p->pos];
+    if (c != '+' && c != '-') break;
+    p->pos++;
+    ex_id b = parse_term(p);
+    if (b < 0) return -1;
+    a = built(p, ex_binary(p->d, c == '+' ? EX_ADD : EX_SUB, a, b));
+  }
+  return a;
+}
+
+ex_id ex_parse(ex_dag *d, const char *src, ex_resolve_fn resolve, void *user,
+               int allow_second, char *err, size_t errlen) {
+  parser p = {d, src ? src : "", 0, resolve, user, allow_second, err, errlen, 0, 0};
+  if (err && errlen) err[0] = 0;
+  if (!d) return fail(&p, 0, "no expression DAG");
+  skip_ws(&p);
+  if (!p.s[p.pos]) return fail(&p, p.pos, "empty expression");
+  ex_id e = parse_sum(&p);
+  if (e < 0) return -1;
+  skip_ws(&p);
+  char c = p.s[p.pos];
+  if (c) {
+    char buf[16];
+    if (c == ')') return fail(&p, p.pos, "unmatched ')'");
+    if (c == '<' || c == '>')
+      return fail(&p, p.pos, "a comparison is only allowed as the condition of if(...)");
+    if (c == '\'')
+      return fail(&p, p.pos, "a prime is only allowed right after the name of an unknown");
+    return fail(&p, p.pos, "unexpected %s after a complete expression (missing operator?)",
+                found(&p, buf, sizeof buf));
+  }
+  return e;
+}
