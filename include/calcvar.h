@@ -237,6 +237,25 @@ cv_status cv_solver_set_tolerances(cv_solver *s, double rtol, double atol);
 /** Maximum Newton iterations (>= 1). */
 cv_status cv_solver_set_max_iterations(cv_solver *s, int maxit);
 
+/** Engines. Newton finds any stationary point (minimum or saddle) and reports its Morse
+ * index; the NLopt minimisers find minima only (docs/engines.md). */
+typedef enum {
+  CVAR_METHOD_NEWTON = 0, /**< Newton on the (KKT) stationarity system, sparse LDL^T */
+  CVAR_METHOD_LBFGS,      /**< NLopt L-BFGS (no constraints) */
+  CVAR_METHOD_TNEWTON,    /**< NLopt preconditioned truncated Newton (no constraints) */
+  CVAR_METHOD_MMA,        /**< NLopt MMA (constraints as pairs of inequalities) */
+  CVAR_METHOD_CCSAQ,      /**< NLopt CCSA with quadratic approximations (as MMA) */
+  CVAR_METHOD_SLSQP,      /**< NLopt SLSQP (equality constraints) */
+  CVAR_METHOD_AUGLAG      /**< NLopt augmented Lagrangian around L-BFGS (equality constraints) */
+} cv_method;
+/** "newton", "lbfgs", "tnewton", "mma", "ccsaq", "slsqp", "auglag"; NULL if out of range. */
+const char *cv_method_name(cv_method m);
+/** Parse a method name; CVAR_EINVAL if unknown. */
+cv_status cv_method_from_name(const char *name, cv_method *m);
+/** The engine of the next solve (default CVAR_METHOD_NEWTON). */
+cv_status cv_solver_set_method(cv_solver *s, cv_method m);
+cv_method cv_solver_get_method(const cv_solver *s);
+
 /** Make the discrete action of p stationary, starting from p's guess (or, after
  * cv_solver_set_start, from given nodal values). Results stay in s until the next solve.
  * Returns CVAR_OK only when converged; otherwise a failure status, with a sentence in

@@ -103,7 +103,7 @@ cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char 
   return CVAR_OK;
 }
 
-cv_status cv_ldlt_solve(cv_ldlt *L, double *x) {
+static cv_status solve_sys(cv_ldlt *L, int sys, double *x) {
   cholmod_dense B;
   memset(&B, 0, sizeof B);
   B.nrow = B.d = B.nzmax = (size_t)L->n;
@@ -111,8 +111,21 @@ cv_status cv_ldlt_solve(cv_ldlt *L, double *x) {
   B.x = x;
   B.xtype = CHOLMOD_REAL;
   B.dtype = CHOLMOD_DOUBLE;
-  if (!cholmod_l_solve2(CHOLMOD_A, L->L, &B, NULL, &L->X, NULL, &L->Y, &L->E, &L->c))
+  if (!cholmod_l_solve2(sys, L->L, &B, NULL, &L->X, NULL, &L->Y, &L->E, &L->c))
     return L->c.status == CHOLMOD_OUT_OF_MEMORY ? CVAR_ENOMEM : CVAR_EDEPENDENCY;
   memcpy(x, L->X->x, (size_t)L->n * sizeof *x);
   return CVAR_OK;
+}
+
+cv_status cv_ldlt_solve(cv_ldlt *L, double *x) { return solve_sys(L, CHOLMOD_A, x); }
+
+/* The natural ordering leaves no permutation, so L and L^T solves act on x directly. */
+cv_status cv_ldlt_solve_L(cv_ldlt *L, int transpose, double *x) {
+  return solve_sys(L, transpose ? CHOLMOD_Lt : CHOLMOD_L, x);
+}
+
+void cv_ldlt_diag(const cv_ldlt *L, double *D) {
+  const SuiteSparse_long *Lp = L->L->p;
+  const double *Lx = L->L->x;
+  for (long j = 0; j < L->n; j++) D[j] = Lx[Lp[j]];
 }

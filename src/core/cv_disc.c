@@ -116,3 +116,27 @@ long cv_disc_num_qpoints(const cv_disc *d) {
   if (d->sing_b && (d->E > 1 || !d->sing_a)) nq += d->ref.qs - d->ref.q;
   return nq;
 }
+
+/* Column c of the upper triangle holds the rows from the first unknown of the first
+ * element containing c's node up to c (block-banded pattern, theory E-2); an integral
+ * multiplier's column is dense (C-3). */
+void cv_disc_pattern(const cv_disc *d, long *colptr, int *gof) {
+  int n = d->n, p = d->p, nc = d->nc;
+  colptr[0] = 0;
+  for (long J = 0, e = 0; J < d->nodes; J++) {
+    if (J > 1 && (J - 1) % p == 0) e++; /* e = first element containing node J */
+    long r0 = cv_disc_elem_first(d, e);
+    /* the node's unknowns in increasing order: y components, then multipliers */
+    for (int t = 0; t < n + nc; t++) {
+      int c = t < n ? cv_disc_fidx(d, J * n + t) : cv_disc_lidx(d, J, t - n);
+      if (c < 0) continue;
+      if (gof) gof[c] = t < n ? (int)(J * n + t) : -1 - (int)(J * nc + t - n);
+      colptr[c + 1] = colptr[c] + ((long)c - r0 + 1);
+    }
+  }
+  for (int r = 0; r < d->ni; r++) {
+    int c = d->nu0 + r;
+    if (gof) gof[c] = -1 - (int)((long)d->nodes * nc + r);
+    colptr[c + 1] = colptr[c] + c + 1;
+  }
+}

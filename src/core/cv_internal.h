@@ -126,6 +126,10 @@ static inline int cv_disc_elem_first(const cv_disc *d, long e) {
   return e == 0 ? 0 : (int)(d->off0 + (e * d->p - 1) * d->stride);
 }
 
+/* Sparsity pattern of the Hessian / KKT matrix (E-2, C-3): colptr (nfree + 1) and, if gof
+ * is not NULL, the y dof of each unknown or -1 - (index into the multipliers). */
+void cv_disc_pattern(const cv_disc *d, long *colptr, int *gof);
+
 /* The rule of element e (Gauss, or the singular-end rule on a flagged end element). */
 cv_rule cv_disc_rule(const cv_disc *d, long e);
 /* Total number of quadrature points over the mesh. */
@@ -147,6 +151,10 @@ cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char 
                          size_t len);
 /* Solve in place: x <- A^{-1} x. */
 cv_status cv_ldlt_solve(cv_ldlt *L, double *x);
+/* x <- L^{-1} x (transpose 0) or L^{-T} x (transpose 1), L unit lower triangular. */
+cv_status cv_ldlt_solve_L(cv_ldlt *L, int transpose, double *x);
+/* The pivots D(j) of the last factorisation. */
+void cv_ldlt_diag(const cv_ldlt *L, double *D);
 
 /* ---- assembly (cv_assemble.c) ---- */
 typedef struct {
@@ -184,6 +192,9 @@ cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const lo
 void cv_kkt_free(cv_kkt *k);
 /* Reject pointwise constraints that fail at an end whose unknowns are all fixed. */
 cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len);
+/* Constraint values and dense Jacobian rows for the NLopt engine. */
+cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, double *jac,
+                                   int ld, const int *lrow, const int *var);
 /* Least-squares starting multipliers from the stationarity condition at Y (C-5). */
 cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M);
 /* M: multipliers, lam[node*nc + k] then nu[r]. Ax and dreg may be NULL. */
@@ -200,6 +211,7 @@ typedef struct {
 struct cv_solver {
   cv_meshspec mesh;
   int degree, nq, maxit;
+  cv_method method;
   double rtol, atol;
   double *start;
   int start_len;
@@ -217,6 +229,7 @@ struct cv_solver {
 };
 double cv_now(void);
 
+cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y);
 cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *y, double *M);
 
 void cv_disc_free(cv_disc *d);

@@ -226,3 +226,46 @@ cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M) {
   cv_free(g);
   return st;
 }
+
+/* Constraint values and their dense Jacobian for the NLopt engine (C-1, C-2): for each
+ * unknown index f of a multiplier row, vals[f] = G_k(x_j, Y_j) or I_r - c_r; when jac is
+ * given, row lrow[f] of jac (leading dimension ld) receives the derivatives with respect
+ * to the variables, variable var[f'] for the y unknown f' (var[f'] < 0: not a variable). */
+cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, double *jac,
+                                   int ld, const int *lrow, const int *var) {
+  const cv_disc *d = k->d;
+  const cv_problem *p = k->prob;
+  int n = d->n, nc = d->nc;
+  cv_status st = CVAR_OK;
+  for (int r = 0; r < d->ni && !st; r++) {
+    double I;
+    int row = d->nu0 + r;
+    memset(k->gK, 0, (size_t)d->nfree * sizeof *k->gK);
+    st = cv_assemble(&k->as, p->ic[r].K, p->ic[r].user, Y, &I, jac ? k->gK : NULL, k->colptr,
+                     NULL, 0.0);
+    vals[row] = I - p->ic[r].c;
+    if (jac && !st)
+      for (int f = 0; f < d->nu0; f++)
+        if (var[f] >= 0) jac[(size_t)lrow[row] * ld + var[f]] = k->gK[f];
+  }
+  unsigned need = CVAR_NEED_F | (jac ? CVAR_NEED_GRAD : 0u);
+  for (long j0 = 0; j0 < d->nodes && nc > 0 && !st; j0 += CV_BATCH) {
+    int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
+    for (int kc = 0; kc < nc && !st; kc++) {
+      double *g, *gy, *gyy;
+      st = eval_constraint(k, kc, Y, j0, m, need, &g, &gy, &gyy);
+      for (int t = 0; t < m && !st; t++) {
+        long node = j0 + t;
+        int row = cv_disc_lidx(d, node, kc);
+        if (row < 0) continue;
+        if (!isfinite(g[t])) st = CVAR_ENONFINITE;
+        vals[row] = g[t];
+        for (int i = 0; i < n && jac; i++) {
+          int fi = cv_disc_fidx(d, node * n + i);
+          if (fi >= 0 && var[fi] >= 0) jac[(size_t)lrow[row] * ld + var[fi]] = gy[i * m + t];
+        }
+      }
+    }
+  }
+  return st;
+}

@@ -37,9 +37,6 @@ static void ws_free(newton_ws *w) {
   cv_free(w->corr);
 }
 
-/* Column c of the upper triangle holds the rows from the first unknown of the first
- * element containing c's node up to c (block-banded pattern, theory E-2); an integral
- * multiplier's column is dense (C-3). */
 static cv_status ws_init(newton_ws *w, const cv_disc *d, size_t nmult) {
   size_t nf = (size_t)d->nfree, one = nf ? nf : 1;
   memset(w, 0, sizeof *w);
@@ -56,24 +53,7 @@ static cv_status ws_init(newton_ws *w, const cv_disc *d, size_t nmult) {
   if (!w->gof || !w->colptr || !w->g || !w->gt || !w->delta || !w->Yt || !w->Mt ||
       !w->dreg || !w->corr)
     return CVAR_ENOMEM;
-  int n = d->n, p = d->p, nc = d->nc;
-  w->colptr[0] = 0;
-  for (long J = 0, e = 0; J < d->nodes; J++) {
-    if (J > 1 && (J - 1) % p == 0) e++; /* e = first element containing node J */
-    long r0 = cv_disc_elem_first(d, e);
-    /* the node's unknowns in increasing order: y components, then multipliers */
-    for (int t = 0; t < n + nc; t++) {
-      int c = t < n ? cv_disc_fidx(d, J * n + t) : cv_disc_lidx(d, J, t - n);
-      if (c < 0) continue;
-      w->gof[c] = t < n ? (int)(J * n + t) : -1 - (int)(J * nc + t - n);
-      w->colptr[c + 1] = w->colptr[c] + ((long)c - r0 + 1);
-    }
-  }
-  for (int r = 0; r < d->ni; r++) {
-    int c = d->nu0 + r;
-    w->gof[c] = -1 - (int)((long)d->nodes * nc + r);
-    w->colptr[c + 1] = w->colptr[c] + c + 1;
-  }
+  cv_disc_pattern(d, w->colptr, w->gof);
   w->L = cv_ldlt_new(d->nfree, w->colptr);
   return w->L ? CVAR_OK : CVAR_ENOMEM;
 }

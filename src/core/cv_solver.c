@@ -107,6 +107,31 @@ cv_status cv_solver_set_tolerances(cv_solver *s, double rtol, double atol) {
   return CVAR_OK;
 }
 
+static const char *const method_names[] = {"newton", "lbfgs", "tnewton", "mma",
+                                            "ccsaq",  "slsqp", "auglag"};
+#define NUM_METHODS (int)(sizeof method_names / sizeof method_names[0])
+
+const char *cv_method_name(cv_method m) {
+  return (int)m >= 0 && (int)m < NUM_METHODS ? method_names[m] : NULL;
+}
+
+cv_status cv_method_from_name(const char *name, cv_method *m) {
+  for (int k = 0; name && k < NUM_METHODS; k++)
+    if (strcmp(name, method_names[k]) == 0) {
+      if (m) *m = (cv_method)k;
+      return CVAR_OK;
+    }
+  return CVAR_EINVAL;
+}
+
+cv_status cv_solver_set_method(cv_solver *s, cv_method m) {
+  if (!s || !cv_method_name(m)) return CVAR_EINVAL;
+  s->method = m;
+  return CVAR_OK;
+}
+
+cv_method cv_solver_get_method(const cv_solver *s) { return s ? s->method : CVAR_METHOD_NEWTON; }
+
 cv_status cv_solver_set_max_iterations(cv_solver *s, int maxit) {
   if (!s || maxit < 1) return CVAR_EINVAL;
   s->maxit = maxit;
@@ -254,7 +279,8 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   if (st) goto done;
   s->have = 1;
   detect_singular_ends(p, &s->disc, s->y);
-  st = cv_newton_run(s, p, &s->disc, s->y, s->mult);
+  st = s->method == CVAR_METHOD_NEWTON ? cv_newton_run(s, p, &s->disc, s->y, s->mult)
+                                       : cv_nlopt_run(s, p, &s->disc, s->y);
 done:
   s->status = st;
   s->time = cv_now() - t0;

@@ -1,0 +1,176 @@
+/* src/cli/args.c — command-line options of `solve` (SCENES.md "Options of solve").
+ * SPDX-License-Identifier: MIT
+ *
+ * Both "--opt VALUE" and "--opt=VALUE" are accepted. Every value is checked here, so a
+ * bad flag is reported before any scene is read or any file is written.
+ */
+#include <errno.h>
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli/cli.h"
+
+static int bad(const char *cmd, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+static int bad(const char *cmd, const char *fmt, ...)
+{
+  va_list ap;
+  va_start(ap, fmt);
+  fprintf(stderr, "calcvar %s: ", cmd);
+  vfprintf(stderr, fmt, ap);
+  fprintf(stderr, "\n");
+  va_end(ap);
+  return EXIT_BADINPUT;
+}
+
+static int parse_int(const char *s, long lo, long hi, int *out)
+{
+  char *end;
+  if (!(*s >= '0' && *s <= '9') && *s != '+')
+    return -1;
+  errno = 0;
+  long v = strtol(s, &end, 10);
+  if (errno || *end || v < lo || v > hi)
+    return -1;
+  *out = (int)v;
+  return 0;
+}
+
+static int parse_pos_double(const char *s, double *out)
+{
+  char *end;
+  errno = 0;
+  double v = strtod(s, &end);
+  if (end == s || *end || !isfinite(v) || !(v > 0))
+    return -1;
+  *out = v;
+  return 0;
+}
+
+void cli_opts_free(cli_opts *o) { free(o->set); }
+
+int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
+{
+  memset(o, 0, sizeof *o);
+  o->method = -1;
+  for (int i = 0; i < argc; i++) {
+    const char *a = argv[i], *v = NULL;
+    char name[32];
+    if (strcmp(a, "--") == 0 || a[0] != '-' || strcmp(a, "-") == 0) {
+      if (strcmp(a, "--") == 0 && ++i >= argc)
+        break;
+      if (o->scene_path)
+        return bad(cmd, "one scene file only: '%s' and '%s'", o->scene_path, argv[i]);
+      o->scene_path = argv[i];
+      continue;
+    }
+    const char *eq = strchr(a, '=');
+    size_t nl = eq ? (size_t)(eq - a) : strlen(a);
+    if (nl >= sizeof name)
+      return bad(cmd, "unknown option '%s'", a);
+    memcpy(name, a, nl);
+    name[nl] = '\0';
+    int flag = strcmp(name, "--quiet") == 0 || strcmp(name, "--help") == 0 ||
+               strcmp(name, "-h") == 0;
+    static const char *const valued[] = {
+      "--elements", "--degree", "--method", "--tolerance", "--max-iterations", "--set",
+      "--adapt", "--continue", "--json", "--csv", "--plot", NULL};
+    int known = flag;
+    for (int k = 0; valued[k]; k++)
+      known |= strcmp(name, valued[k]) == 0;
+    if (!known)
+      return bad(cmd, "unknown option '%s' (see calcvar --help)", name);
+    if (flag) {
+      if (eq)
+        return bad(cmd, "%s takes no value", name);
+      if (strcmp(name, "--quiet") == 0)
+        o->quiet = 1;
+      else
+        o->help = 1;
+      continue;
+    }
+    if (eq)
+      v = eq + 1;
+    else if (i + 1 < argc)
+      v = argv[++i];
+    else
+      return bad(cmd, "%s needs a value", name);
+
+    if (strcmp(name, "--elements") == 0) {
+      /* INT_MAX / 9 keeps nodes = elements * degree + 1 an int at degree 8. */
+      if (parse_int(v, 1, INT_MAX / 9, &o->elements) < 0)
+        return bad(cmd, "--elements needs a whole number >= 1, got '%s'", v);
+    } else if (strcmp(name, "--degree") == 0) {
+      if (parse_int(v, 1, 8, &o->degree) < 0)
+        return bad(cmd, "--degree needs a whole number from 1 to 8, got '%s'", v);
+    } else if (strcmp(name, "--max-iterations") == 0) {
+      if (parse_int(v, 1, INT_MAX, &o->max_iterations) < 0)
+        return bad(cmd, "--max-iterations needs a whole number >= 1, got '%s'", v);
+    } else if (strcmp(name, "--method") == 0) {
+      if ((o->method = scene_method_from_name(v)) < 0)
+        return bad(cmd, "unknown method '%s' (known: newton, lbfgs, tnewton, mma, ccsaq, "
+                   "slsqp, auglag)", v);
+    } else if (strcmp(name, "--tolerance") == 0) {
+      if (parse_pos_double(v, &o->tolerance) < 0 || o->tolerance < 10 * DBL_EPSILON ||
+          o->tolerance >= 1)
+        return bad(cmd, "--tolerance needs a number from 2.2e-15 (10 eps) to below 1, "
+                   "got '%s'", v);
+    } else if (strcmp(name, "--adapt") == 0) {
+      if (parse_pos_double(v, &o->adapt) < 0)
+        return bad(cmd, "--adapt needs a target error > 0, got '%s'", v);
+    } else if (strcmp(name, "--set") == 0) {
+      const char *e = strchr(v, '=');
+      if (!e || e == v || !e[1])
+        return bad(cmd, "--set needs name=value, got '%s'", v);
+      sc_set *ns = realloc(o->set, (size_t)(o->nset + 1) * sizeof *ns);
+      if (!ns)
+        return bad(cmd, "out of memory");
+      o->set = ns;
+      /* Split in place: argv strings are writable (C11 5.1.2.2.1). */
+      *(char *)e = '\0';
+      o->set[o->nset].name = v;
+      o->set[o->nset].value = e + 1;
+      o->nset++;
+    } else if (strcmp(name, "--continue") == 0) {
+      const char *e = strchr(v, '='), *c = e ? strchr(e, ':') : NULL;
+      char *end;
+      if (!e || e == v || !c || c == e + 1 || !c[1])
+        return bad(cmd, "--continue needs name=from:to, got '%s'", v);
+      strtod(e + 1, &end);
+      if (end != c)
+        return bad(cmd, "--continue name=from:to: 'from' is not a number in '%s'", v);
+      strtod(c + 1, &end);
+      if (*end)
+        return bad(cmd, "--continue name=from:to: 'to' is not a number in '%s'", v);
+      o->cont = v;
+    } else if (strcmp(name, "--json") == 0) {
+      o->json = v;
+    } else if (strcmp(name, "--csv") == 0) {
+      o->csv = v;
+    } else if (strcmp(name, "--plot") == 0) {
+      size_t n = strlen(v);
+      if (n < 5 || (strcmp(v + n - 4, ".png") != 0 && strcmp(v + n - 4, ".svg") != 0))
+        return bad(cmd, "--plot FILE must end in .png or .svg, got '%s'", v);
+      o->plot = v;
+    }
+    if (!*v)
+      return bad(cmd, "%s needs a non-empty value", name);
+  }
+  if (o->help)
+    return 0;
+  if (!o->scene_path)
+    return bad(cmd, "a scene file is missing: calcvar %s SCENE [options]", cmd);
+  if (o->json && o->csv && strcmp(o->json, "-") == 0 && strcmp(o->csv, "-") == 0)
+    return bad(cmd, "--json - and --csv - cannot both write to stdout");
+  if (o->json && o->csv && strcmp(o->json, o->csv) == 0 && strcmp(o->json, "-") != 0)
+    return bad(cmd, "--json and --csv name the same file '%s'", o->json);
+  return 0;
+}

@@ -1,0 +1,93 @@
+/* src/cli/cli.h — the calcvar command: shared declarations of its subcommands and reports.
+ * SPDX-License-Identifier: MIT */
+#ifndef CV_CLI_H
+#define CV_CLI_H
+
+#include <stdio.h>
+
+#include "calcvar.h"
+#include "scene/scene.h"
+
+/* Exit statuses of SCENES.md. */
+enum { EXIT_SOLVED = 0, EXIT_UNSOLVED = 1, EXIT_BADINPUT = 2 };
+
+/* Options of `solve` (and later `converge`): zero / NULL / -1 mean "as the scene says". */
+typedef struct {
+  const char *scene_path;
+  int elements, degree, max_iterations;
+  int method; /* sc_method or -1 */
+  double tolerance;
+  double adapt;
+  const char *cont; /* --continue name=from:to */
+  int nset;
+  sc_set *set;
+  const char *json, *csv, *plot;
+  int quiet, help;
+} cli_opts;
+
+/* args.c: parse argv (after the command word). Returns 0, or EXIT_BADINPUT after printing
+ * the reason. `cmd` names the command in messages. */
+int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o);
+void cli_opts_free(cli_opts *o);
+
+/* What `solve` reports; has_* flags say which keys apply (SCENES.md: keys that do not
+ * apply are left out). report.c fills it from a solver and its scene. */
+typedef struct {
+  const scene *sc;
+  sc_method method;
+  cv_status st;
+  const char *status;
+  char message[640];
+  int elements, degree, nodes, n;
+  int has_action, has_gradient_norm, has_time;
+  double action, gradient_norm, time_s;
+  int iterations;
+  int has_morse;
+  int morse;
+  const char *kind;
+  int has_err_nodal, has_err_action, has_err_est;
+  double err_nodal, err_action, err_est;
+  int has_energy;
+  double emin, emax;
+  int *has_mom;
+  double *mom_min, *mom_max;
+  int *has_rep;
+  double *rep;
+  double *x, *y; /* nodes and node-major values y[j*n + i] */
+} cli_report;
+
+const char *cli_status_string(cv_status st);
+int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_status st);
+/* Estimate the max nodal error by a solve on twice the elements (report.c). */
+int cli_report_estimate(cli_report *r, const scene *s, const cv_problem *p);
+void cli_report_free(cli_report *r);
+
+int cli_report_json(FILE *f, const cli_report *r);
+int cli_report_csv(FILE *f, const cli_report *r);
+void cli_report_text(FILE *f, const cli_report *r);
+
+/* outfile.c: all-or-nothing output files (a temporary file renamed at the end). */
+typedef struct {
+  const char *path; /* "-" is stdout */
+  char *tmp;
+  FILE *f;
+} cli_outfile;
+int cli_outfile_open(cli_outfile *o, const char *path);
+int cli_outfile_commit(cli_outfile *o);
+void cli_outfile_abandon(cli_outfile *o);
+
+/* Subcommands. */
+int cli_gallery(void);
+int cli_solve(int argc, char **argv);
+int cli_check(int argc, char **argv);
+int cli_unsupported(const char *cmd);
+
+/* gallery_scenes.c */
+typedef struct {
+  const char *name;
+  const char *text;
+} cli_gallery_scene;
+extern const cli_gallery_scene cli_gallery_scenes[];
+extern const int cli_gallery_count;
+
+#endif /* CV_CLI_H */

@@ -1,0 +1,46 @@
+/* src/cli/main.c — the calcvar command: dispatch to the subcommands.
+ * SPDX-License-Identifier: MIT */
+#include <stdio.h>
+#include <string.h>
+
+#include "cli/cli.h"
+
+static void usage(FILE *f)
+{
+  fputs("usage:\n"
+        "  calcvar                         run the built-in demo gallery\n"
+        "  calcvar solve SCENE [options]   solve one scene (calcvar solve --help)\n"
+        "  calcvar check SCENE             parse, degrees of freedom, derivative check\n"
+        "  calcvar converge SCENE          (not in this build yet)\n"
+        "  calcvar equations SCENE         (not in this build yet)\n"
+        "  calcvar modes SCENE             (not in this build yet)\n"
+        "  calcvar --help | --version\n"
+        "Scene files: docs/scenes.md. Exit status: 0 solved, 1 not solved, 2 bad input.\n",
+        f);
+}
+
+int main(int argc, char **argv)
+{
+  if (argc < 2)
+    return cli_gallery();
+  const char *cmd = argv[1];
+  if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {
+    usage(stdout);
+    return EXIT_SOLVED;
+  }
+  if (strcmp(cmd, "--version") == 0) {
+    int a, b, c;
+    cv_version(&a, &b, &c);
+    printf("calcvar %d.%d.%d\n", a, b, c);
+    return EXIT_SOLVED;
+  }
+  if (strcmp(cmd, "solve") == 0)
+    return cli_solve(argc - 2, argv + 2);
+  if (strcmp(cmd, "check") == 0)
+    return cli_check(argc - 2, argv + 2);
+  if (strcmp(cmd, "converge") == 0 || strcmp(cmd, "equations") == 0 ||
+      strcmp(cmd, "modes") == 0)
+    return cli_unsupported(cmd);
+  fprintf(stderr, "calcvar: unknown command '%s' (calcvar --help lists them)\n", cmd);
+  return EXIT_BADINPUT;
+}

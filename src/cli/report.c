@@ -1,0 +1,257 @@
+/* src/cli/report.c — gather what `solve` reports from a solver and its scene.
+ * SPDX-License-Identifier: MIT
+ *
+ * Energy, momenta and [report] integrals are evaluated at the solver's quadrature points
+ * (cv_solver_get_qpoints), so a report integral is the same sum the action is; the energy
+ * range is taken over those points (docs/cli.md). A quantity that comes out non-finite is
+ * left out of the report rather than printed as NaN.
+ */
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli/cli.h"
+
+const char *cli_status_string(cv_status st)
+{
+  switch (st) {
+  case CVAR_OK:
+    return "converged";
+  case CVAR_EMAXITER:
+    return "max_iterations";
+  case CVAR_ENONFINITE:
+  case CVAR_EDIVERGED:
+    return "diverged";
+  case CVAR_ESINGULAR:
+    return "singular";
+  default:
+    return "no_progress";
+  }
+}
+
+void cli_report_free(cli_report *r)
+{
+  free(r->has_mom);
+  free(r->mom_min);
+  free(r->mom_max);
+  free(r->has_rep);
+  free(r->rep);
+  free(r->x);
+  free(r->y);
+  memset(r, 0, sizeof *r);
+}
+
+/* min and max of v[0..m-1]; returns 0 when every value is finite, else -1. */
+static int range(const double *v, int m, double *lo, double *hi)
+{
+  *lo = INFINITY;
+  *hi = -INFINITY;
+  for (int k = 0; k < m; k++) {
+    if (!isfinite(v[k]))
+      return -1;
+    *lo = v[k] < *lo ? v[k] : *lo;
+    *hi = v[k] > *hi ? v[k] : *hi;
+  }
+  return m > 0 ? 0 : -1;
+}
+
+/* Max over nodes and unknowns of |y_h - y_exact| at the nodes, over the unknowns that
+ * have an [exact] expression. */
+static int nodal_error(cli_report *r, const scene *s)
+{
+  int nn = r->nodes, n = s->n, any = 0;
+  for (int i = 0; i < n; i++)
+    any |= s->exact[i] >= 0;
+  if (!any)
+    return 0;
+  double *ex = malloc((size_t)nn * n * sizeof *ex);
+  if (!ex || scene_eval_exact(s, nn, r->x, ex) < 0) {
+    free(ex);
+    return -1;
+  }
+  double e = 0;
+  int finite = 1;
+  for (int i = 0; i < n; i++)
+    if (s->exact[i] >= 0)
+      for (int j = 0; j < nn; j++) {
+        double d = fabs(r->y[(size_t)j * n + i] - ex[(size_t)i * nn + j]);
+        finite &= isfinite(d);
+        e = d > e ? d : e;
+      }
+  free(ex);
+  if (finite) {
+    r->has_err_nodal = 1;
+    r->err_nodal = e;
+  }
+  return 0;
+}
+
+/* Energy, momenta and report integrals at the quadrature points. */
+static int qpoint_quantities(cli_report *r, scene *s, cv_solver *sv)
+{
+  int n = s->n, nq = cv_solver_get_num_qpoints(sv), rc = -1;
+  if (nq <= 0)
+    return 0;
+  size_t q = (size_t)nq;
+  double *x = malloc(q * sizeof *x), *w = malloc(q * sizeof *w);
+  double *y = malloc(q * n * sizeof *y), *dy = malloc(q * n * sizeof *dy);
+  size_t nv = q * (size_t)(n > s->nreports ? n : s->nreports);
+  double *v = malloc((nv > q ? nv : q) * sizeof *v);
+  if (!x || !w || !y || !dy || !v)
+    goto done;
+  if (cv_solver_get_qpoints(sv, x, w, y, dy) != CVAR_OK) {
+    rc = 0; /* nothing to evaluate on: leave the keys out */
+    goto done;
+  }
+  if (!scene_F_depends_on_variable(s)) {
+    if (scene_eval_energy(s, nq, x, y, dy, v) < 0)
+      goto done;
+    r->has_energy = range(v, nq, &r->emin, &r->emax) == 0;
+  }
+  if (scene_eval_momenta(s, nq, x, y, dy, v) < 0)
+    goto done;
+  for (int i = 0; i < n; i++)
+    if (!scene_F_depends_on_unknown(s, i))
+      r->has_mom[i] = range(v + (size_t)i * q, nq, &r->mom_min[i], &r->mom_max[i]) == 0;
+  if (s->nreports > 0 && scene_eval_reports(s, nq, x, y, dy, v) < 0)
+    goto done;
+  for (int k = 0; k < s->nreports; k++) {
+    double sum = 0;
+    for (int j = 0; j < nq; j++)
+      sum += w[j] * v[(size_t)k * q + j];
+    r->rep[k] = sum;
+    r->has_rep[k] = isfinite(sum);
+  }
+  rc = 0;
+done:
+  free(x);
+  free(w);
+  free(y);
+  free(dy);
+  free(v);
+  return rc;
+}
+
+static void compose_message(cli_report *r, cv_solver *sv)
+{
+  const char *detail = cv_solver_last_error(sv);
+  if (r->st != CVAR_OK) {
+    snprintf(r->message, sizeof r->message, "%s", detail && detail[0] ? detail
+                                                                      : cv_strerror(r->st));
+    return;
+  }
+  int k = snprintf(r->message, sizeof r->message, "Converged in %d iteration%s",
+                   r->iterations, r->iterations == 1 ? "" : "s");
+  if (r->kind && k > 0 && (size_t)k < sizeof r->message) {
+    if (strcmp(r->kind, "degenerate") == 0)
+      snprintf(r->message + k, sizeof r->message - (size_t)k,
+               "; the Hessian is degenerate there%s%s.", detail && detail[0] ? ": " : "",
+               detail ? detail : "");
+    else
+      snprintf(r->message + k, sizeof r->message - (size_t)k,
+               " to a %s of the action (Morse index %d).", r->kind, r->morse);
+  } else if (k > 0 && (size_t)k < sizeof r->message) {
+    snprintf(r->message + k, sizeof r->message - (size_t)k, ".");
+  }
+}
+
+/* Fill r after cv_solve returned st. Returns 0, or -1 on allocation failure. */
+int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_status st)
+{
+  int n = s->n;
+  memset(r, 0, sizeof *r);
+  r->sc = s;
+  r->method = m;
+  r->st = st;
+  r->status = cli_status_string(st);
+  r->n = n;
+  r->elements = cv_solver_get_num_elements(sv);
+  r->degree = cv_solver_get_degree(sv);
+  r->nodes = cv_solver_get_num_nodes(sv);
+  r->iterations = cv_solver_get_num_iterations(sv);
+  r->action = cv_solver_get_action(sv);
+  r->has_action = isfinite(r->action);
+  r->gradient_norm = cv_solver_get_gradient_norm(sv);
+  r->has_gradient_norm = isfinite(r->gradient_norm);
+  r->time_s = cv_solver_get_time(sv);
+  r->has_time = isfinite(r->time_s);
+
+  r->has_mom = calloc((size_t)n, sizeof *r->has_mom);
+  r->mom_min = calloc((size_t)n, sizeof *r->mom_min);
+  r->mom_max = calloc((size_t)n, sizeof *r->mom_max);
+  r->has_rep = calloc((size_t)s->nreports + 1, sizeof *r->has_rep);
+  r->rep = calloc((size_t)s->nreports + 1, sizeof *r->rep);
+  int nn = r->nodes > 0 ? r->nodes : 0;
+  r->x = calloc((size_t)nn + 1, sizeof *r->x);
+  r->y = calloc((size_t)nn * n + 1, sizeof *r->y);
+  if (!r->has_mom || !r->mom_min || !r->mom_max || !r->has_rep || !r->rep || !r->x || !r->y)
+    return -1;
+  if (nn > 0 && (cv_solver_get_nodes(sv, r->x) != CVAR_OK ||
+                 cv_solver_get_values(sv, r->y) != CVAR_OK))
+    r->nodes = nn = 0;
+
+  if (m == SC_NEWTON) {
+    int morse = cv_solver_get_morse_index(sv), nfree = cv_solver_get_num_free(sv);
+    if (morse >= 0) {
+      r->has_morse = 1;
+      r->morse = morse;
+      if (cv_solver_get_degenerate(sv))
+        r->kind = "degenerate";
+      else if (morse == 0)
+        r->kind = "minimum";
+      else if (morse == nfree)
+        r->kind = "maximum";
+      else
+        r->kind = "saddle";
+    }
+  }
+  if (nn > 0 && nodal_error(r, s) < 0)
+    return -1;
+  if (s->has_exact_action && r->has_action) {
+    r->has_err_action = 1;
+    r->err_action = fabs(r->action - s->exact_action);
+  }
+  if (nn > 0 && qpoint_quantities(r, s, sv) < 0)
+    return -1;
+  compose_message(r, sv);
+  return 0;
+}
+
+/* Error estimate without [exact]: solve again on twice the elements (same grading and
+ * degree) and compare at this mesh's nodes. With nodal errors of order h^(2p), e_h =
+ * |y_h - y_h/2| / (1 - 2^(-2p)) (Richardson); where the order is lower (singular ends)
+ * this underestimates, as docs/cli.md says. */
+int cli_report_estimate(cli_report *r, const scene *s, const cv_problem *p)
+{
+  int n = s->n, nn = r->nodes;
+  if (nn <= 0 || r->st != CVAR_OK || s->elements > INT_MAX / 18)
+    return 0;
+  scene fine = *s;
+  fine.elements = s->elements * 2;
+  char err[SC_ERRLEN];
+  cv_status why;
+  cv_solver *f = cv_solver_new(&why);
+  double *yf = malloc((size_t)nn * n * sizeof *yf);
+  int rc = -1;
+  if (!f || !yf)
+    goto done;
+  rc = 0;
+  if (scene_solver_configure(&fine, f, err, sizeof err) != CVAR_OK || cv_solve(f, p) != CVAR_OK ||
+      cv_solver_eval(f, nn, r->x, yf, NULL) != CVAR_OK)
+    goto done;
+  double e = 0;
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < nn; j++)
+      e = fmax(e, fabs(r->y[(size_t)j * n + i] - yf[(size_t)i * nn + j]));
+  e /= 1 - pow(2.0, -2.0 * r->degree);
+  if (isfinite(e)) {
+    r->has_err_est = 1;
+    r->err_est = e;
+  }
+done:
+  cv_solver_free(f);
+  free(yf);
+  return rc;
+}

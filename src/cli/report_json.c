@@ -1,0 +1,97 @@
+/* src/cli/report_json.c — the JSON report of SCENES.md ("--json"), with jansson.
+ * SPDX-License-Identifier: MIT
+ *
+ * Keys that do not apply are left out (never placeholders); so is any number that came
+ * out non-finite, since JSON has no NaN. Reals are written with 17 significant digits, so
+ * they read back to the same double.
+ */
+#include <jansson.h>
+#include <math.h>
+
+#include "cli/cli.h"
+
+/* Set key to a real only when it is finite (json_real refuses NaN and infinities). */
+static int set_real(json_t *o, const char *key, double v)
+{
+  if (!isfinite(v))
+    return 0;
+  return json_object_set_new(o, key, json_real(v));
+}
+
+static json_t *min_max(double lo, double hi, int drift)
+{
+  json_t *o = json_object();
+  if (!o)
+    return NULL;
+  set_real(o, "min", lo);
+  set_real(o, "max", hi);
+  if (drift)
+    set_real(o, "drift", hi - lo);
+  return o;
+}
+
+int cli_report_json(FILE *f, const cli_report *r)
+{
+  const scene *s = r->sc;
+  json_t *o = json_object(), *a;
+  if (!o)
+    return -1;
+  json_object_set_new(o, "title", json_string(s->title));
+  json_object_set_new(o, "status", json_string(r->status));
+  json_object_set_new(o, "message", json_string(r->message));
+  json_object_set_new(o, "method", json_string(scene_method_name(r->method)));
+  if (r->nodes > 0) {
+    json_object_set_new(o, "elements", json_integer(r->elements));
+    json_object_set_new(o, "degree", json_integer(r->degree));
+    json_object_set_new(o, "nodes", json_integer(r->nodes));
+  }
+  a = json_array();
+  for (int i = 0; i < s->n; i++)
+    json_array_append_new(a, json_string(s->unknowns[i]));
+  json_object_set_new(o, "unknowns", a);
+  if (r->has_action)
+    set_real(o, "action", r->action);
+  if (r->has_gradient_norm)
+    set_real(o, "gradient_norm", r->gradient_norm);
+  json_object_set_new(o, "iterations", json_integer(r->iterations));
+  if (r->has_time)
+    set_real(o, "time_s", r->time_s);
+  if (r->has_morse) {
+    json_object_set_new(o, "morse_index", json_integer(r->morse));
+    json_object_set_new(o, "stationary_kind", json_string(r->kind));
+  }
+  if (r->has_err_nodal || r->has_err_action) {
+    json_t *e = json_object();
+    if (r->has_err_nodal)
+      set_real(e, "max_nodal", r->err_nodal);
+    if (r->has_err_action)
+      set_real(e, "action", r->err_action);
+    json_object_set_new(o, "error", e);
+  }
+  if (r->has_err_est)
+    set_real(o, "error_estimate", r->err_est);
+  if (r->has_energy)
+    json_object_set_new(o, "energy", min_max(r->emin, r->emax, 1));
+  json_t *mom = json_object();
+  for (int i = 0; i < s->n; i++)
+    if (r->has_mom[i])
+      json_object_set_new(mom, s->unknowns[i], min_max(r->mom_min[i], r->mom_max[i], 0));
+  if (json_object_size(mom) > 0)
+    json_object_set_new(o, "momenta", mom);
+  else
+    json_decref(mom);
+  json_t *rep = json_object();
+  for (int k = 0; k < s->nreports; k++)
+    if (r->has_rep[k])
+      set_real(rep, s->reports[k].name, r->rep[k]);
+  if (json_object_size(rep) > 0)
+    json_object_set_new(o, "report", rep);
+  else
+    json_decref(rep);
+
+  int rc = json_dumpf(o, f, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
+  if (rc == 0 && fputc('\n', f) == EOF)
+    rc = -1;
+  json_decref(o);
+  return rc;
+}

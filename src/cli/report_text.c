@@ -1,0 +1,42 @@
+/* src/cli/report_text.c — the human summary `solve` prints by default.
+ * SPDX-License-Identifier: MIT */
+#include "cli/cli.h"
+
+void cli_report_text(FILE *f, const cli_report *r)
+{
+  const scene *s = r->sc;
+  fprintf(f, "%s\n", s->title);
+  fprintf(f, "  status      %s: %s\n", r->status, r->message);
+  fprintf(f, "  method      %s, %d iteration%s", scene_method_name(r->method), r->iterations,
+          r->iterations == 1 ? "" : "s");
+  if (r->has_time)
+    fprintf(f, ", %.3g s", r->time_s);
+  fputc('\n', f);
+  if (r->nodes > 0)
+    fprintf(f, "  mesh        %d elements of degree %d, %d nodes\n", r->elements, r->degree,
+            r->nodes);
+  if (r->has_action)
+    fprintf(f, "  action      %.15g\n", r->action);
+  if (r->has_gradient_norm)
+    fprintf(f, "  residual    %.3g (max-norm of the scaled Euler-Lagrange residual)\n",
+            r->gradient_norm);
+  if (r->has_morse)
+    fprintf(f, "  stationary  %s (Morse index %d)\n", r->kind, r->morse);
+  if (r->has_err_nodal)
+    fprintf(f, "  error       %.3g max at the nodes (against [exact])\n", r->err_nodal);
+  if (r->has_err_action)
+    fprintf(f, "  error       %.3g in the action (against [exact] action = %.17g)\n",
+            r->err_action, s->exact_action);
+  if (r->has_err_est)
+    fprintf(f, "  estimate    %.3g max nodal error (from a mesh twice as fine)\n", r->err_est);
+  if (r->has_energy)
+    fprintf(f, "  energy      H from %.15g to %.15g (drift %.3g)\n", r->emin, r->emax,
+            r->emax - r->emin);
+  for (int i = 0; i < s->n; i++)
+    if (r->has_mom[i])
+      fprintf(f, "  momentum    dF/d%s' from %.15g to %.15g (%s is cyclic)\n", s->unknowns[i],
+              r->mom_min[i], r->mom_max[i], s->unknowns[i]);
+  for (int k = 0; k < s->nreports; k++)
+    if (r->has_rep[k])
+      fprintf(f, "  report      %s = %.15g\n", s->reports[k].name, r->rep[k]);
+}

@@ -1,0 +1,136 @@
+/* src/scene/scene.h — scene files (shared/SCENES.md): load, validate, build a cv_problem.
+ * SPDX-License-Identifier: MIT
+ *
+ * Internal to the library and the calcvar command (not installed). The loader never
+ * prints and never exits: every failure comes back as one sentence "FILE:LINE: what is
+ * wrong" (or "FILE: what is wrong" when there is no line, e.g. a --set override) in a
+ * caller buffer of errlen bytes (SC_ERRLEN is a comfortable size).
+ *
+ * Lifetime: a cv_problem built from a scene refers to the scene's expression DAG and
+ * guess data, so free the problem before the scene.
+ *
+ * Slots of every expression (the convention of src/expr): 0 = the variable,
+ * 1..n = the unknowns y_i, n+1..2n = their derivatives y'_i.
+ */
+#ifndef CV_SCENE_H
+#define CV_SCENE_H
+
+#include <stddef.h>
+
+#include "calcvar.h"
+#include "expr/expr.h"
+
+enum { SC_ERRLEN = 1024 };
+
+/** One `--set name=value` override; value is a constant expression. */
+typedef struct {
+  const char *name;
+  const char *value;
+} sc_set;
+
+/** A named entry of [parameters], [definitions], [constraints], [integrals], [report]. */
+typedef struct {
+  char *name;
+  int line;     /* line of the entry in the scene file */
+  ex_id expr;   /* the expression (parameters: the folded number) */
+  ex_id expr2;  /* [integrals]: the constant c as a node; else -1 */
+  double value; /* [parameters]: the value; [integrals]: c */
+} sc_item;
+
+/** End conditions of one unknown: fixed values or natural (free) ends. */
+typedef struct {
+  double value[2]; /* at a and at b; meaningful where not free */
+  int free_end[2]; /* nonzero: natural boundary condition dF/dy' = 0 there */
+  int line;
+} sc_boundary;
+
+/** Methods of SCENES.md "Method names". */
+typedef enum {
+  SC_NEWTON = 0, SC_LBFGS, SC_TNEWTON, SC_MMA, SC_CCSAQ, SC_SLSQP, SC_AUGLAG, SC_NUM_METHODS
+} sc_method;
+
+typedef struct scene {
+  char *file;     /* the name used in messages */
+  char *title;
+  char *variable; /* default "x" */
+  double a, b;
+  int n;          /* number of unknowns */
+  char **unknowns;
+
+  ex_dag *dag;    /* owns every expression below */
+  ex_id F;        /* the integrand */
+  int F_line;
+
+  sc_boundary *bc; /* [n] */
+  ex_id *guess;    /* [n]: expression of the variable, or -1 for the default */
+  ex_id *exact;    /* [n]: expression of the variable, or -1 when not given */
+  int has_exact_action;
+  double exact_action;
+
+  int nparams, ndefs, ncons, nints, nreports;
+  sc_item *params, *defs, *cons, *ints, *reports;
+
+  /* [mesh] */
+  int elements;        /* default 100 */
+  int degree;          /* default 1 */
+  int nbreak;
+  double *breakpoints; /* sorted, inside (a, b) */
+  double adapt;        /* 0: off */
+  int adapt_line;
+  double grading;      /* 0: uniform; else the exponent k >= 1 (an addition, docs/scenes.md) */
+  int graded_end;      /* CVAR_GRADE_A, CVAR_GRADE_B or CVAR_GRADE_BOTH */
+
+  /* [solver] */
+  sc_method method;
+  int method_line;     /* 0 when not given */
+  double tolerance;    /* default 1e-10 */
+  int max_iterations;  /* default 50 */
+} scene;
+
+/** Load a scene file. `name` for messages is the path itself. nset overrides (may be 0). */
+scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
+                       size_t errlen);
+/** Load a scene from memory: len bytes (NUL bytes inside are rejected), `name` is used in
+ * messages (e.g. "gallery:catenary"). */
+scene *scene_load_buffer(const char *text, size_t len, const char *name, int nset,
+                         const sc_set *set, char *err, size_t errlen);
+/** Release a scene; NULL is a no-op. */
+void scene_free(scene *s);
+
+/** The method's name ("newton", "lbfgs", ...) and the reverse look-up (-1 if unknown). */
+const char *scene_method_name(sc_method m);
+int scene_method_from_name(const char *name);
+/** Derivative groups a method asks the integrand for: newton F|GRAD|HESS, the NLopt
+ * minimisers F|GRAD. */
+unsigned scene_method_need(sc_method m);
+
+/** A problem for the scene's integrand, ends and guess (constraints are not attached:
+ * the core has no API for them yet). max_need: CVAR_NEED_* bits the integrand compiles. */
+cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size_t errlen);
+/** Apply [mesh] and [solver] to a solver (elements, degree, grading, breakpoints,
+ * tolerances, maximum iterations). */
+cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_t errlen);
+
+/** Whether F depends explicitly on the variable / on unknown i (not through y'_i). */
+int scene_F_depends_on_variable(const scene *s);
+int scene_F_depends_on_unknown(const scene *s, int i);
+
+/* Evaluators over m points, structure of arrays like cv_solver_get_qpoints: x[k],
+ * y[i*m + k], dy[i*m + k]. Each returns 0 on success, -1 on allocation failure.
+ * Non-finite values are written as they come: the caller checks. */
+
+/** exact[i*m + k] from [exact]; NaN for unknowns without an exact solution. */
+int scene_eval_exact(const scene *s, int m, const double *x, double *exact);
+/** The guess (the [guess] expression or the default) at m abscissae: y[i*m + k]. */
+int scene_eval_guess(const scene *s, int m, const double *x, double *y);
+/** H = sum_i y'_i dF/dy'_i - F at m points. */
+int scene_eval_energy(scene *s, int m, const double *x, const double *y, const double *dy,
+                      double *H);
+/** p[i*m + k] = dF/dy'_i at m points, every unknown. */
+int scene_eval_momenta(scene *s, int m, const double *x, const double *y, const double *dy,
+                       double *p);
+/** K_r at m points: out[r*m + k] for each [report] entry r. */
+int scene_eval_reports(scene *s, int m, const double *x, const double *y, const double *dy,
+                       double *out);
+
+#endif /* CV_SCENE_H */

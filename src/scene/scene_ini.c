@@ -1,0 +1,121 @@
+/* src/scene/scene_ini.c — feed the logical lines through libinih, collect entries per section.
+ * SPDX-License-Identifier: MIT
+ *
+ * inih reads through ini_parse_stream with our reader, which hands out one canonical line
+ * per logical line: "[section]" or "KEY = @INDEX". The value itself stays in the logical
+ * line (any length: INI_MAX_LINE never cuts it) and the handler fetches it by INDEX. inih
+ * processes each line right after reading it, so the reader's current index is also the
+ * handler's line (Debian's inih passes no line number: INI_HANDLER_LINENO is 0). inih
+ * decides what is a section and what is a key; the handler rejects keys outside a
+ * section and keys given twice.
+ */
+#include <ini.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene/scene_internal.h"
+
+typedef struct {
+  sc_llines *ll;
+  sc_raw *raw;
+  int next;   /* next logical line the reader hands out */
+  int cur;    /* the logical line inih is processing */
+  char *err;
+  size_t errlen;
+  int failed;
+} feed;
+
+static char *reader(char *str, int num, void *stream)
+{
+  feed *f = stream;
+  if (f->next >= f->ll->n)
+    return NULL;
+  f->cur = f->next++;
+  const sc_lline *l = &f->ll->l[f->cur];
+  if (l->is_section)
+    snprintf(str, (size_t)num, "[%s]\n", sc_section_name(l->section));
+  else
+    snprintf(str, (size_t)num, "%s = @%d\n", l->entry.key, f->cur);
+  return str;
+}
+
+static int handler(void *user, const char *section, const char *name, const char *value)
+{
+  feed *f = user;
+  sc_lline *l = &f->ll->l[f->cur];
+  const char *file = f->raw->file;
+  char *end;
+  long idx = value[0] == '@' ? strtol(value + 1, &end, 10) : -1;
+
+  if (l->is_section || idx != f->cur || *end || strcmp(name, l->entry.key) != 0) {
+    /* inih split the line somewhere else than at our '=' (it also accepts ':'). */
+    sc_err(f->err, f->errlen, file, l->line, "expected 'name = value', got a ':' in '%s'",
+           l->is_section ? "" : l->entry.key);
+    f->failed = 1;
+    return 0;
+  }
+  int sec = sc_section_from_name(section);
+  if (sec < 0) {
+    sc_err(f->err, f->errlen, file, l->line,
+           "'%s' is outside any section (start with [scene])", name);
+    f->failed = 1;
+    return 0;
+  }
+  sc_raw *raw = f->raw;
+  for (int i = 0; i < raw->ne[sec]; i++)
+    if (strcmp(raw->e[sec][i].key, name) == 0) {
+      sc_err(f->err, f->errlen, file, l->line, "'%s' is given twice in [%s] (first at line %d)",
+             name, section, raw->e[sec][i].line);
+      f->failed = 1;
+      return 0;
+    }
+  sc_entry *e = realloc(raw->e[sec], (size_t)(raw->ne[sec] + 1) * sizeof *e);
+  if (!e) {
+    sc_err(f->err, f->errlen, file, l->line, "out of memory");
+    f->failed = 1;
+    return 0;
+  }
+  raw->e[sec] = e;
+  e[raw->ne[sec]++] = l->entry; /* ownership moves to raw */
+  memset(&l->entry, 0, sizeof l->entry);
+  return 1;
+}
+
+void sc_raw_free(sc_raw *raw)
+{
+  for (int s = 0; s < SEC_COUNT; s++) {
+    for (int i = 0; i < raw->ne[s]; i++)
+      sc_entry_free(&raw->e[s][i]);
+    free(raw->e[s]);
+    raw->e[s] = NULL;
+    raw->ne[s] = 0;
+  }
+}
+
+int sc_raw_read(sc_raw *raw, const char *text, size_t len, const char *file, char *err,
+                size_t errlen)
+{
+  sc_llines ll;
+  memset(raw, 0, sizeof *raw);
+  raw->file = file;
+  if (sc_llines_read(&ll, text, len, file, err, errlen) < 0)
+    return -1;
+  for (int i = 0; i < ll.n; i++)
+    if (ll.l[i].is_section)
+      raw->sec_line[ll.l[i].section] = ll.l[i].line;
+
+  feed f = {&ll, raw, 0, 0, err, errlen, 0};
+  int r = ini_parse_stream(reader, &f, handler, &f);
+  if (r != 0 && !f.failed) {
+    /* inih found a syntax error the pre-pass let through: r is the canonical line. */
+    int line = r > 0 && r <= ll.n ? ll.l[r - 1].line : 0;
+    sc_err(err, errlen, file, line, "syntax error");
+  }
+  sc_llines_free(&ll);
+  if (r != 0) {
+    sc_raw_free(raw);
+    return -1;
+  }
+  return 0;
+}

@@ -1,0 +1,117 @@
+/* src/scene/scene_internal.h — private types of the scene loader: logical lines, raw entries.
+ * SPDX-License-Identifier: MIT */
+#ifndef CV_SCENE_INTERNAL_H
+#define CV_SCENE_INTERNAL_H
+
+#include <stdarg.h>
+#include <stddef.h>
+
+#include "scene/scene.h"
+
+/* Where a piece of a (possibly continued) value came from: the value's characters from
+ * `off` on were read from physical line `line`, starting at 1-based column `col`. Used to
+ * turn an expression error at "column C" of the joined value back into FILE:LINE. */
+typedef struct {
+  int off;
+  int line;
+  int col;
+} sc_piece;
+
+/* One `key = value` after the pre-pass: comments stripped, continuation lines joined by
+ * one space, surrounding white space trimmed. */
+typedef struct {
+  char *key;
+  char *value;
+  int line; /* physical line of the key */
+  int npieces;
+  sc_piece *pieces;
+} sc_entry;
+
+typedef enum {
+  SEC_SCENE, SEC_PARAMETERS, SEC_DEFINITIONS, SEC_BOUNDARY, SEC_GUESS, SEC_CONSTRAINTS,
+  SEC_INTEGRALS, SEC_EXACT, SEC_REPORT, SEC_MESH, SEC_SOLVER, SEC_COUNT
+} sc_section;
+
+/* A logical line: a section header or a key line (with its continuations). */
+typedef struct {
+  int is_section;
+  int section; /* is_section: the sc_section */
+  int line;    /* physical line where it starts */
+  sc_entry entry;
+} sc_lline;
+
+typedef struct {
+  int n;
+  sc_lline *l;
+} sc_llines;
+
+/* Entries per section in file order, as inih delivered them. */
+typedef struct {
+  const char *file;
+  sc_entry *e[SEC_COUNT];
+  int ne[SEC_COUNT];
+  int sec_line[SEC_COUNT]; /* line of the section header, 0 when absent */
+} sc_raw;
+
+/* scene_error.c */
+void sc_err(char *err, size_t errlen, const char *file, int line, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 5, 6)))
+#endif
+    ;
+char *sc_strdup(const char *s);
+char *sc_strndup(const char *s, size_t n);
+
+/* scene_lines.c: the pre-pass (physical lines -> logical lines). */
+const char *sc_section_name(int sec);
+int sc_section_from_name(const char *name);
+int sc_llines_read(sc_llines *ll, const char *text, size_t len, const char *file, char *err,
+                   size_t errlen);
+void sc_llines_free(sc_llines *ll);
+
+/* scene_ini.c: feed the logical lines through libinih, collect entries per section. */
+int sc_raw_read(sc_raw *raw, const char *text, size_t len, const char *file, char *err,
+                size_t errlen);
+void sc_raw_free(sc_raw *raw);
+void sc_entry_free(sc_entry *e);
+
+/* Map a 0-based offset in an entry's value to a physical line and 1-based column. */
+void sc_entry_locate(const sc_entry *e, int off, int *line, int *col);
+
+/* scene_names.c: names and the resolver used while parsing expressions. */
+int sc_is_identifier(const char *s);
+int sc_is_reserved(const char *s);
+
+/* The loader's state while it interprets the entries (scene_load.c and friends). */
+typedef enum { SC_R_PARAM, SC_R_FULL } sc_rmode;
+typedef struct {
+  scene *s;
+  sc_raw raw;
+  const char *file;
+  char *err;
+  size_t errlen;
+  sc_rmode mode; /* what names resolve: parameters only, or everything */
+  int limit;     /* parameters (SC_R_PARAM) or definitions (SC_R_FULL) usable: index < limit */
+} sc_loader;
+
+/* A value split at commas outside parentheses; off[i] is item i's offset in the value. */
+typedef struct {
+  int n;
+  char **item;
+  int *off;
+} sc_list;
+
+/* scene_parse.c */
+int sc_list_split(const char *value, sc_list *list);
+void sc_list_free(sc_list *list);
+ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what);
+int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
+                   const char *what, double *value);
+const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap);
+int sc_first_slot(const scene *s, ex_id e, int from, int to);
+
+/* scene_eval.c */
+int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const double *x,
+                  const double *y, const double *dy, double *out);
+
+#endif /* CV_SCENE_INTERNAL_H */

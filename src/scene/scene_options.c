@@ -1,0 +1,204 @@
+/* src/scene/scene_options.c — [mesh] and [solver]: discretisation and method settings.
+ * SPDX-License-Identifier: MIT */
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene/scene_internal.h"
+
+int sc_load_mesh(sc_loader *L);
+int sc_load_solver(sc_loader *L);
+
+static const char *const method_names[SC_NUM_METHODS] = {
+  "newton", "lbfgs", "tnewton", "mma", "ccsaq", "slsqp", "auglag"};
+
+const char *scene_method_name(sc_method m)
+{
+  return m >= 0 && m < SC_NUM_METHODS ? method_names[m] : "?";
+}
+
+int scene_method_from_name(const char *name)
+{
+  for (int i = 0; i < SC_NUM_METHODS; i++)
+    if (strcmp(name, method_names[i]) == 0)
+      return i;
+  return -1;
+}
+
+unsigned scene_method_need(sc_method m)
+{
+  return m == SC_NEWTON ? CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS
+                        : CVAR_NEED_F | CVAR_NEED_GRAD;
+}
+
+/* A whole number written in decimal digits (no expression: counts are not computed). */
+static int parse_count(sc_loader *L, const sc_entry *e, long lo, long hi, int *out)
+{
+  const char *p = e->value;
+  char *end;
+  if (*p == '+')
+    p++;
+  long v = (*p >= '0' && *p <= '9') ? strtol(p, &end, 10) : -1;
+  if (v < 0 || *end != '\0' || v < lo || v > hi) {
+    sc_err(L->err, L->errlen, L->file, e->line, "%s must be a whole number from %ld to %ld, "
+           "got '%s'", e->key, lo, hi, e->value);
+    return -1;
+  }
+  *out = (int)v;
+  return 0;
+}
+
+static int check_keys(sc_loader *L, int sec, const char *const *keys, const char *list)
+{
+  for (int i = 0; i < L->raw.ne[sec]; i++) {
+    const sc_entry *e = &L->raw.e[sec][i];
+    int ok = 0;
+    for (int k = 0; keys[k]; k++)
+      ok |= strcmp(e->key, keys[k]) == 0;
+    if (!ok) {
+      sc_err(L->err, L->errlen, L->file, e->line, "unknown key '%s' in [%s] (known: %s)",
+             e->key, sc_section_name(sec), list);
+      return -1;
+    }
+  }
+  return 0;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+static int load_breakpoints(sc_loader *L, const sc_entry *e)
+{
+  scene *s = L->s;
+  sc_list list;
+  if (sc_list_split(e->value, &list) < 0 ||
+      !(s->breakpoints = malloc((size_t)list.n * sizeof *s->breakpoints))) {
+    sc_list_free(&list);
+    sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
+    return -1;
+  }
+  for (int i = 0; i < list.n; i++) {
+    double v;
+    if (sc_parse_const(L, e, list.off[i], list.item[i], "breakpoint", &v) < 0) {
+      sc_list_free(&list);
+      return -1;
+    }
+    if (!(v > s->a && v < s->b)) {
+      sc_err(L->err, L->errlen, L->file, e->line,
+             "breakpoint %.17g is not inside the interval (%.17g, %.17g)", v, s->a, s->b);
+      sc_list_free(&list);
+      return -1;
+    }
+    s->breakpoints[s->nbreak++] = v;
+  }
+  sc_list_free(&list);
+  qsort(s->breakpoints, (size_t)s->nbreak, sizeof *s->breakpoints, cmp_double);
+  for (int i = 1; i < s->nbreak; i++)
+    if (s->breakpoints[i] == s->breakpoints[i - 1]) {
+      sc_err(L->err, L->errlen, L->file, e->line, "breakpoint %.17g is given twice",
+             s->breakpoints[i]);
+      return -1;
+    }
+  return 0;
+}
+
+int sc_load_mesh(sc_loader *L)
+{
+  static const char *const keys[] = {"elements", "degree", "breakpoints", "adapt",
+                                     "grading", "grading_at", NULL};
+  scene *s = L->s;
+  s->elements = 100;
+  s->degree = 1;
+  s->graded_end = CVAR_GRADE_A;
+  if (check_keys(L, SEC_MESH, keys,
+                 "elements, degree, breakpoints, adapt, grading, grading_at") < 0)
+    return -1;
+  for (int i = 0; i < L->raw.ne[SEC_MESH]; i++) {
+    const sc_entry *e = &L->raw.e[SEC_MESH][i];
+    const char *k = e->key;
+    if (strcmp(k, "elements") == 0) {
+      /* INT_MAX / 9: nodes = elements * degree + 1 must stay an int at degree 8. */
+      if (parse_count(L, e, 1, INT_MAX / 9, &s->elements) < 0)
+        return -1;
+    } else if (strcmp(k, "degree") == 0) {
+      if (parse_count(L, e, 1, 8, &s->degree) < 0)
+        return -1;
+    } else if (strcmp(k, "breakpoints") == 0) {
+      if (load_breakpoints(L, e) < 0)
+        return -1;
+    } else if (strcmp(k, "adapt") == 0) {
+      if (sc_parse_const(L, e, 0, e->value, "adapt", &s->adapt) < 0)
+        return -1;
+      if (!(s->adapt > 0)) {
+        sc_err(L->err, L->errlen, L->file, e->line,
+               "adapt is the target max nodal error and must be > 0, got %g", s->adapt);
+        return -1;
+      }
+      s->adapt_line = e->line;
+    } else if (strcmp(k, "grading") == 0) {
+      if (sc_parse_const(L, e, 0, e->value, "grading", &s->grading) < 0)
+        return -1;
+      if (!(s->grading >= 1)) {
+        sc_err(L->err, L->errlen, L->file, e->line,
+               "grading is the exponent k >= 1 of x = a + (b - a) t^k, got %g", s->grading);
+        return -1;
+      }
+    } else { /* grading_at */
+      const char *v = e->value;
+      if (strcmp(v, "a") == 0)
+        s->graded_end = CVAR_GRADE_A;
+      else if (strcmp(v, "b") == 0)
+        s->graded_end = CVAR_GRADE_B;
+      else if (strcmp(v, "both") == 0)
+        s->graded_end = CVAR_GRADE_BOTH;
+      else {
+        sc_err(L->err, L->errlen, L->file, e->line,
+               "grading_at must be a, b or both, got '%s'", v);
+        return -1;
+      }
+    }
+  }
+  return 0;
+}
+
+int sc_load_solver(sc_loader *L)
+{
+  static const char *const keys[] = {"method", "tolerance", "max_iterations", NULL};
+  scene *s = L->s;
+  s->method = SC_NEWTON;
+  s->tolerance = 1e-10;
+  s->max_iterations = 50;
+  if (check_keys(L, SEC_SOLVER, keys, "method, tolerance, max_iterations") < 0)
+    return -1;
+  for (int i = 0; i < L->raw.ne[SEC_SOLVER]; i++) {
+    const sc_entry *e = &L->raw.e[SEC_SOLVER][i];
+    if (strcmp(e->key, "method") == 0) {
+      int m = scene_method_from_name(e->value);
+      if (m < 0) {
+        sc_err(L->err, L->errlen, L->file, e->line, "unknown method '%s' (known: newton, "
+               "lbfgs, tnewton, mma, ccsaq, slsqp, auglag)", e->value);
+        return -1;
+      }
+      s->method = (sc_method)m;
+      s->method_line = e->line;
+    } else if (strcmp(e->key, "tolerance") == 0) {
+      if (sc_parse_const(L, e, 0, e->value, "tolerance", &s->tolerance) < 0)
+        return -1;
+      /* The core rejects rtol below 10 eps: a step test cannot resolve less. */
+      if (!(s->tolerance >= 10 * DBL_EPSILON && s->tolerance < 1)) {
+        sc_err(L->err, L->errlen, L->file, e->line,
+               "tolerance must be at least 10 eps = %.3g and below 1, got %g",
+               10 * DBL_EPSILON, s->tolerance);
+        return -1;
+      }
+    } else if (parse_count(L, e, 1, INT_MAX, &s->max_iterations) < 0) {
+      return -1;
+    }
+  }
+  return 0;
+}

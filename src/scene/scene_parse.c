@@ -1,0 +1,215 @@
+/* src/scene/scene_parse.c — expressions in scene values: lists, name resolution, messages.
+ * SPDX-License-Identifier: MIT */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene/scene_internal.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+void sc_list_free(sc_list *list)
+{
+  for (int i = 0; i < list->n; i++)
+    free(list->item[i]);
+  free(list->item);
+  free(list->off);
+  memset(list, 0, sizeof *list);
+}
+
+/* Split at commas outside parentheses (SCENES.md: `atan2(1, 2), 0` is two values); each
+ * item is trimmed. Returns the item count, or -1 on allocation failure. */
+int sc_list_split(const char *value, sc_list *list)
+{
+  int depth = 0, cap = 0;
+  const char *start = value;
+  memset(list, 0, sizeof *list);
+  for (const char *p = value;; p++) {
+    if (*p == '(')
+      depth++;
+    else if (*p == ')' && depth > 0)
+      depth--;
+    if (*p == '\0' || (*p == ',' && depth == 0)) {
+      const char *a = start, *b = p;
+      while (a < b && (*a == ' ' || *a == '\t'))
+        a++;
+      while (b > a && (b[-1] == ' ' || b[-1] == '\t'))
+        b--;
+      if (list->n == cap) {
+        cap = cap ? 2 * cap : 4;
+        char **it = realloc(list->item, (size_t)cap * sizeof *it);
+        if (it)
+          list->item = it;
+        int *off = realloc(list->off, (size_t)cap * sizeof *off);
+        if (off)
+          list->off = off;
+        if (!it || !off)
+          goto nomem;
+      }
+      list->item[list->n] = sc_strndup(a, (size_t)(b - a));
+      if (!list->item[list->n])
+        goto nomem;
+      list->off[list->n++] = (int)(a - value);
+      if (*p == '\0')
+        break;
+      start = p + 1;
+    }
+  }
+  return list->n;
+nomem:
+  sc_list_free(list);
+  return -1;
+}
+
+/* The name of a slot for messages: the variable, y or y'. */
+const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap)
+{
+  if (slot == 0)
+    snprintf(buf, cap, "%s", s->variable);
+  else if (slot <= s->n)
+    snprintf(buf, cap, "%s", s->unknowns[slot - 1]);
+  else
+    snprintf(buf, cap, "%s'", s->unknowns[slot - 1 - s->n]);
+  return buf;
+}
+
+/* First slot in [from, to] that e depends on, or -1. */
+int sc_first_slot(const scene *s, ex_id e, int from, int to)
+{
+  for (int k = from; k <= to; k++)
+    if (ex_depends_on(s->dag, e, k))
+      return k;
+  return -1;
+}
+
+static int find_name(char *const *names, int n, const char *name)
+{
+  for (int i = 0; i < n; i++)
+    if (strcmp(names[i], name) == 0)
+      return i;
+  return -1;
+}
+
+static int find_item(const sc_item *it, int n, const char *name)
+{
+  for (int i = 0; i < n; i++)
+    if (it[i].name && strcmp(it[i].name, name) == 0)
+      return i;
+  return -1;
+}
+
+/* Resolve a name for ex_parse. Parameters become their numbers and definitions their
+ * nodes, so both are substituted where named (SCENES.md [definitions]). */
+static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *err,
+                     size_t errlen)
+{
+  sc_loader *L = user;
+  scene *s = L->s;
+  int i;
+
+  if (strcmp(name, "pi") == 0 && primes == 0)
+    return ex_num(d, M_PI);
+  if ((i = find_item(s->params, s->nparams, name)) >= 0) {
+    if (L->mode == SC_R_PARAM && i >= L->limit) {
+      snprintf(err, errlen, i == L->limit ? "parameter '%s' refers to itself"
+                                          : "parameter '%s' is used before it is defined "
+                                            "(line %d)", name, s->params[i].line);
+      return -1;
+    }
+    if (primes) {
+      snprintf(err, errlen, "a prime is only allowed on an unknown, not on '%s'", name);
+      return -1;
+    }
+    return ex_num(d, s->params[i].value);
+  }
+  if (L->mode == SC_R_PARAM) {
+    snprintf(err, errlen, "unknown name '%s' (a parameter may use only numbers, pi and "
+             "earlier parameters)", name);
+    return -1;
+  }
+  if ((i = find_item(s->defs, s->ndefs, name)) >= 0) {
+    if (i >= L->limit) {
+      snprintf(err, errlen, i == L->limit ? "definition '%s' refers to itself"
+                                          : "definition '%s' is used before it is defined "
+                                            "(line %d)", name, s->defs[i].line);
+      return -1;
+    }
+    if (primes) {
+      snprintf(err, errlen, "a prime is only allowed on an unknown, not on '%s'", name);
+      return -1;
+    }
+    return s->defs[i].expr;
+  }
+  if (strcmp(name, s->variable) == 0) {
+    if (primes) {
+      snprintf(err, errlen, "a prime is only allowed on an unknown, not on the variable "
+               "'%s'", name);
+      return -1;
+    }
+    return ex_slot(d, 0);
+  }
+  if ((i = find_name(s->unknowns, s->n, name)) >= 0) {
+    if (primes > 1) {
+      snprintf(err, errlen, "only first derivatives may appear: '%s' has %d primes", name,
+               primes);
+      return -1;
+    }
+    return ex_slot(d, primes ? 1 + s->n + i : 1 + i);
+  }
+  snprintf(err, errlen, "unknown name '%s'", name);
+  return -1;
+}
+
+/* Parse text, which starts at offset off of entry e's value. On failure the message
+ * points at the physical line (and column) of the offending character. */
+ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what)
+{
+  char msg[400] = "";
+  int line, col;
+  if (text[0] == '\0') {
+    sc_entry_locate(e, off, &line, &col);
+    sc_err(L->err, L->errlen, L->file, line, "%s: a value is missing", what);
+    return -1;
+  }
+  ex_id r = ex_parse(L->s->dag, text, resolve, L, 0, msg, sizeof msg);
+  if (r >= 0)
+    return r;
+  int c = 0, k = 0;
+  if (sscanf(msg, "column %d: %n", &c, &k) >= 1 && k > 0 && c >= 1) {
+    sc_entry_locate(e, off + c - 1, &line, &col);
+    sc_err(L->err, L->errlen, L->file, line, "%s, column %d: %s", what, col, msg + k);
+  } else {
+    sc_entry_locate(e, off, &line, &col);
+    sc_err(L->err, L->errlen, L->file, line, "%s: %s", what, msg[0] ? msg : "out of memory");
+  }
+  return -1;
+}
+
+/* A constant expression (numbers, pi, parameters, definitions built from those), which
+ * must be finite. Returns 0, or -1 with a message. */
+int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
+                   const char *what, double *value)
+{
+  char nb[128];
+  int line, col;
+  ex_id r = sc_parse(L, e, off, text, what);
+  if (r < 0)
+    return -1;
+  sc_entry_locate(e, off, &line, &col);
+  int slot = sc_first_slot(L->s, r, 0, 2 * L->s->n);
+  if (slot >= 0 || ex_eval_const(L->s->dag, r, value) != 0) {
+    sc_err(L->err, L->errlen, L->file, line,
+           "%s must be a constant expression, but '%s' depends on '%s'", what, text,
+           slot >= 0 ? sc_slot_name(L->s, slot, nb, sizeof nb) : "?");
+    return -1;
+  }
+  if (!isfinite(*value)) {
+    sc_err(L->err, L->errlen, L->file, line, "%s '%s' is not a finite number (%g)", what,
+           text, *value);
+    return -1;
+  }
+  return 0;
+}

@@ -1,0 +1,89 @@
+/* src/scene/scene_problem.c — a cv_problem and solver settings from a loaded scene.
+ * SPDX-License-Identifier: MIT */
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "core/cv_internal_owned.h"
+#include "expr/ex_integrand.h"
+#include "scene/scene_internal.h"
+
+/* cv_guess_fn over the scene's [guess] (and the default for unknowns without one). */
+static int guess_cb(int m, const double *x, double *y, void *user)
+{
+  return scene_eval_guess(user, m, x, y) < 0 ? -1 : 0;
+}
+
+cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size_t errlen)
+{
+  cv_status why;
+  char msg[512] = "";
+  if (err && errlen)
+    err[0] = '\0';
+  cv_problem *p = cv_problem_new(s->n, s->a, s->b, &why);
+  if (!p) {
+    sc_err(err, errlen, s->file, 0, "cannot create the problem: %s", cv_strerror(why));
+    return NULL;
+  }
+  ex_integrand *ig = ex_integrand_new(s->dag, s->n, s->F, max_need, msg, sizeof msg);
+  if (!ig) {
+    sc_err(err, errlen, s->file, s->F_line, "integrand: %s", msg[0] ? msg : "out of memory");
+    goto fail;
+  }
+  why = cv_problem_set_integrand_owned(p, ex_integrand_eval, ig, ex_integrand_release);
+  if (why != CVAR_OK) {
+    sc_err(err, errlen, s->file, s->F_line, "integrand: %s", cv_strerror(why));
+    goto fail;
+  }
+  for (int i = 0; i < s->n; i++)
+    for (int end = 0; end < 2; end++) {
+      why = s->bc[i].free_end[end] ? cv_problem_set_free_end(p, i, end)
+                                   : cv_problem_set_end_value(p, i, end, s->bc[i].value[end]);
+      if (why != CVAR_OK) {
+        sc_err(err, errlen, s->file, s->bc[i].line, "[boundary] %s: %s", s->unknowns[i],
+               cv_strerror(why));
+        goto fail;
+      }
+    }
+  int any_guess = 0;
+  for (int i = 0; i < s->n; i++)
+    any_guess |= s->guess[i] >= 0;
+  /* Without [guess] the core's default is the same as ours (SCENES.md). */
+  if (any_guess && (why = cv_problem_set_guess(p, guess_cb, (void *)s)) != CVAR_OK) {
+    sc_err(err, errlen, s->file, 0, "[guess]: %s", cv_strerror(why));
+    goto fail;
+  }
+  return p;
+fail:
+  cv_problem_free(p);
+  return NULL;
+}
+
+cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_t errlen)
+{
+  const char *what = "elements";
+  if (err && errlen)
+    err[0] = '\0';
+  cv_status st = s->grading > 0
+                     ? cv_solver_set_mesh_graded(sv, s->elements, s->grading, s->graded_end)
+                     : cv_solver_set_elements(sv, s->elements);
+  if (st == CVAR_OK) {
+    what = "degree";
+    st = cv_solver_set_degree(sv, s->degree);
+  }
+  if (st == CVAR_OK && s->nbreak > 0) {
+    what = "breakpoints";
+    st = cv_solver_set_breakpoints(sv, s->nbreak, s->breakpoints);
+  }
+  if (st == CVAR_OK) {
+    what = "tolerance";
+    st = cv_solver_set_tolerances(sv, s->tolerance, s->tolerance);
+  }
+  if (st == CVAR_OK) {
+    what = "max_iterations";
+    st = cv_solver_set_max_iterations(sv, s->max_iterations);
+  }
+  if (st != CVAR_OK)
+    sc_err(err, errlen, s->file, 0, "%s: %s (%s)", what, cv_solver_last_error(sv),
+           cv_strerror(st));
+  return st;
+}
