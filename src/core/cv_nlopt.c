@@ -26,14 +26,58 @@ typedef struct {
   int *rows;          /* constraint row -> unknown index of its multiplier, or nu row */
   int *lrow, *var;    /* unknown index -> constraint row / NLopt variable, or -1 */
   int m;              /* number of constraint rows */
-  double scale;
+  double scale, action;
   long evals;
   cv_status stop;     /* status stored before a forced stop */
   nlopt_opt opt;
+  /* Preconditioned variables (theory NL-1): y = y0 + L^{-T} |D|^{-1/2} z with L D L^T the
+   * factor of a model Hessian (stiffness + mass), so the minimisers see an O(1)-conditioned
+   * problem instead of one whose condition grows like (elements)^2. */
+  cv_ldlt *P;
+  double *dinv, *Y0, *w;
 } nl_ctx;
 
-static void load(nl_ctx *c, const double *x) {
-  for (int v = 0; v < c->nv; v++) c->Y[c->yof[v]] = x[v];
+/* y(z) into c->Y, theory (NL-1). */
+static void load(nl_ctx *c, const double *z) {
+  int nf = c->d->nfree;
+  memset(c->w, 0, (size_t)nf * sizeof *c->w);
+  for (int v = 0; v < c->nv; v++) c->w[c->fof[v]] = c->dinv[c->fof[v]] * z[v];
+  cv_ldlt_solve_L(c->P, 1, c->w);
+  memcpy(c->Y, c->Y0, (size_t)c->d->ndof * sizeof *c->Y);
+  for (int v = 0; v < c->nv; v++) c->Y[c->yof[v]] += c->w[c->fof[v]];
+}
+
+/* A gradient row over the y unknowns (unknown-indexed in r, zero elsewhere) to z:
+ * dz = |D|^{-1/2} L^{-1} r. Overwrites r; writes nv values to out. */
+static void to_z(nl_ctx *c, double *r, double *out) {
+  cv_ldlt_solve_L(c->P, 0, r);
+  for (int v = 0; v < c->nv; v++) out[v] = c->dinv[c->fof[v]] * r[c->fof[v]];
+}
+
+/* Model Hessian integrand: (|y'|^2 + |y|^2 / L^2) / 2 per component, L = b - a. */
+static int model_F(int m, const double *x, const double *y, const double *dy, unsigned need,
+                   cv_partials *o, void *user) {
+  const int *nn = user;
+  int n = nn[0];
+  double iL2 = 1.0 / ((double)nn[1] * 1e-6); /* nn[1] holds (b-a)^2 in micro-units */
+  (void)x;
+  (void)need;
+  for (int k = 0; k < m; k++) {
+    double s = 0.0;
+    for (int i = 0; i < n; i++) s += dy[i * m + k] * dy[i * m + k] + iL2 * y[i * m + k] * y[i * m + k];
+    o->F[k] = 0.5 * s;
+    for (int i = 0; i < n && o->Fy; i++) {
+      o->Fy[i * m + k] = iL2 * y[i * m + k];
+      o->Fp[i * m + k] = dy[i * m + k];
+    }
+    for (int i = 0; i < n && o->Fyy; i++)
+      for (int j = 0; j < n; j++) {
+        o->Fyy[(i * n + j) * m + k] = i == j ? iL2 : 0.0;
+        o->Fyp[(i * n + j) * m + k] = 0.0;
+        o->Fpp[(i * n + j) * m + k] = i == j ? 1.0 : 0.0;
+      }
+  }
+  return 0;
 }
 
 static double objective(unsigned n, const double *x, double *grad, void *data) {
@@ -43,7 +87,7 @@ static double objective(unsigned n, const double *x, double *grad, void *data) {
   c->evals++;
   load(c, x);
   for (int v = 0; v < c->nv; v++) {
-    if (!(fabs(x[v]) <= RUNAWAY * c->scale)) {
+    if (!(fabs(c->Y[c->yof[v]]) <= RUNAWAY * c->scale)) {
       c->stop = CVAR_ENOTMIN;
       nlopt_force_stop(c->opt);
       return 0.0;
@@ -58,15 +102,18 @@ static double objective(unsigned n, const double *x, double *grad, void *data) {
     return 0.0;
   }
   if (st) return HUGE_VAL; /* outside the integrand's domain: a rejected trial point */
-  if (grad)
-    for (int v = 0; v < c->nv; v++) grad[v] = c->g[c->fof[v]];
+  if (grad) {
+    for (int f = 0; f < c->d->nfree; f++) c->w[f] = 0.0;
+    for (int v = 0; v < c->nv; v++) c->w[c->fof[v]] = c->g[c->fof[v]];
+    to_z(c, c->w, grad);
+  }
   return S;
 }
 
-/* Constraint rows: G_k(x_j, Y_j) at the nodes with multipliers, then I_r - c_r; sign = +1
- * or -1 (MMA and CCSAQ take inequalities only: h <= 0 and -h <= 0). */
-static void constraints(unsigned m, double *result, unsigned n, const double *x, double *grad,
-                        double sign, nl_ctx *c) {
+/* Constraint rows: G_k(x_j, Y_j) at the nodes with multipliers, then I_r - c_r. */
+static void eq_constraints(unsigned m, double *result, unsigned n, const double *x,
+                           double *grad, void *data) {
+  nl_ctx *c = data;
   (void)n;
   load(c, x);
   if (grad) memset(grad, 0, (size_t)m * c->nv * sizeof *grad);
@@ -75,19 +122,17 @@ static void constraints(unsigned m, double *result, unsigned n, const double *x,
     c->stop = st;
     nlopt_force_stop(c->opt);
   }
-  for (unsigned i = 0; i < m; i++) result[i] = st ? 0.0 : sign * c->g[c->rows[i]];
-  if (grad && sign < 0)
-    for (size_t i = 0; i < (size_t)m * c->nv; i++) grad[i] = -grad[i];
+  for (unsigned i = 0; i < m; i++) result[i] = st ? 0.0 : c->g[c->rows[i]];
+  if (!grad) return;
+  /* Each Jacobian row from y to z (NL-1): row <- |D|^{-1/2} L^{-1} row. */
+  for (unsigned i = 0; i < m; i++) {
+    double *row = grad + (size_t)i * c->nv;
+    memset(c->w, 0, (size_t)c->d->nfree * sizeof *c->w);
+    for (int v = 0; v < c->nv; v++) c->w[c->fof[v]] = row[v];
+    to_z(c, c->w, row);
+  }
 }
 
-static void eq_constraints(unsigned m, double *r, unsigned n, const double *x, double *g,
-                           void *data) {
-  constraints(m, r, n, x, g, 1.0, data);
-}
-static void neg_constraints(unsigned m, double *r, unsigned n, const double *x, double *g,
-                            void *data) {
-  constraints(m, r, n, x, g, -1.0, data);
-}
 
 static nlopt_algorithm algorithm(cv_method m) {
   switch (m) {
@@ -98,6 +143,48 @@ static nlopt_algorithm algorithm(cv_method m) {
   case CVAR_METHOD_SLSQP: return NLOPT_LD_SLSQP;
   default: return NLOPT_AUGLAG;
   }
+}
+
+/* Scaled residual of the Lagrangian (N-3) at Y with least-squares multipliers (C-5), which
+ * are left in the solver's multiplier array; the action goes to c->action. */
+static double stationarity(nl_ctx *c, cv_kkt *kkt, const double *Y) {
+  const cv_disc *d = c->d;
+  double S, rn = 0.0;
+  cv_status st = CVAR_OK;
+  if (d->nc > 0 || d->ni > 0) st = cv_kkt_init_multipliers(kkt, Y, c->s->mult);
+  if (!st) st = cv_kkt_eval(kkt, Y, c->s->mult, &S, c->g, NULL, NULL);
+  if (st) return NAN;
+  c->action = S;
+  for (int f = 0; f < d->nfree; f++) rn = fmax(rn, fabs(c->g[f]) / d->mass[f]);
+  return rn;
+}
+
+/* Factor the model Hessian (stiffness + mass of each component, identity on multiplier
+ * rows) in the solver's sparsity pattern; D is positive, so |D|^{-1/2} is plain D^{-1/2}. */
+static cv_status precondition(nl_ctx *c, const cv_disc *d, const long *colptr) {
+  int nn[2];
+  double S, L2 = (d->b - d->a) * (d->b - d->a);
+  nn[0] = d->n;
+  nn[1] = (int)fmin(2e9, fmax(1.0, L2 * 1e6));
+  c->P = cv_ldlt_new(d->nfree, colptr);
+  if (!c->P) return CVAR_ENOMEM;
+  double *Ax = cv_ldlt_values(c->P);
+  cv_status st = cv_assemble(&c->kkt->as, model_F, nn, c->Y0, &S, NULL, colptr, Ax, 1.0);
+  if (st) return st;
+  for (int f = 0; f < d->nfree; f++) c->dinv[f] = 1.0;
+  for (int f = 0; f < d->nfree; f++)
+    if (c->var[f] < 0) Ax[colptr[f + 1] - 1] = 1.0; /* multiplier rows: identity */
+  int neg;
+  double dmin, dmax;
+  char msg[160];
+  st = cv_ldlt_factor(c->P, &neg, &dmin, &dmax, msg, sizeof msg);
+  if (st || neg > 0) {
+    cv_set_msg(c->s->msg, sizeof c->s->msg, "model Hessian for preconditioning is singular");
+    return st ? st : CVAR_ESINGULAR;
+  }
+  cv_ldlt_diag(c->P, c->dinv);
+  for (int f = 0; f < d->nfree; f++) c->dinv[f] = 1.0 / sqrt(c->dinv[f]);
+  return CVAR_OK;
 }
 
 cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y) {
@@ -117,8 +204,8 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
                cv_method_name(s->method));
     return CVAR_EINVAL;
   }
-  /* The column layout is only needed by cv_kkt_eval's signature (no Hessian here). */
   colptr = cv_calloc((size_t)d->nfree + 1, sizeof *colptr);
+  if (colptr) cv_disc_pattern(d, colptr, NULL);
   c.g = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.g);
   c.yof = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.yof);
   c.fof = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.fof);
@@ -160,6 +247,14 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
   }
   c.s = s;
   c.d = d;
+  c.Y0 = cv_malloc((size_t)d->ndof * sizeof *c.Y0);
+  c.w = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.w);
+  c.dinv = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.dinv);
+  if (!c.Y0 || !c.w || !c.dinv) {
+    st = CVAR_ENOMEM;
+    goto cleanup;
+  }
+  memcpy(c.Y0, Y, (size_t)d->ndof * sizeof *Y);
   c.kkt = &kkt;
   c.Y = Y;
   c.stop = CVAR_OK;
@@ -171,16 +266,23 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
     st = CVAR_ENOMEM;
     goto cleanup;
   }
-  for (int v = 0; v < c.nv; v++) x[v] = Y[c.yof[v]];
+  st = precondition(&c, d, colptr);
+  if (st) goto cleanup;
+  for (int v = 0; v < c.nv; v++) x[v] = 0.0; /* z = 0 is the initial guess y0 */
   /* Constraint tolerance: 10 rtol in units of G (or of the integral). */
   for (int i = 0; i < c.m; i++) tol[i] = 10 * s->rtol;
-  c.opt = nlopt_create(algorithm(s->method), (unsigned)c.nv);
+  /* MMA and CCSAQ take only inequality constraints; an equality as two opposite
+   * inequalities leaves them no interior to move in (they stall far from the answer). NLopt's
+   * remedy is AUGLAG_EQ: the equalities go to an augmented Lagrangian whose subproblems
+   * MMA or CCSAQ solve. */
+  int eq_wrap = c.m > 0 && (s->method == CVAR_METHOD_MMA || s->method == CVAR_METHOD_CCSAQ);
+  c.opt = nlopt_create(eq_wrap ? NLOPT_AUGLAG_EQ : algorithm(s->method), (unsigned)c.nv);
   if (!c.opt) {
     st = CVAR_ENOMEM;
     goto cleanup;
   }
-  if (s->method == CVAR_METHOD_AUGLAG) {
-    local = nlopt_create(NLOPT_LD_LBFGS, (unsigned)c.nv);
+  if (s->method == CVAR_METHOD_AUGLAG || eq_wrap) {
+    local = nlopt_create(eq_wrap ? algorithm(s->method) : NLOPT_LD_LBFGS, (unsigned)c.nv);
     if (!local) {
       st = CVAR_ENOMEM;
       goto cleanup;
@@ -196,13 +298,7 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
   nlopt_set_maxeval(c.opt, 200 * s->maxit);
   if (c.m > 0) {
     nlopt_result r;
-    if (s->method == CVAR_METHOD_MMA || s->method == CVAR_METHOD_CCSAQ) {
-      r = nlopt_add_inequality_mconstraint(c.opt, (unsigned)c.m, eq_constraints, &c, tol);
-      if (r > 0)
-        r = nlopt_add_inequality_mconstraint(c.opt, (unsigned)c.m, neg_constraints, &c, tol);
-    } else {
-      r = nlopt_add_equality_mconstraint(c.opt, (unsigned)c.m, eq_constraints, &c, tol);
-    }
+    r = nlopt_add_equality_mconstraint(c.opt, (unsigned)c.m, eq_constraints, &c, tol);
     if (r < 0) {
       st = CVAR_EDEPENDENCY;
       cv_set_msg(s->msg, sizeof s->msg, "NLopt refused the constraints (%s)",
@@ -217,6 +313,7 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
     cv_set_msg(s->msg, sizeof s->msg, "the integrand is not finite at the initial guess");
     goto cleanup;
   }
+  double g0 = stationarity(&c, &kkt, Y);
   nlopt_result r = nlopt_optimize(c.opt, x, &fmin);
   load(&c, x);
   s->iterations = (int)c.evals;
@@ -251,21 +348,20 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
     cv_set_msg(s->msg, sizeof s->msg, "%s converged (%s) in %ld evaluations",
                cv_method_name(s->method), nlopt_result_to_string(r), c.evals);
   }
-  /* Report: action, multipliers by least squares (C-5), scaled residual of the Lagrangian. */
-  {
-    double S;
-    cv_status st2 = CVAR_OK;
-    if (constrained) st2 = cv_kkt_init_multipliers(&kkt, Y, s->mult);
-    if (!st2) st2 = cv_kkt_eval(&kkt, Y, s->mult, &S, c.g, NULL, NULL);
-    if (!st2) {
-      s->action = S;
-      double rn = 0.0;
-      for (int f = 0; f < d->nfree; f++) rn = fmax(rn, fabs(c.g[f]) / d->mass[f]);
-      s->gnorm = rn;
-    } else if (st == CVAR_OK) {
-      st = st2;
-      cv_set_msg(s->msg, sizeof s->msg, "the integrand is not finite at the point reached");
-    }
+  /* Report: action, multipliers by least squares (C-5), scaled residual of the Lagrangian.
+   * A minimiser stops on small changes of S or z, which can happen short of stationarity;
+   * converged is said only when the residual fell by at least 100 (NL-2). */
+  s->gnorm = stationarity(&c, &kkt, Y);
+  s->action = c.action;
+  if (!isfinite(s->gnorm) && st == CVAR_OK) {
+    st = CVAR_ENONFINITE;
+    cv_set_msg(s->msg, sizeof s->msg, "the integrand is not finite at the point reached");
+  } else if (st == CVAR_OK && !(s->gnorm <= 1e-2 * g0) && s->gnorm > 1e-12) {
+    st = CVAR_ESTALL;
+    cv_set_msg(s->msg, sizeof s->msg,
+               "%s stopped short of a stationary point (scaled residual %.3g, %.3g at the "
+               "start); try newton, or another method",
+               cv_method_name(s->method), s->gnorm, g0);
   }
 cleanup:
   if (st == CVAR_ENOMEM && !s->msg[0]) cv_set_msg(s->msg, sizeof s->msg, "out of memory");
@@ -279,6 +375,10 @@ cleanup:
   cv_free(c.rows);
   cv_free(c.lrow);
   cv_free(c.var);
+  cv_free(c.Y0);
+  cv_free(c.w);
+  cv_free(c.dinv);
+  cv_ldlt_free(c.P);
   cv_free(x);
   cv_free(tol);
   return st;

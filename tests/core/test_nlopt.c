@@ -48,10 +48,10 @@ static void compare(const char *name, cv_problem *p, int n, int E, int deg) {
     cv_solver_set_method(s, all[k]);
     cv_status st = cv_solve(s, p);
     double d = st == CVAR_OK ? diff(ref, s, n) : NAN;
-    printf("%-10s %-8s %-14s diff %.2e  action diff %.2e  evals %d\n", name,
+    printf("%-10s %-8s %-14s diff %.2e  action diff %.2e  evals %d gnorm %.2e\n", name,
            cv_method_name(all[k]), cv_status_name(st), d,
            fabs(cv_solver_get_action(s) - cv_solver_get_action(ref)),
-           cv_solver_get_num_iterations(s));
+           cv_solver_get_num_iterations(s), cv_solver_get_gradient_norm(s));
     CHECK(st == CVAR_OK, "%s %s: %s", name, cv_method_name(all[k]), cv_solver_last_error(s));
     char what[64];
     snprintf(what, sizeof what, "%s %s vs newton", name, cv_method_name(all[k]));
@@ -104,8 +104,8 @@ int main(void) {
       cv_solver_get_nodes(s, x);
       cv_solver_get_values(s, y);
       for (int j = 0; j < nn; j++) err = fmax(err, fabs(y[j] - (cosh(x[j]) - cosh(1.0))));
-      printf("chain      %-8s %-14s err %.2e  mu %.10f  evals %d\n", cv_method_name(con[k]),
-             cv_status_name(st), err, mu, cv_solver_get_num_iterations(s));
+      printf("chain      %-8s %-14s err %.2e  mu %.10f  evals %d (%s) gnorm %.2e\n", cv_method_name(con[k]),
+             cv_status_name(st), err, mu, cv_solver_get_num_iterations(s), cv_solver_last_error(s), cv_solver_get_gradient_norm(s));
       CHECK(st == CVAR_OK, "chain %s: %s", cv_method_name(con[k]), cv_solver_last_error(s));
       CHECK_NEAR("chain nodal error (nlopt)", err, 0, 1e-5);
       CHECK_NEAR("chain |mu| (nlopt, least squares)", fabs(mu), cosh(1.0), 1e-4);
