@@ -292,7 +292,8 @@ double cv_solver_get_time(const cv_solver *s);
 int cv_solver_get_morse_index(const cv_solver *s);
 /** Nonzero when the Hessian at the last iterate has a (numerically) zero pivot. */
 int cv_solver_get_degenerate(const cv_solver *s);
-/** Number of free scalar unknowns of the discrete problem (size of the Hessian). */
+/** Dimension of the discrete problem: free scalar nodal values minus constraint rows (the
+ * largest possible Morse index). */
 int cv_solver_get_num_free(const cv_solver *s);
 
 /** The multiplier field of pointwise constraint k at the nodes of the last solve,

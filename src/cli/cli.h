@@ -54,12 +54,20 @@ typedef struct {
   int *has_rep;
   double *rep;
   double *x, *y; /* nodes and node-major values y[j*n + i] */
+  double *lam;   /* multiplier fields lam[c*nodes + j] of [constraints], or NULL */
+  int *has_mu;   /* [integrals] multipliers */
+  double *mu;
 } cli_report;
 
 const char *cli_status_string(cv_status st);
 int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_status st);
-/* Estimate the max nodal error by a solve on twice the elements (report.c). */
+/* estimate.c: the max nodal error of a solve without [exact], from a reference solve on
+ * a mesh whose element boundaries include every node (docs/cli.md). cli_estimate_error
+ * gives the max over all nodes and over the element boundaries (NaN when the reference
+ * solve fails); both return 0, or -1 on allocation failure. */
 int cli_report_estimate(cli_report *r, const scene *s, const cv_problem *p);
+int cli_estimate_error(const scene *s, const cv_problem *p, int nodes, int degree,
+                       const double *x, const double *y, double *e_all, double *e_vertex);
 void cli_report_free(cli_report *r);
 
 int cli_report_json(FILE *f, const cli_report *r);
@@ -80,6 +88,8 @@ void cli_outfile_abandon(cli_outfile *o);
 int cli_gallery(void);
 int cli_solve(int argc, char **argv);
 int cli_check(int argc, char **argv);
+int cli_equations(int argc, char **argv); /* cli_equations.c */
+int cli_modes(int argc, char **argv);     /* cli_modes.c */
 int cli_unsupported(const char *cmd);
 
 /* gallery_scenes.c */

@@ -46,13 +46,14 @@ static int unsupported(const cli_opts *o, const scene *s)
     fprintf(stderr, "calcvar solve: --plot is not supported by this build yet\n");
     return EXIT_BADINPUT;
   }
-  if (s->method != SC_NEWTON) {
+  if ((s->method == SC_LBFGS || s->method == SC_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
+    /* an unconstrained minimiser cannot impose [constraints] or [integrals] */
     if (o->method >= 0)
-      fprintf(stderr, "calcvar solve: method '%s' is not supported by this build yet (use "
-              "newton)\n", scene_method_name(s->method));
+      fprintf(stderr, "calcvar solve: --method %s cannot impose constraints; use mma, ccsaq, "
+              "slsqp, auglag or newton\n", scene_method_name(s->method));
     else
-      fprintf(stderr, "%s:%d: method '%s' is not supported by this build yet (use newton)\n",
-              s->file, s->method_line, scene_method_name(s->method));
+      fprintf(stderr, "%s:%d: method %s cannot impose constraints; use mma, ccsaq, slsqp, "
+              "auglag or newton\n", s->file, s->method_line, scene_method_name(s->method));
     return EXIT_BADINPUT;
   }
   if (s->adapt > 0) {
@@ -97,13 +98,6 @@ int cli_solve(int argc, char **argv)
     s->max_iterations = o.max_iterations;
   if ((rc = unsupported(&o, s)) != 0)
     goto done;
-  if (s->ncons > 0 || s->nints > 0) {
-    /* Read correctly but cannot be solved here: exit 1, SCENES.md's "not solved". */
-    fprintf(stderr, "%s:%d: constraints are not supported by this build yet\n", s->file,
-            s->ncons > 0 ? s->cons[0].line : s->ints[0].line);
-    rc = EXIT_UNSOLVED;
-    goto done;
-  }
   cv_status why;
   if (!(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err)) ||
       !(sv = cv_solver_new(&why)) || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK) {
@@ -118,6 +112,12 @@ int cli_solve(int argc, char **argv)
   }
 
   cv_status st = cv_solve(sv, p);
+  if (st == CVAR_EINVAL) {
+    /* Input the core refused before solving (e.g. a dense NLopt Jacobian too large). */
+    fprintf(stderr, "%s: %s\n", s->file, cv_solver_last_error(sv));
+    rc = EXIT_BADINPUT;
+    goto done;
+  }
   if (cli_report_collect(&r, s, sv, s->method, st) < 0) {
     fprintf(stderr, "calcvar solve: out of memory while reporting\n");
     rc = EXIT_UNSOLVED;

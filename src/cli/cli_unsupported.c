@@ -1,5 +1,5 @@
 /* src/cli/cli_unsupported.c — commands of SCENES.md that this build does not provide yet
- * (converge, equations, modes): say so and exit 2, never pretend.
+ * (converge): say so and exit 2, never pretend.
  * SPDX-License-Identifier: MIT */
 #include <stdio.h>
 

@@ -12,8 +12,8 @@ static void usage(FILE *f)
         "  calcvar solve SCENE [options]   solve one scene (calcvar solve --help)\n"
         "  calcvar check SCENE             parse, degrees of freedom, derivative check\n"
         "  calcvar converge SCENE          (not in this build yet)\n"
-        "  calcvar equations SCENE         (not in this build yet)\n"
-        "  calcvar modes SCENE             (not in this build yet)\n"
+        "  calcvar equations SCENE         momenta, Euler-Lagrange equations, Hamiltonian\n"
+        "  calcvar modes SCENE             equilibrium and small-oscillation frequencies\n"
         "  calcvar --help | --version\n"
         "Scene files: docs/scenes.md. Exit status: 0 solved, 1 not solved, 2 bad input.\n",
         f);
@@ -38,8 +38,11 @@ int main(int argc, char **argv)
     return cli_solve(argc - 2, argv + 2);
   if (strcmp(cmd, "check") == 0)
     return cli_check(argc - 2, argv + 2);
-  if (strcmp(cmd, "converge") == 0 || strcmp(cmd, "equations") == 0 ||
-      strcmp(cmd, "modes") == 0)
+  if (strcmp(cmd, "equations") == 0)
+    return cli_equations(argc - 2, argv + 2);
+  if (strcmp(cmd, "modes") == 0)
+    return cli_modes(argc - 2, argv + 2);
+  if (strcmp(cmd, "converge") == 0)
     return cli_unsupported(cmd);
   fprintf(stderr, "calcvar: unknown command '%s' (calcvar --help lists them)\n", cmd);
   return EXIT_BADINPUT;

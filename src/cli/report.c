@@ -40,6 +40,9 @@ void cli_report_free(cli_report *r)
   free(r->rep);
   free(r->x);
   free(r->y);
+  free(r->lam);
+  free(r->has_mu);
+  free(r->mu);
   memset(r, 0, sizeof *r);
 }
 
@@ -88,6 +91,18 @@ static int nodal_error(cli_report *r, const scene *s)
   return 0;
 }
 
+/* Whether any [constraints] or [integrals] expression depends on the slot. */
+static int constraints_depend_on(const scene *s, int slot)
+{
+  for (int k = 0; k < s->ncons; k++)
+    if (ex_depends_on(s->dag, s->cons[k].expr, slot))
+      return 1;
+  for (int k = 0; k < s->nints; k++)
+    if (ex_depends_on(s->dag, s->ints[k].expr, slot))
+      return 1;
+  return 0;
+}
+
 /* Energy, momenta and report integrals at the quadrature points. */
 static int qpoint_quantities(cli_report *r, scene *s, cv_solver *sv)
 {
@@ -105,7 +120,10 @@ static int qpoint_quantities(cli_report *r, scene *s, cv_solver *sv)
     rc = 0; /* nothing to evaluate on: leave the keys out */
     goto done;
   }
-  if (!scene_F_depends_on_variable(s)) {
+  /* With constraints, H of F alone is conserved only when no constraint depends on the
+   * variable and there is no integral constraint (whose multiplier enters the conserved
+   * quantity); a momentum only when no constraint involves that unknown (docs/cli.md). */
+  if (!scene_F_depends_on_variable(s) && s->nints == 0 && !constraints_depend_on(s, 0)) {
     if (scene_eval_energy(s, nq, x, y, dy, v) < 0)
       goto done;
     r->has_energy = range(v, nq, &r->emin, &r->emax) == 0;
@@ -113,7 +131,7 @@ static int qpoint_quantities(cli_report *r, scene *s, cv_solver *sv)
   if (scene_eval_momenta(s, nq, x, y, dy, v) < 0)
     goto done;
   for (int i = 0; i < n; i++)
-    if (!scene_F_depends_on_unknown(s, i))
+    if (!scene_F_depends_on_unknown(s, i) && !constraints_depend_on(s, 1 + i))
       r->has_mom[i] = range(v + (size_t)i * q, nq, &r->mom_min[i], &r->mom_max[i]) == 0;
   if (s->nreports > 0 && scene_eval_reports(s, nq, x, y, dy, v) < 0)
     goto done;
@@ -209,6 +227,22 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
   }
   if (nn > 0 && nodal_error(r, s) < 0)
     return -1;
+  /* Multiplier fields (CSV lambda_NAME) and integral multipliers (JSON multipliers). */
+  if (nn > 0 && s->ncons > 0) {
+    r->lam = malloc((size_t)nn * s->ncons * sizeof *r->lam);
+    if (!r->lam)
+      return -1;
+    for (int c = 0; c < s->ncons; c++)
+      if (cv_solver_get_multiplier_field(sv, c, r->lam + (size_t)c * nn) != CVAR_OK)
+        for (int j = 0; j < nn; j++)
+          r->lam[(size_t)c * nn + j] = NAN;
+  }
+  r->has_mu = calloc((size_t)s->nints + 1, sizeof *r->has_mu);
+  r->mu = calloc((size_t)s->nints + 1, sizeof *r->mu);
+  if (!r->has_mu || !r->mu)
+    return -1;
+  for (int k = 0; k < s->nints; k++)
+    r->has_mu[k] = cv_solver_get_multiplier(sv, k, &r->mu[k]) == CVAR_OK && isfinite(r->mu[k]);
   if (s->has_exact_action && r->has_action) {
     r->has_err_action = 1;
     r->err_action = fabs(r->action - s->exact_action);
@@ -217,41 +251,4 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
     return -1;
   compose_message(r, sv);
   return 0;
-}
-
-/* Error estimate without [exact]: solve again on twice the elements (same grading and
- * degree) and compare at this mesh's nodes. With nodal errors of order h^(2p), e_h =
- * |y_h - y_h/2| / (1 - 2^(-2p)) (Richardson); where the order is lower (singular ends)
- * this underestimates, as docs/cli.md says. */
-int cli_report_estimate(cli_report *r, const scene *s, const cv_problem *p)
-{
-  int n = s->n, nn = r->nodes;
-  if (nn <= 0 || r->st != CVAR_OK || s->elements > INT_MAX / 18)
-    return 0;
-  scene fine = *s;
-  fine.elements = s->elements * 2;
-  char err[SC_ERRLEN];
-  cv_status why;
-  cv_solver *f = cv_solver_new(&why);
-  double *yf = malloc((size_t)nn * n * sizeof *yf);
-  int rc = -1;
-  if (!f || !yf)
-    goto done;
-  rc = 0;
-  if (scene_solver_configure(&fine, f, err, sizeof err) != CVAR_OK || cv_solve(f, p) != CVAR_OK ||
-      cv_solver_eval(f, nn, r->x, yf, NULL) != CVAR_OK)
-    goto done;
-  double e = 0;
-  for (int i = 0; i < n; i++)
-    for (int j = 0; j < nn; j++)
-      e = fmax(e, fabs(r->y[(size_t)j * n + i] - yf[(size_t)i * nn + j]));
-  e /= 1 - pow(2.0, -2.0 * r->degree);
-  if (isfinite(e)) {
-    r->has_err_est = 1;
-    r->err_est = e;
-  }
-done:
-  cv_solver_free(f);
-  free(yf);
-  return rc;
 }

@@ -33,8 +33,11 @@ int cli_report_csv(FILE *f, const cli_report *r)
       fputc(',', f);
       field(f, r->y[(size_t)j * n + i]);
     }
-    for (int c = 0; c < s->ncons; c++)
-      fputc(',', f); /* multiplier fields: not computed by this build */
+    for (int c = 0; c < s->ncons; c++) {
+      fputc(',', f);
+      if (r->lam)
+        field(f, r->lam[(size_t)c * r->nodes + j]);
+    }
     fputc('\n', f);
   }
   return ferror(f) ? -1 : 0;

@@ -30,12 +30,13 @@ static json_t *min_max(double lo, double hi, int drift)
   return o;
 }
 
-int cli_report_json(FILE *f, const cli_report *r)
+/* The report as a jansson object (NULL when out of memory); `converge` adds its keys. */
+json_t *cli_report_json_object(const cli_report *r)
 {
   const scene *s = r->sc;
   json_t *o = json_object(), *a;
   if (!o)
-    return -1;
+    return NULL;
   json_object_set_new(o, "title", json_string(s->title));
   json_object_set_new(o, "status", json_string(r->status));
   json_object_set_new(o, "message", json_string(r->message));
@@ -80,6 +81,14 @@ int cli_report_json(FILE *f, const cli_report *r)
     json_object_set_new(o, "momenta", mom);
   else
     json_decref(mom);
+  json_t *mul = json_object();
+  for (int k = 0; k < s->nints; k++)
+    if (r->has_mu && r->has_mu[k])
+      set_real(mul, s->ints[k].name, r->mu[k]);
+  if (json_object_size(mul) > 0)
+    json_object_set_new(o, "multipliers", mul);
+  else
+    json_decref(mul);
   json_t *rep = json_object();
   for (int k = 0; k < s->nreports; k++)
     if (r->has_rep[k])
@@ -89,6 +98,14 @@ int cli_report_json(FILE *f, const cli_report *r)
   else
     json_decref(rep);
 
+  return o;
+}
+
+int cli_report_json(FILE *f, const cli_report *r)
+{
+  json_t *o = cli_report_json_object(r);
+  if (!o)
+    return -1;
   int rc = json_dumpf(o, f, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
   if (rc == 0 && fputc('\n', f) == EOF)
     rc = -1;

@@ -294,7 +294,13 @@ const char *cv_solver_last_error(const cv_solver *s) {
 int cv_solver_get_num_nodes(const cv_solver *s) { return s && s->have ? s->disc.nodes : 0; }
 int cv_solver_get_num_elements(const cv_solver *s) { return s && s->have ? s->disc.E : 0; }
 int cv_solver_get_degree(const cv_solver *s) { return s && s->have ? s->disc.p : 0; }
-int cv_solver_get_num_free(const cv_solver *s) { return s && s->have ? s->disc.nfree : 0; }
+int cv_solver_get_num_free(const cv_solver *s) {
+  if (!s || !s->have) return 0;
+  const cv_disc *d = &s->disc;
+  long rows = d->ni; /* constraint rows: one per multiplier */
+  for (long j = 0; j < d->nodes && d->nc > 0; j++) rows += cv_disc_lidx(d, j, 0) >= 0 ? d->nc : 0;
+  return (int)(d->nfree - 2 * rows); /* free y unknowns minus constraints */
+}
 double cv_solver_get_action(const cv_solver *s) { return s ? s->action : NAN; }
 double cv_solver_get_gradient_norm(const cv_solver *s) { return s ? s->gnorm : NAN; }
 int cv_solver_get_num_iterations(const cv_solver *s) { return s ? s->iterations : 0; }

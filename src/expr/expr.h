@@ -104,4 +104,9 @@ int ex_eval(const ex_dag *d, ex_id e, const double *slots, double *value);
  * caller's in[], out[] and work arrays must not overlap one another (the kernels are
  * compiled with restrict so they vectorise). */
 
+/* Collect like terms (ex_collect.c): every sum in e becomes sum_k c_k t_k + c0 with each
+ * distinct term once, numeric factors peeled off (2*t, t/2, -t). For display: combining
+ * coefficients may change the value by rounding (a few ulps). -1 on allocation failure. */
+ex_id ex_collect(ex_dag *d, ex_id e);
+
 #endif /* CV_EXPR_H */

@@ -104,8 +104,9 @@ int scene_method_from_name(const char *name);
  * minimisers F|GRAD. */
 unsigned scene_method_need(sc_method m);
 
-/** A problem for the scene's integrand, ends and guess (constraints are not attached:
- * the core has no API for them yet). max_need: CVAR_NEED_* bits the integrand compiles. */
+/** A problem for the scene's integrand, ends, guess, [constraints] and [integrals]. max_need:
+ * CVAR_NEED_* bits the integrand and constraints compile. A pointwise constraint that fails
+ * at an end whose values are all fixed is reported as FILE:LINE (SCENES.md). */
 cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size_t errlen);
 /** Apply [mesh] and [solver] to a solver (elements, degree, grading, breakpoints,
  * tolerances, maximum iterations). */

@@ -1,0 +1,201 @@
+/* src/cli/cli_equations.c — `calcvar equations SCENE`: momenta, Euler–Lagrange equations,
+ * Hamiltonian and conservation laws of a scene's integrand, for a person or as JSON.
+ * SPDX-License-Identifier: MIT
+ *
+ * The expressions come from scene_equations_new (src/scene/scene_mechanics.c). They are
+ * printed in the scene grammar (ex_print), with parameters as numbers, so the JSON strings
+ * parse and evaluate without the scene (docs/mechanics.md).
+ */
+#include <jansson.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli/cli.h"
+#include "scene/scene_mechanics.h"
+
+static void usage(FILE *f)
+{
+  fputs("usage: calcvar equations SCENE [--set name=value] [--json FILE] [--quiet]\n"
+        "  prints, for each unknown y, the momentum p = dF/dy', the Euler-Lagrange\n"
+        "  equation d/dx dF/dy' - dF/dy = 0 expanded with y'', the Hamiltonian\n"
+        "  H = sum y' dF/dy' - F, the cyclic unknowns and whether F depends on the variable\n"
+        "  --json FILE   the same as JSON ('-' for stdout)\n", f);
+}
+
+/* e printed in the scene grammar, malloc'ed; NULL on allocation failure. */
+static char *print_expr(const scene *s, const sc_equations *eq, ex_id e)
+{
+  const char *const *names = (const char *const *)eq->names;
+  size_t len = ex_print(s->dag, e, names, NULL, 0) + 1;
+  char *buf = malloc(len);
+  if (buf)
+    ex_print(s->dag, e, names, buf, len);
+  return buf;
+}
+
+/* The printed texts: mom[i], el[i], then H, then F; one array, NULL entries on failure. */
+typedef struct {
+  char **mom, **el, *H, *F;
+} texts;
+
+static int texts_make(texts *t, const scene *s, const sc_equations *eq)
+{
+  int n = s->n;
+  memset(t, 0, sizeof *t);
+  t->mom = calloc((size_t)n, sizeof *t->mom);
+  t->el = calloc((size_t)n, sizeof *t->el);
+  if (!t->mom || !t->el)
+    return -1;
+  for (int i = 0; i < n; i++)
+    if (!(t->mom[i] = print_expr(s, eq, eq->momentum[i])) ||
+        !(t->el[i] = print_expr(s, eq, eq->el[i])))
+      return -1;
+  ex_id F = ex_collect(s->dag, s->F);
+  if (F < 0 || !(t->H = print_expr(s, eq, eq->hamiltonian)) || !(t->F = print_expr(s, eq, F)))
+    return -1;
+  return 0;
+}
+
+static void texts_free(texts *t, int n)
+{
+  for (int i = 0; i < n; i++) {
+    if (t->mom)
+      free(t->mom[i]);
+    if (t->el)
+      free(t->el[i]);
+  }
+  free(t->mom);
+  free(t->el);
+  free(t->H);
+  free(t->F);
+}
+
+static int write_json(FILE *f, const scene *s, const sc_equations *eq, const texts *t)
+{
+  json_t *o = json_object(), *mom = json_object(), *el = json_object(), *cyc = json_array();
+  int rc = -1;
+  if (!o || !mom || !el || !cyc) {
+    json_decref(mom);
+    json_decref(el);
+    json_decref(cyc);
+    goto done;
+  }
+  for (int i = 0; i < s->n; i++) {
+    json_object_set_new(mom, s->unknowns[i], json_string(t->mom[i]));
+    json_object_set_new(el, s->unknowns[i], json_string(t->el[i]));
+    if (eq->cyclic[i])
+      json_array_append_new(cyc, json_string(s->unknowns[i]));
+  }
+  json_object_set_new(o, "momenta", mom);
+  json_object_set_new(o, "euler_lagrange", el);
+  json_object_set_new(o, "hamiltonian", json_string(t->H));
+  json_object_set_new(o, "cyclic", cyc);
+  json_object_set_new(o, "autonomous", json_boolean(eq->autonomous));
+  rc = json_dumpf(o, f, JSON_INDENT(2) | JSON_PRESERVE_ORDER);
+  if (rc == 0 && fputc('\n', f) == EOF)
+    rc = -1;
+done:
+  json_decref(o);
+  return rc;
+}
+
+static void write_text(FILE *f, const scene *s, const sc_equations *eq, const texts *t)
+{
+  int n = s->n, ncyc = 0;
+  fprintf(f, "%s (%s)\n", s->title, s->file);
+  fprintf(f, "  F(%s, y, y') = %s\n", s->variable, t->F);
+  if (s->nparams > 0) {
+    fprintf(f, "  parameters   substituted as numbers:");
+    for (int k = 0; k < s->nparams; k++)
+      fprintf(f, "%s %s = %.17g", k ? "," : "", s->params[k].name, s->params[k].value);
+    fprintf(f, "\n");
+  }
+  for (int i = 0; i < n; i++) {
+    const char *u = s->unknowns[i];
+    fprintf(f, "\n  %s\n", u);
+    fprintf(f, "    momentum         p_%s = dF/d%s' = %s\n", u, u, t->mom[i]);
+    fprintf(f, "    Euler-Lagrange   %s = 0\n", t->el[i]);
+    if (eq->cyclic[i])
+      ncyc++;
+  }
+  if (s->ncons + s->nints > 0) {
+    fprintf(f, "\n  multipliers  the equations are those of F");
+    for (int c = 0; c < s->ncons; c++)
+      fprintf(f, " + %s*(%s constraint)", eq->names[1 + 3 * n + c], s->cons[c].name);
+    for (int r = 0; r < s->nints; r++)
+      fprintf(f, " + %s*(%s integrand)", eq->names[1 + 3 * n + s->ncons + r],
+              s->ints[r].name);
+    fprintf(f, "\n");
+  }
+  fprintf(f, "\n  Hamiltonian  H = %s\n", t->H);
+  fprintf(f, "  autonomous   %s\n", eq->autonomous
+          ? "yes: F has no explicit dependence on the variable, so H is conserved"
+          : "no: F depends explicitly on the variable, so H is not conserved in general");
+  fprintf(f, "  cyclic      ");
+  for (int i = 0; i < n; i++)
+    if (eq->cyclic[i])
+      fprintf(f, " %s", s->unknowns[i]);
+  fprintf(f, "%s\n", ncyc ? " (F does not depend on them: their momenta are conserved)"
+                          : " none");
+  if ((ncyc || eq->autonomous) && s->ncons + s->nints > 0)
+    fprintf(f, "               (for F alone: constraints that involve %s or the unknowns can "
+            "break these conservation laws)\n", s->variable);
+}
+
+int cli_equations(int argc, char **argv)
+{
+  cli_opts o;
+  char err[SC_ERRLEN] = "";
+  int rc = cli_args_parse("equations", argc, argv, &o);
+  if (rc != 0 || o.help) {
+    if (o.help)
+      usage(stdout);
+    cli_opts_free(&o);
+    return rc;
+  }
+  if (o.csv || o.plot || o.adapt > 0 || o.cont || o.elements || o.degree || o.method >= 0 ||
+      o.tolerance > 0 || o.max_iterations) {
+    fprintf(stderr, "calcvar equations: only --set, --json and --quiet apply to equations\n");
+    cli_opts_free(&o);
+    return EXIT_BADINPUT;
+  }
+  scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
+  sc_equations eq;
+  texts t;
+  cli_outfile jf = {0};
+  memset(&eq, 0, sizeof eq);
+  memset(&t, 0, sizeof t);
+  if (!s) {
+    fprintf(stderr, "%s\n", err);
+    rc = EXIT_BADINPUT;
+    goto done;
+  }
+  /* Output files are opened before the work: an unwritable path is bad input. */
+  if (o.json && cli_outfile_open(&jf, o.json) < 0) {
+    rc = EXIT_BADINPUT;
+    goto done;
+  }
+  if (scene_equations_new(s, &eq, err, sizeof err) < 0 || texts_make(&t, s, &eq) < 0) {
+    fprintf(stderr, "%s\n", err[0] ? err : "calcvar equations: out of memory");
+    rc = EXIT_UNSOLVED;
+    goto done;
+  }
+  if (o.json) {
+    if (write_json(jf.f, s, &eq, &t) < 0 || cli_outfile_commit(&jf) < 0) {
+      fprintf(stderr, "calcvar equations: the JSON could not be written\n");
+      rc = EXIT_UNSOLVED;
+      goto done;
+    }
+  }
+  if (!o.quiet && (!o.json || strcmp(o.json, "-") != 0))
+    write_text(stdout, s, &eq, &t);
+  rc = EXIT_SOLVED;
+done:
+  cli_outfile_abandon(&jf);
+  texts_free(&t, s ? s->n : 0);
+  scene_equations_free(&eq);
+  scene_free(s);
+  cli_opts_free(&o);
+  return rc;
+}

@@ -1,0 +1,170 @@
+/* src/cli/cli_modes.c — `calcvar modes SCENE`: the equilibrium of a Lagrangian L(y, y') and
+ * its small oscillations, for a person or as JSON (SCENES.md).
+ * SPDX-License-Identifier: MIT
+ *
+ * The numbers come from scene_modes_new (src/scene/scene_modes.c). Exit status: 0 modes
+ * found; 1 no equilibrium from the guess, M not positive definite, or non-finite values
+ * (nothing written); 2 bad input, including a scene whose integrand depends on the
+ * variable or that has constraints (modes does not apply to it).
+ */
+#include <jansson.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli/cli.h"
+#include "scene/scene_mechanics.h"
+
+static const double TWO_PI = 6.28318530717958647692;
+
+static void usage(FILE *f)
+{
+  fputs("usage: calcvar modes SCENE [--set name=value] [--json FILE] [--quiet]\n"
+        "  finds an equilibrium dL/dy = 0 (y' = 0) from the guess at the start of the\n"
+        "  interval, forms M = d2L/dy'dy' and K = -d2L/dydy there and prints each w^2 of\n"
+        "  K v = w^2 M v: stable (period 2 pi/w), unstable (growth rate sqrt(-w^2)) or\n"
+        "  neutral (w^2 = 0: a free translation or rotation), with its mode shape\n"
+        "  --json FILE   the same as JSON ('-' for stdout)\n", f);
+}
+
+static const char *kind_name(sc_mode_kind k)
+{
+  return k == SC_MODE_STABLE ? "stable" : k == SC_MODE_UNSTABLE ? "unstable" : "neutral";
+}
+
+static int write_json(FILE *f, const scene *s, const sc_modes *md)
+{
+  int n = s->n;
+  json_t *o = json_object(), *eqm = json_object(), *modes = json_array();
+  int rc = -1;
+  if (!o || !eqm || !modes) {
+    json_decref(eqm);
+    json_decref(modes);
+    goto done;
+  }
+  for (int i = 0; i < n; i++)
+    json_object_set_new(eqm, s->unknowns[i], json_real(md->equilibrium[i]));
+  for (int k = 0; k < n; k++) {
+    json_t *m = json_object(), *sh = json_object();
+    if (!m || !sh) {
+      json_decref(m);
+      json_decref(sh);
+      json_decref(eqm);
+      json_decref(modes);
+      goto done;
+    }
+    json_object_set_new(m, "omega2", json_real(md->omega2[k]));
+    json_object_set_new(m, "kind", json_string(kind_name(md->kind[k])));
+    for (int i = 0; i < n; i++)
+      json_object_set_new(sh, s->unknowns[i], json_real(md->shape[k * n + i]));
+    json_object_set_new(m, "shape", sh);
+    json_array_append_new(modes, m);
+  }
+  json_object_set_new(o, "equilibrium", eqm);
+  json_object_set_new(o, "modes", modes);
+  rc = json_dumpf(o, f, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
+  if (rc == 0 && fputc('\n', f) == EOF)
+    rc = -1;
+done:
+  json_decref(o);
+  return rc;
+}
+
+static void print_matrix(FILE *f, const char *label, int n, const double *A)
+{
+  for (int i = 0; i < n; i++) {
+    fprintf(f, "  %-14s", i == 0 ? label : "");
+    for (int j = 0; j < n; j++)
+      fprintf(f, " %14.8g", A[i * n + j]);
+    fprintf(f, "\n");
+  }
+}
+
+static void write_text(FILE *f, const scene *s, const sc_modes *md)
+{
+  int n = s->n;
+  fprintf(f, "%s (%s)\n", s->title, s->file);
+  fprintf(f, "  equilibrium ");
+  for (int i = 0; i < n; i++)
+    fprintf(f, " %s = %.15g%s", s->unknowns[i], md->equilibrium[i], i + 1 < n ? "," : "");
+  fprintf(f, "\n               (Newton from the guess at %s = %.15g: %d iteration%s, "
+          "max |dL/dy| = %.2g)\n", s->variable, s->a, md->iterations,
+          md->iterations == 1 ? "" : "s", md->residual);
+  print_matrix(f, "M = L_y'y'", n, md->mass);
+  print_matrix(f, "K = -L_yy", n, md->stiffness);
+  if (md->gyroscopic > 0)
+    fprintf(f, "  note         L has gyroscopic terms (L_y'y not symmetric, max |G| = %.3g); "
+            "these modes leave them out\n", md->gyroscopic);
+  fprintf(f, "\n  %-4s %-22s %-9s %-28s %s\n", "mode", "omega^2", "kind", "", "shape (v'Mv = 1)");
+  for (int k = 0; k < n; k++) {
+    double w2 = md->omega2[k];
+    char what[64];
+    if (md->kind[k] == SC_MODE_STABLE)
+      snprintf(what, sizeof what, "omega %.6g, period %.6g", sqrt(w2), TWO_PI / sqrt(w2));
+    else if (md->kind[k] == SC_MODE_UNSTABLE)
+      snprintf(what, sizeof what, "growth rate %.6g", sqrt(-w2));
+    else
+      snprintf(what, sizeof what, "free motion");
+    fprintf(f, "  %-4d %-22.15g %-9s %-28s", k + 1, w2, kind_name(md->kind[k]), what);
+    for (int i = 0; i < n; i++)
+      fprintf(f, " %s %.6g", s->unknowns[i], md->shape[k * n + i]);
+    fprintf(f, "\n");
+  }
+}
+
+int cli_modes(int argc, char **argv)
+{
+  cli_opts o;
+  char err[SC_ERRLEN] = "";
+  int rc = cli_args_parse("modes", argc, argv, &o);
+  if (rc != 0 || o.help) {
+    if (o.help)
+      usage(stdout);
+    cli_opts_free(&o);
+    return rc;
+  }
+  if (o.csv || o.plot || o.adapt > 0 || o.cont || o.elements || o.degree || o.method >= 0 ||
+      o.tolerance > 0 || o.max_iterations) {
+    fprintf(stderr, "calcvar modes: only --set, --json and --quiet apply to modes\n");
+    cli_opts_free(&o);
+    return EXIT_BADINPUT;
+  }
+  scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
+  sc_modes md;
+  cli_outfile jf = {0};
+  memset(&md, 0, sizeof md);
+  if (!s) {
+    fprintf(stderr, "%s\n", err);
+    rc = EXIT_BADINPUT;
+    goto done;
+  }
+  /* Output files are opened before the work: an unwritable path is bad input. */
+  if (o.json && cli_outfile_open(&jf, o.json) < 0) {
+    rc = EXIT_BADINPUT;
+    goto done;
+  }
+  int st = scene_modes_new(s, &md, err, sizeof err);
+  if (st != SC_MODES_OK) {
+    fprintf(stderr, "%s\n", err);
+    rc = st == SC_MODES_EXPLICIT || st == SC_MODES_CONSTRAINED ? EXIT_BADINPUT
+                                                                 : EXIT_UNSOLVED;
+    goto done;
+  }
+  if (o.json) {
+    if (write_json(jf.f, s, &md) < 0 || cli_outfile_commit(&jf) < 0) {
+      fprintf(stderr, "calcvar modes: the JSON could not be written\n");
+      rc = EXIT_UNSOLVED;
+      goto done;
+    }
+  }
+  if (!o.quiet && (!o.json || strcmp(o.json, "-") != 0))
+    write_text(stdout, s, &md);
+  rc = EXIT_SOLVED;
+done:
+  cli_outfile_abandon(&jf);
+  scene_modes_free(&md);
+  scene_free(s);
+  cli_opts_free(&o);
+  return rc;
+}
