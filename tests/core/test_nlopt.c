@@ -61,6 +61,17 @@ static void compare(const char *name, cv_problem *p, int n, int E, int deg) {
   cv_solver_free(ref);
 }
 
+/* G = ph - (pi/2) s: holds at the sphere geodesic's ends; used for the size limit only. */
+static int linear_ph_G(int m, const double *x, const double *y, unsigned need, double *G,
+                       double *Gy, double *Gyy, void *user) {
+  (void)need; (void)user; (void)Gyy;
+  for (int k = 0; k < m; k++) {
+    G[k] = y[m + k] - PI / 2 * x[k];
+    if (Gy) { Gy[k] = 0; Gy[m + k] = 1; }
+  }
+  return 0;
+}
+
 int main(void) {
   double c = 2 * cosh(0.5), yf = -2 + sqrt(4.75);
   cv_problem *p = cv_problem_new(1, -1, 1, NULL);
@@ -118,6 +129,25 @@ int main(void) {
     cv_status st = cv_solve(s, p);
     CHECK(st == CVAR_EINVAL && strstr(cv_solver_last_error(s), "cannot impose constraints"),
           "lbfgs with a constraint: %s: %s", cv_status_name(st), cv_solver_last_error(s));
+    cv_solver_free(s);
+    cv_problem_free(p);
+  }
+
+  /* NLopt's dense constraint Jacobian: refused above its limit with a sentence, before any
+   * allocation of that size (2000 elements of degree 2: 3999 rows x 7998 variables). */
+  {
+    p = cv_problem_new(2, 0, 1, NULL);
+    cv_problem_set_integrand(p, sphere_F, NULL);
+    cv_problem_set_dirichlet(p, 0, PI / 3, PI / 2);
+    cv_problem_set_dirichlet(p, 1, 0, PI / 2);
+    cv_problem_add_constraint(p, linear_ph_G, NULL, NULL);
+    cv_solver *s = cv_solver_new(NULL);
+    cv_solver_set_elements(s, 2000);
+    cv_solver_set_degree(s, 2);
+    cv_solver_set_method(s, CVAR_METHOD_SLSQP);
+    cv_status st = cv_solve(s, p);
+    CHECK(st == CVAR_EINVAL && strstr(cv_solver_last_error(s), "use method newton"),
+          "dense Jacobian limit: %s: %s", cv_status_name(st), cv_solver_last_error(s));
     cv_solver_free(s);
     cv_problem_free(p);
   }
