@@ -1,7 +1,7 @@
 /* include/calcvar.h — public C API of calcvar, direct solution of variational problems.
- * SPDX-License-Identifier: MIT
- *
- * calcvar makes the functional  I[y] = \int_a^b F(x, y, y') dx,  y : [a, b] -> R^n,
+ * SPDX-License-Identifier: MIT */
+/** \file
+ * calcvar makes the functional  I[y] = int_a^b F(x, y, y') dx,  y : [a, b] -> R^n,
  * stationary by direct discretisation: y lives on a mesh of polynomial elements
  * (Gauss-Lobatto-Legendre nodes), the discrete action is integrated by Gauss-Legendre
  * quadrature, and Newton's method on the exact gradient and Hessian (sparse LDL^T,
@@ -46,11 +46,12 @@ extern "C" {
 
 /** \name Version */
 /**@{*/
-#define CVAR_VERSION_MAJOR 0
-#define CVAR_VERSION_MINOR 1
-#define CVAR_VERSION_PATCH 0
+#define CVAR_VERSION_MAJOR 0 /**< major version of this header */
+#define CVAR_VERSION_MINOR 1 /**< minor version of this header */
+#define CVAR_VERSION_PATCH 0 /**< patch level of this header */
 /** Pack a version for `#if` tests: CVAR_VERSION_PACK(0, 1, 0). */
 #define CVAR_VERSION_PACK(a, b, c) ((a) * 10000 + (b) * 100 + (c))
+/** This header's version, packed: compare with CVAR_VERSION_PACK(a, b, c) in `#if`. */
 #define CVAR_VERSION CVAR_VERSION_PACK(CVAR_VERSION_MAJOR, CVAR_VERSION_MINOR, CVAR_VERSION_PATCH)
 /** The library's version, to compare with the header's. Any pointer may be NULL. */
 void cv_version(int *major, int *minor, int *patch);
@@ -59,6 +60,7 @@ void cv_version(int *major, int *minor, int *patch);
 /** \name Status codes
  * One X-macro list generates the enum and the message table (cv_strerror). */
 /**@{*/
+/** The statuses in order, each with its cv_strerror sentence; CVAR_OK is 0. */
 #define CVAR_STATUS_LIST(X)                                                                    \
   X(CVAR_OK, "success")                                                                       \
   X(CVAR_EINVAL, "invalid argument")                                                          \
@@ -73,8 +75,12 @@ void cv_version(int *major, int *minor, int *patch);
   X(CVAR_EDEPENDENCY, "failure inside a dependency (CHOLMOD, NLopt)")                         \
   X(CVAR_ESTATE, "no solution available (call cv_solve first)")
 
+/** Turns one CVAR_STATUS_LIST entry into an enumerator (undefined again below). */
 #define CVAR_ENUM_ITEM(name, msg) name,
-/** Result of every fallible call. CVAR_OK is 0; all other values are failures. */
+/** Result of every fallible call. CVAR_OK is 0; all other values are failures. The values,
+ * in order, are those of CVAR_STATUS_LIST: CVAR_OK, CVAR_EINVAL, CVAR_ENOMEM, CVAR_ECALLBACK,
+ * CVAR_ENONFINITE, CVAR_ESINGULAR, CVAR_EMAXITER, CVAR_ESTALL, CVAR_EDIVERGED, CVAR_ENOTMIN,
+ * CVAR_EDEPENDENCY, CVAR_ESTATE; CVAR_NUM_STATUS counts them. */
 typedef enum { CVAR_STATUS_LIST(CVAR_ENUM_ITEM) CVAR_NUM_STATUS } cv_status;
 #undef CVAR_ENUM_ITEM
 
@@ -105,9 +111,12 @@ enum {
  * The solver fills every entry it hands over with NaN before the call, so entries the
  * callback forgets are caught as non-finite. */
 typedef struct {
-  double *F;
-  double *Fy, *Fp;
-  double *Fyy, *Fyp, *Fpp;
+  double *F;   /**< F[k], length m */
+  double *Fy;  /**< dF/dy_i at [i*m + k], length n*m; NULL unless CVAR_NEED_GRAD */
+  double *Fp;  /**< dF/dy'_i at [i*m + k], length n*m; NULL unless CVAR_NEED_GRAD */
+  double *Fyy; /**< d2F/dy_i dy_j at [(i*n + j)*m + k]; NULL unless CVAR_NEED_HESS */
+  double *Fyp; /**< d2F/dy_i dy'_j at [(i*n + j)*m + k]; NULL unless CVAR_NEED_HESS */
+  double *Fpp; /**< d2F/dy'_i dy'_j at [(i*n + j)*m + k]; NULL unless CVAR_NEED_HESS */
 } cv_partials;
 
 /** Integrand F(x, y, y') and its partials at m points.
@@ -129,6 +138,8 @@ typedef int (*cv_guess_fn)(int m, const double *x, double *y, void *user);
 
 /** \name Problem: what is to be made stationary */
 /**@{*/
+/** A variational problem: interval, unknowns, integrand, end conditions, constraints.
+ * Opaque; made by cv_problem_new, released by cv_problem_free. */
 typedef struct cv_problem cv_problem;
 
 /** A new problem with n >= 1 unknown functions on [a, b], a < b, both finite.
@@ -149,6 +160,7 @@ cv_status cv_problem_set_free_end(cv_problem *p, int k, int end);
 /** Initial guess (default: the straight line between the end values; with a free end,
  * the constant fixed value; with both ends free, 0). NULL restores the default. */
 cv_status cv_problem_set_guess(cv_problem *p, cv_guess_fn g, void *user);
+/** The number n of unknown functions. */
 int cv_problem_get_num_unknowns(const cv_problem *p);
 /** The interval; a or b may be NULL. */
 void cv_problem_get_interval(const cv_problem *p, double *a, double *b);
@@ -181,7 +193,9 @@ cv_status cv_problem_add_constraint(cv_problem *p, cv_constraint_fn G, void *use
  * the partials asked for. *index (may be NULL) receives its number, 0, 1, ... */
 cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, void *user, double c,
                                   int *index);
+/** The number of pointwise constraints added so far. */
 int cv_problem_get_num_constraints(const cv_problem *p);
+/** The number of integral constraints added so far. */
 int cv_problem_get_num_integrals(const cv_problem *p);
 
 /** Outcome of cv_problem_check_derivatives. */
@@ -204,6 +218,8 @@ cv_status cv_problem_check_derivatives(const cv_problem *p, int m, const double 
 
 /** \name Solver: discretisation, options, results */
 /**@{*/
+/** A solver: discretisation, options, and the results of the last cv_solve. Opaque; made
+ * by cv_solver_new, released by cv_solver_free; one solver may solve many problems. */
 typedef struct cv_solver cv_solver;
 
 /** Mesh grading end for cv_solver_set_mesh_graded. */
@@ -254,6 +270,7 @@ const char *cv_method_name(cv_method m);
 cv_status cv_method_from_name(const char *name, cv_method *m);
 /** The engine of the next solve (default CVAR_METHOD_NEWTON). */
 cv_status cv_solver_set_method(cv_solver *s, cv_method m);
+/** The engine of the next solve. */
 cv_method cv_solver_get_method(const cv_solver *s);
 
 /** Make the discrete action of p stationary, starting from p's guess (or, after
@@ -262,6 +279,24 @@ cv_method cv_solver_get_method(const cv_solver *s);
  * cv_solver_last_error(). On failure the results still describe the last iterate (for
  * diagnosis) but cv_solver_get_status() tells it did not converge. */
 cv_status cv_solve(cv_solver *s, const cv_problem *p);
+
+/** Automatic continuation (on by default; theory HC-2): when Newton from the start fails to
+ * converge on an unconstrained problem, follow the homotopy from the start to the problem
+ * in small steps before giving up. The message then says so. */
+cv_status cv_solver_set_continuation(cv_solver *s, int on);
+/** Continuation steps taken by the last solve (0 when Newton converged directly). */
+int cv_solver_get_continuation_steps(const cv_solver *s);
+
+/** Adaptive refinement (theory AD-1): solve, estimate the error of every element by a second
+ * solve on the mesh with every element halved, bisect the elements whose estimate exceeds
+ * tol / 4, and repeat until the estimated max nodal error is at most tol, or the mesh would
+ * exceed max_elements (then CVAR_EMAXITER with a sentence). tol = 0 turns it off (default).
+ * The starting mesh is the one set by the other mesh setters. */
+cv_status cv_solver_set_adapt(cv_solver *s, double tol, int max_elements);
+/** Estimated max nodal error of the last adaptive solve (NaN when not adaptive). */
+double cv_solver_get_error_estimate(const cv_solver *s);
+/** Refinement rounds of the last adaptive solve. */
+int cv_solver_get_adapt_rounds(const cv_solver *s);
 
 /** Start the next solve from nodal values y (node-major, length nodes*n as laid out by
  * the current mesh and degree); NULL returns to the problem's guess. Copied. */
@@ -273,7 +308,9 @@ cv_status cv_solver_get_status(const cv_solver *s);
 const char *cv_solver_last_error(const cv_solver *s);
 /** Nodes of the mesh of the last solve, including both ends (0 before any solve). */
 int cv_solver_get_num_nodes(const cv_solver *s);
+/** Elements of the mesh of the last solve (breakpoints may have added some; 0 before any). */
 int cv_solver_get_num_elements(const cv_solver *s);
+/** Polynomial degree of the elements of the last solve (0 before any). */
 int cv_solver_get_degree(const cv_solver *s);
 /** x[j] of node j, length cv_solver_get_num_nodes(). */
 cv_status cv_solver_get_nodes(const cv_solver *s, double *x);
@@ -284,6 +321,7 @@ double cv_solver_get_action(const cv_solver *s);
 /** Max-norm of the discrete Euler-Lagrange residual scaled by the lumped nodal weights
  * (theory (N-3)); mesh independent. */
 double cv_solver_get_gradient_norm(const cv_solver *s);
+/** Newton (or minimiser) iterations of the last solve. */
 int cv_solver_get_num_iterations(const cv_solver *s);
 /** Wall-clock seconds of the last cv_solve. */
 double cv_solver_get_time(const cv_solver *s);
@@ -303,10 +341,11 @@ cv_status cv_solver_get_multiplier_field(const cv_solver *s, int k, double *lamb
 /** The scalar multiplier of integral constraint k of the last solve. */
 cv_status cv_solver_get_multiplier(const cv_solver *s, int k, double *mu);
 
-/** Quadrature points of the last solve's mesh: count, then the points with weights and
- * the solution there. Each output may be NULL. x, w: length nq; y, dy: n*nq, laid out
- * y[i*nq + k] (structure of arrays). Sum_k w[k] g(x[k]) is the solver's integral of g. */
+/** Number nq of quadrature points of the last solve's mesh (0 before any). */
 int cv_solver_get_num_qpoints(const cv_solver *s);
+/** Quadrature points of the last solve's mesh with their weights and the solution there.
+ * Each output may be NULL. x, w: length nq; y, dy: n*nq, laid out y[i*nq + k] (structure of
+ * arrays). Sum_k w[k] g(x[k]) is the solver's integral of g. */
 cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double *y,
                                 double *dy);
 /** Evaluate the last solution (degree-p interpolant) at m abscissae in [a, b]:

@@ -152,13 +152,11 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
   int *flp = as->fl;
   cv_status st;
   for (int e0 = 0, ne; e0 < d->E; e0 += ne) {
-    /* A batch: one singular-end element alone, or up to CV_BATCH points of regular ones. */
+    /* A batch: up to CV_BATCH points of elements sharing one rule; with per-element
+     * singular-end rules (Q-2) one element at a time. */
     cv_rule rule = cv_disc_rule(d, e0), *r = &rule;
-    int q = r->q, nb = CV_BATCH / q;
-    int special = (e0 == 0 && d->sing_a) || (e0 == d->E - 1 && d->sing_b);
-    int last = d->sing_b ? d->E - 1 : d->E; /* regular elements end before a singular b */
-    ne = special ? 1 : (last - e0 < nb ? last - e0 : nb);
-    if (ne < 1) ne = 1;
+    int q = r->q, nb = d->srule ? 1 : CV_BATCH / q;
+    ne = d->E - e0 < nb ? d->E - e0 : nb;
     int m = ne * q;
     fill_points(as, Y, r, e0, ne);
     st = call_integrand(as, Fn, user, m, need);

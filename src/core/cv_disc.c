@@ -1,5 +1,6 @@
 /* src/core/cv_disc.c — the discretisation of one solve: mesh, reference element, dof map.
  * SPDX-License-Identifier: MIT */
+#include <math.h>
 #include <string.h>
 
 #include "cv_internal.h"
@@ -10,6 +11,7 @@ void cv_disc_free(cv_disc *d) {
   cv_free(d->fix0);
   cv_free(d->fix1);
   cv_free(d->mass);
+  cv_free(d->srule);
   memset(d, 0, sizeof *d);
 }
 
@@ -104,17 +106,50 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
 
 cv_rule cv_disc_rule(const cv_disc *d, long e) {
   const cv_refelem *r = &d->ref;
-  cv_rule R = {r->q, r->tau, r->omega, r->B, r->D};
-  if (e == 0 && d->sing_a) R = (cv_rule){r->qs, r->tsa, r->wsa, r->Bsa, r->Dsa};
-  else if (e == d->E - 1 && d->sing_b) R = (cv_rule){r->qs, r->tsb, r->wsb, r->Bsb, r->Dsb};
-  return R;
+  if (d->srule) {
+    int qs = r->qs, P1 = d->p + 1;
+    const double *base = d->srule + (size_t)e * qs * (2 + 2 * P1);
+    return (cv_rule){qs, base, base + qs, base + 2 * qs, base + 2 * qs + qs * P1};
+  }
+  return (cv_rule){r->q, r->tau, r->omega, r->B, r->D};
 }
 
 long cv_disc_num_qpoints(const cv_disc *d) {
-  long nq = (long)d->E * d->ref.q;
-  if (d->sing_a) nq += d->ref.qs - d->ref.q;
-  if (d->sing_b && (d->E > 1 || !d->sing_a)) nq += d->ref.qs - d->ref.q;
-  return nq;
+  return (long)d->E * (d->srule ? d->ref.qs : d->ref.q);
+}
+
+/* Rules for an integrand singular at an end c (theory Q-2): on every element, Gauss in
+ * u = sqrt(|x - c|), so x = c +- u^2 and dx = 2u du turn a factor |x - c|^(-1/2) into a
+ * smooth one. On the element touching c this is the substitution x = c + h t^2; on the
+ * others it removes what a graded mesh leaves of the singularity (measured: a fixed
+ * Gauss rule on the second element still let the discrete brachistochrone exploit it).
+ * With both ends singular each element uses the nearer one. */
+cv_status cv_disc_build_singular_rules(cv_disc *d) {
+  const cv_refelem *r = &d->ref;
+  int qs = r->qs, P1 = d->p + 1;
+  size_t per = (size_t)qs * (2 + 2 * P1);
+  double t[CV_MAX_QUAD], w[CV_MAX_QUAD];
+  cv_free(d->srule);
+  d->srule = NULL;
+  if (!d->sing_a && !d->sing_b) return CVAR_OK;
+  d->srule = cv_malloc((size_t)d->E * per * sizeof *d->srule);
+  if (!d->srule) return CVAR_ENOMEM;
+  cv_gauss_legendre(qs, t, w);
+  for (long e = 0; e < d->E; e++) {
+    double x0 = d->xe[e], x1 = d->xe[e + 1], h = x1 - x0, J = 0.5 * h;
+    int at_a = d->sing_a && (!d->sing_b || x0 + x1 <= d->a + d->b);
+    double c = at_a ? d->a : d->b;
+    double u0 = sqrt(fabs(x0 - c)), u1 = sqrt(fabs(x1 - c));
+    double *tau = d->srule + (size_t)e * per, *om = tau + qs, *B = om + qs, *D = B + qs * P1;
+    for (int k = 0; k < qs; k++) {
+      double u = u0 + (u1 - u0) * 0.5 * (t[k] + 1.0), wu = 0.5 * fabs(u1 - u0) * w[k];
+      double x = at_a ? c + u * u : c - u * u;
+      tau[k] = 2.0 * (x - x0) / h - 1.0;
+      om[k] = wu * 2.0 * u / J; /* weight in x, divided by the element's J = h/2 */
+      cv_lagrange(d->p, r->xi, tau[k], B + k * P1, D + k * P1);
+    }
+  }
+  return CVAR_OK;
 }
 
 /* Column c of the upper triangle holds the rows from the first unknown of the first

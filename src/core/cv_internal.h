@@ -57,12 +57,7 @@ typedef struct {
   double omega[CV_MAX_QUAD];      /* Gauss weights */
   double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];  /* B[k*(p+1)+l] = phi_l(tau_k) */
   double D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];  /* D[k*(p+1)+l] = phi_l'(tau_k) on [-1,1] */
-  /* Rules for an end element whose integrand is singular at the end (theory Q-2): Gauss
-   * in t after xi = -1 + 2 t^2 (end a) or xi = 1 - 2 t^2 (end b). */
-  int qs;
-  double tsa[CV_MAX_QUAD], tsb[CV_MAX_QUAD], wsa[CV_MAX_QUAD], wsb[CV_MAX_QUAD];
-  double Bsa[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], Dsa[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
-  double Bsb[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], Dsb[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
+  int qs; /* points of the singular-end rules, built per element in cv_disc.c */
 } cv_refelem;
 
 /* One quadrature rule on the reference element with its basis tables. */
@@ -104,8 +99,12 @@ typedef struct {
   int *fix0, *fix1;    /* index of each y component at node 0 / last, or -1 */
   int lam0, lamL, nu0; /* first multiplier at node 0 / last node (-1: none), integrals */
   double *mass;        /* lumped nodal weight of each unknown (theory N-3) */
-  int sing_a, sing_b;  /* integrand singular at that end: its element uses rule Q-2 */
+  int sing_a, sing_b;  /* integrand singular at that end: rules Q-2 on every element */
+  double *srule;       /* per-element rules (tau, omega, B, D) when singular, else NULL */
 } cv_disc;
+
+/* Build the per-element singular-end rules after sing_a/sing_b are set. */
+cv_status cv_disc_build_singular_rules(cv_disc *d);
 
 /* index of y dof g = node*n + i, or -1 when fixed */
 static inline int cv_disc_fidx(const cv_disc *d, long g) {
@@ -226,11 +225,25 @@ struct cv_solver {
   double action, gnorm, time;
   int iterations, morse, degenerate;
   double t_assemble, t_factor; /* seconds in assembly / LDL^T factor+solve (for bench/) */
+  double adapt_tol, err_est;   /* adaptive refinement (cv_adapt.c) */
+  int adapt_max, rounds;
+  int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
 };
+cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
+cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
 double cv_now(void);
 
 cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y);
-cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *y, double *M);
+/* Homotopy towards the problem from Y0 (theory HC-1); t in [0, 1], weight w > 0. */
+typedef struct {
+  double t, w;
+  const double *Y0;
+} cv_homotopy;
+cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *y, double *M,
+                        const cv_homotopy *h);
+/* After a failed Newton solve from Y0: continuation in t from Y0 (theory HC-2). */
+cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y,
+                              double *M, const double *Y0);
 
 void cv_disc_free(cv_disc *d);
 cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,

@@ -82,6 +82,31 @@ static const char *where_failed(cv_status st) {
                               : "the integrand (or a partial) is not finite";
 }
 
+/* The system Newton solves: the Lagrangian's gradient and Hessian (cv_kkt_eval), or with a
+ * homotopy h (unconstrained problems only) the convex combination of theory (HC-1):
+ *   G_t = t g(Y) + (1 - t) w M (Y - Y0),   H_t = t H(Y) + (1 - t) w M,
+ * M the lumped weights, whose solution is Y0 at t = 0 and the problem's at t = 1. */
+static cv_status eval_system(cv_kkt *kkt, const cv_homotopy *h, const newton_ws *w,
+                             const double *Y, const double *M, double *S, double *G,
+                             double *Ax, double *dreg) {
+  cv_status st = cv_kkt_eval(kkt, Y, M, S, G, Ax, dreg);
+  if (st || !h) return st;
+  const cv_disc *d = w->d;
+  double t = h->t, c = (1.0 - t) * h->w, pen = 0.0;
+  for (int f = 0; f < d->nfree; f++) {
+    int gi = w->gof[f];
+    double dy = Y[gi] - h->Y0[gi];
+    G[f] = t * G[f] + c * d->mass[f] * dy;
+    pen += d->mass[f] * dy * dy;
+  }
+  *S = t * *S + 0.5 * c * pen;
+  if (Ax) {
+    for (long k = 0; k < w->colptr[d->nfree]; k++) Ax[k] *= t;
+    for (int f = 0; f < d->nfree; f++) Ax[w->colptr[f + 1] - 1] += c * d->mass[f];
+  }
+  return CVAR_OK;
+}
+
 /* x <- K^{-1} x for the unregularised K = Kd + diag(dreg) from the factor of Kd, the
  * regularised (quasi-definite) matrix, by iterative refinement (C-4):
  * x_{k+1} = x_k + Kd^{-1} (b - K x_k) = x_k - Kd^{-1} (dreg .* x_k). */
@@ -107,7 +132,8 @@ static void apply_step(newton_ws *w, const double *Y, const double *M, size_t nm
   }
 }
 
-cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M) {
+cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M,
+                        const cv_homotopy *h) {
   newton_ws w;
   cv_kkt kkt;
   cv_status st;
@@ -148,7 +174,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   double atol = s->atol * scale, *Ax = cv_ldlt_values(w.L);
 
   double ta = cv_now();
-  st = cv_kkt_eval(&kkt, Y, M, &S, w.g, Ax, w.dreg);
+  st = eval_system(&kkt, h, &w, Y, M, &S, w.g, Ax, w.dreg);
   s->t_assemble += cv_now() - ta;
   if (st) {
     s->action = NAN;
@@ -222,7 +248,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
       apply_step(&w, Y, M, nmult, alpha);
       ta = cv_now();
-      cv_status ast = cv_kkt_eval(&kkt, w.Yt, w.Mt, &St, w.gt, Ax, w.dreg);
+      cv_status ast = eval_system(&kkt, h, &w, w.Yt, w.Mt, &St, w.gt, Ax, w.dreg);
       s->t_assemble += cv_now() - ta;
       if (ast == CVAR_ECALLBACK || ast == CVAR_ENOMEM) {
         st = ast;

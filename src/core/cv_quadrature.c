@@ -85,21 +85,7 @@ void cv_refelem_init(cv_refelem *r, int p, int q) {
   cv_gauss_legendre(q, r->tau, r->omega);
   for (int k = 0; k < q; k++)
     cv_lagrange(p, r->xi, r->tau[k], r->B + k * (p + 1), r->D + k * (p + 1));
-  /* Singular-end rule (Q-2): xi = -1 + 2 t^2, t in [0, 1], d xi = 4 t dt, so an integrand
-   * growing like (xi + 1)^(-1/2) becomes smooth in t. Twice the regular points plus four,
-   * capped: the transformed integrand is smooth but not polynomial. */
-  int qs = 2 * q + 4 > CV_MAX_QUAD ? CV_MAX_QUAD : 2 * q + 4;
-  double t[CV_MAX_QUAD], w[CV_MAX_QUAD];
-  cv_gauss_legendre(qs, t, w);
-  r->qs = qs;
-  for (int k = 0; k < qs; k++) {
-    double tk = 0.5 * (t[k] + 1.0);
-    r->tsa[k] = -1.0 + 2.0 * tk * tk;
-    r->tsb[qs - 1 - k] = -r->tsa[k];
-    r->wsa[k] = r->wsb[qs - 1 - k] = 2.0 * w[k] * tk; /* (w/2) * 4 t */
-  }
-  for (int k = 0; k < qs; k++) {
-    cv_lagrange(p, r->xi, r->tsa[k], r->Bsa + k * (p + 1), r->Dsa + k * (p + 1));
-    cv_lagrange(p, r->xi, r->tsb[k], r->Bsb + k * (p + 1), r->Dsb + k * (p + 1));
-  }
+  /* Singular-end rules (Q-2): twice the regular points plus four, capped; the
+   * transformed integrand is smooth but not polynomial. */
+  r->qs = 2 * q + 4 > CV_MAX_QUAD ? CV_MAX_QUAD : 2 * q + 4;
 }

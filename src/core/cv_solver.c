@@ -17,6 +17,9 @@ cv_solver *cv_solver_new(cv_status *why) {
   s->degree = 1;
   s->rtol = s->atol = 1e-10;
   s->maxit = 50;
+  s->continuation = 1;
+  s->adapt_max = 1000000;
+  s->err_est = NAN;
   s->status = CVAR_ESTATE;
   s->morse = -1;
   cv_set_msg(s->msg, sizeof s->msg, "no solve yet");
@@ -243,9 +246,8 @@ double cv_now(void) {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-cv_status cv_solve(cv_solver *s, const cv_problem *p) {
-  if (!s) return CVAR_EINVAL;
-  double t0 = cv_now();
+/* One solve on the mesh of s->mesh (no adaptation). */
+cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
   cv_status st;
   cv_free(s->y);
   cv_free(s->mult);
@@ -257,6 +259,7 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   s->degenerate = 0;
   s->action = s->gnorm = NAN;
   s->t_assemble = s->t_factor = 0.0;
+  s->csteps = 0;
   if (!p || !p->F) {
     st = CVAR_EINVAL;
     cv_set_msg(s->msg, sizeof s->msg, p ? "no integrand set" : "problem is NULL");
@@ -279,9 +282,45 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   if (st) goto done;
   s->have = 1;
   detect_singular_ends(p, &s->disc, s->y);
-  st = s->method == CVAR_METHOD_NEWTON ? cv_newton_run(s, p, &s->disc, s->y, s->mult)
-                                       : cv_nlopt_run(s, p, &s->disc, s->y);
+  st = cv_disc_build_singular_rules(&s->disc);
+  if (st) {
+    cv_set_msg(s->msg, sizeof s->msg, "out of memory for the singular-end quadrature");
+    goto done;
+  }
+  if (s->method != CVAR_METHOD_NEWTON) {
+    st = cv_nlopt_run(s, p, &s->disc, s->y);
+    goto done;
+  }
+  /* Newton from the start; if it fails to converge (not on bad input or a callback's
+   * abort), continuation from the same start before giving up (theory HC-2). */
+  double *Y0 = cv_malloc((size_t)s->disc.ndof * sizeof *Y0);
+  if (!Y0) {
+    st = CVAR_ENOMEM;
+    cv_set_msg(s->msg, sizeof s->msg, "out of memory");
+    goto done;
+  }
+  memcpy(Y0, s->y, (size_t)s->disc.ndof * sizeof *Y0);
+  st = cv_newton_run(s, p, &s->disc, s->y, s->mult, NULL);
+  /* Globalisation failures only: not a singular Hessian (continuation cannot cure an
+   * invariance), not an integrand failing at the start itself, and not an iteration limit
+   * the caller chose below 20 (then the limit is what they asked for). */
+  int lost = st == CVAR_ESTALL || st == CVAR_EDIVERGED ||
+             (st == CVAR_ENONFINITE && s->iterations > 0) ||
+             (st == CVAR_EMAXITER && s->maxit >= 20);
+  if (lost && p->nc == 0 && p->ni == 0 && s->continuation)
+    st = cv_continuation_run(s, p, &s->disc, s->y, s->mult, Y0);
+  cv_free(Y0);
 done:
+  s->status = st;
+  return st;
+}
+
+cv_status cv_solve(cv_solver *s, const cv_problem *p) {
+  if (!s) return CVAR_EINVAL;
+  double t0 = cv_now();
+  s->err_est = NAN;
+  s->rounds = 0;
+  cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
   s->status = st;
   s->time = cv_now() - t0;
   return st;
@@ -445,3 +484,21 @@ cv_status cv_solver_get_multiplier(const cv_solver *s, int k, double *mu) {
   *mu = s->mult[(size_t)s->disc.nodes * s->disc.nc + k];
   return CVAR_OK;
 }
+
+cv_status cv_solver_set_adapt(cv_solver *s, double tol, int max_elements) {
+  if (!s || !(tol >= 0) || !isfinite(tol) || max_elements < 1) return CVAR_EINVAL;
+  s->adapt_tol = tol;
+  s->adapt_max = max_elements;
+  return CVAR_OK;
+}
+
+double cv_solver_get_error_estimate(const cv_solver *s) { return s ? s->err_est : NAN; }
+int cv_solver_get_adapt_rounds(const cv_solver *s) { return s ? s->rounds : 0; }
+
+cv_status cv_solver_set_continuation(cv_solver *s, int on) {
+  if (!s) return CVAR_EINVAL;
+  s->continuation = on != 0;
+  return CVAR_OK;
+}
+
+int cv_solver_get_continuation_steps(const cv_solver *s) { return s ? s->csteps : 0; }

@@ -1,0 +1,192 @@
+/* src/core/cv_adapt.c — adaptive h-refinement driven by a two-mesh error estimate, theory
+ * (AD-1).
+ * SPDX-License-Identifier: MIT */
+#include <math.h>
+#include <string.h>
+
+#include "cv_internal.h"
+
+#define MAX_ROUNDS 80
+
+/* Point solver s at the mesh with boundaries xe[0..E] (a user mesh on [0, 1]). */
+static cv_status use_mesh(cv_solver *s, const double *xe, int E, double *t) {
+  double a = xe[0], L = xe[E] - xe[0];
+  for (int i = 0; i <= E; i++) t[i] = (xe[i] - a) / L;
+  t[0] = 0.0;
+  t[E] = 1.0;
+  return cv_solver_set_mesh(s, E, t);
+}
+
+/* Start s (about to be solved on its mesh) from the solution held by `from`. */
+static cv_status warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from) {
+  cv_disc d;
+  char msg[160];
+  cv_status st = cv_disc_init(&d, p, s, msg, sizeof msg);
+  if (st) return st;
+  int n = p->n, N = d.nodes;
+  double *x = cv_malloc((size_t)N * sizeof *x), *ys = cv_malloc((size_t)N * n * sizeof *ys);
+  double *y = cv_malloc((size_t)N * n * sizeof *y);
+  if (!x || !ys || !y) st = CVAR_ENOMEM;
+  if (!st) {
+    cv_disc_fill_nodes(&d, x);
+    st = cv_solver_eval(from, N, x, ys, NULL);
+  }
+  if (!st) {
+    for (int j = 0; j < N; j++)
+      for (int i = 0; i < n; i++) y[(size_t)j * n + i] = ys[(size_t)i * N + j];
+    st = cv_solver_set_start(s, N * n, y);
+  }
+  cv_free(x);
+  cv_free(ys);
+  cv_free(y);
+  cv_disc_free(&d);
+  return st;
+}
+
+/* (AD-1) Solve on the current mesh and on the mesh with every element halved; the error of
+ * element e is estimated as max over its nodes of |y_h - y_{h/2}| / (1 - 2^-(p+1)), the
+ * Richardson factor of the interior nodes' order p+1 (the element ends converge faster,
+ * O(h^2p), so this errs on the safe side). Elements above tol/4 are bisected. */
+cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
+  cv_status st;
+  cv_solver *f = cv_solver_new(&st);
+  double *xe = NULL, *t = NULL, *xn = NULL, *yf = NULL, *eta = NULL;
+  cv_meshspec spec0 = s->mesh;
+  int E = 0, n = p->n;
+  double tol = s->adapt_tol;
+  if (!f) return CVAR_ENOMEM;
+  f->degree = s->degree;
+  f->nq = s->nq;
+  f->rtol = s->rtol;
+  f->atol = s->atol;
+  f->maxit = s->maxit;
+  f->method = s->method;
+  /* the starting mesh, as the other setters describe it */
+  st = cv_mesh_build(&s->mesh, p->a, p->b, &E, &xe, s->msg, sizeof s->msg);
+  if (st) goto cleanup;
+  s->mesh.t = NULL; /* spec0 keeps the caller's user mesh; restored at the end */
+  s->mesh.nbreak = 0; /* breakpoints are already boundaries of xe, and stay so */
+  for (s->rounds = 1; s->rounds <= MAX_ROUNDS; s->rounds++) {
+    cv_free(t);
+    t = cv_malloc((size_t)(2 * E + 1) * sizeof *t);
+    if (!t) {
+      st = CVAR_ENOMEM;
+      goto cleanup;
+    }
+    st = use_mesh(s, xe, E, t);
+    if (!st && s->rounds > 1) st = warm_start(s, p, f);
+    if (st) goto cleanup;
+    st = cv_solve_mesh(s, p);
+    cv_solver_set_start(s, 0, NULL);
+    if (st) {
+      char why[320];
+      memcpy(why, s->msg, sizeof why);
+      why[sizeof why - 1] = '\0';
+      cv_set_msg(s->msg, sizeof s->msg, "adaptive refinement, round %d (%d elements): %s",
+                 s->rounds, E, why);
+      goto cleanup;
+    }
+    /* the halved mesh */
+    double *xf = cv_malloc((size_t)(2 * E + 1) * sizeof *xf);
+    if (!xf) {
+      st = CVAR_ENOMEM;
+      goto cleanup;
+    }
+    for (int e = 0; e < E; e++) {
+      xf[2 * e] = xe[e];
+      xf[2 * e + 1] = 0.5 * (xe[e] + xe[e + 1]);
+    }
+    xf[2 * E] = xe[E];
+    st = use_mesh(f, xf, 2 * E, t);
+    cv_free(xf);
+    if (!st) st = warm_start(f, p, s);
+    if (!st) st = cv_solve_mesh(f, p);
+    cv_solver_set_start(f, 0, NULL);
+    if (st) {
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "adaptive refinement, round %d: the solve on the halved mesh (%d elements) "
+                 "failed: %s",
+                 s->rounds, 2 * E, f->msg);
+      s->status = st;
+      goto cleanup;
+    }
+    /* indicators */
+    int N = s->disc.nodes, pdeg = s->disc.p;
+    cv_free(xn);
+    cv_free(yf);
+    cv_free(eta);
+    xn = cv_malloc((size_t)N * sizeof *xn);
+    yf = cv_malloc((size_t)N * n * sizeof *yf);
+    eta = cv_calloc((size_t)E, sizeof *eta);
+    if (!xn || !yf || !eta) {
+      st = CVAR_ENOMEM;
+      goto cleanup;
+    }
+    cv_disc_fill_nodes(&s->disc, xn);
+    st = cv_solver_eval(f, N, xn, yf, NULL);
+    if (st) goto cleanup;
+    double factor = 1.0 / (1.0 - pow(2.0, -(pdeg + 1))), est = 0.0;
+    for (int e = 0; e < E; e++)
+      for (int l = 0; l <= pdeg; l++) {
+        long j = (long)e * pdeg + l;
+        for (int i = 0; i < n; i++) {
+          double d = factor * fabs(s->y[j * n + i] - yf[(size_t)i * N + j]);
+          if (!(d <= eta[e])) eta[e] = d; /* NaN propagates */
+        }
+      }
+    for (int e = 0; e < E; e++)
+      if (!(eta[e] <= est)) est = eta[e];
+    s->err_est = est;
+    if (!isfinite(est)) {
+      st = CVAR_ENONFINITE;
+      cv_set_msg(s->msg, sizeof s->msg, "adaptive refinement: the error estimate is not finite");
+      goto cleanup;
+    }
+    if (est <= tol) {
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "converged on an adapted mesh of %d elements after %d rounds (estimated max "
+                 "nodal error %.2g <= %.2g)",
+                 E, s->rounds, est, tol);
+      st = CVAR_OK;
+      goto cleanup;
+    }
+    int marked = 0;
+    for (int e = 0; e < E; e++) marked += eta[e] > 0.25 * tol;
+    if (E + marked > s->adapt_max) {
+      st = CVAR_EMAXITER;
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "adaptive refinement reached the cap of %d elements with an estimated max "
+                 "nodal error of %.2g > %.2g; raise the cap or the degree",
+                 s->adapt_max, est, tol);
+      goto cleanup;
+    }
+    double *xn2 = cv_malloc((size_t)(E + marked + 1) * sizeof *xn2);
+    if (!xn2) {
+      st = CVAR_ENOMEM;
+      goto cleanup;
+    }
+    int k = 0;
+    for (int e = 0; e < E; e++) {
+      xn2[k++] = xe[e];
+      if (eta[e] > 0.25 * tol) xn2[k++] = 0.5 * (xe[e] + xe[e + 1]);
+    }
+    xn2[k] = xe[E];
+    cv_free(xe);
+    xe = xn2;
+    E = k;
+  }
+  st = CVAR_EMAXITER;
+  cv_set_msg(s->msg, sizeof s->msg,
+             "adaptive refinement did not reach %.2g in %d rounds (estimated error %.2g)", tol,
+             MAX_ROUNDS, s->err_est);
+cleanup:
+  cv_free(s->mesh.t);
+  s->mesh = spec0; /* the caller's mesh settings, for the next solve */
+  cv_free(xe);
+  cv_free(t);
+  cv_free(xn);
+  cv_free(yf);
+  cv_free(eta);
+  cv_solver_free(f);
+  return st;
+}
