@@ -173,6 +173,13 @@ static void compose_message(cli_report *r, cv_solver *sv)
   } else if (k > 0 && (size_t)k < sizeof r->message) {
     snprintf(r->message + k, sizeof r->message - (size_t)k, ".");
   }
+  /* What the solver decided on its own (graded mesh, continuation, adaptation) follows. */
+  size_t used = strlen(r->message);
+  if (detail && detail[0] && strncmp(detail, "converged in ", 13) != 0 &&
+      used + 2 < sizeof r->message)
+    snprintf(r->message + used, sizeof r->message - used, " %c%s.",
+             detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A' : detail[0],
+             detail + 1);
 }
 
 /* Fill r after cv_solve returned st. Returns 0, or -1 on allocation failure. */

@@ -1,6 +1,7 @@
 /* src/core/cv_solver.c — the solver object: options, the solve driver, results and getters.
  * SPDX-License-Identifier: MIT */
 #include <float.h>
+#include <stdio.h>
 #include <math.h>
 #include <string.h>
 #include <time.h>
@@ -246,6 +247,34 @@ double cv_now(void) {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
+/* Discretisation, starting values and singular-end detection for the current mesh spec. */
+static cv_status setup(cv_solver *s, const cv_problem *p) {
+  cv_status st;
+  cv_free(s->y);
+  cv_free(s->mult);
+  s->y = s->mult = NULL;
+  cv_disc_free(&s->disc);
+  s->have = 0;
+  st = cv_disc_init(&s->disc, p, s, s->msg, sizeof s->msg);
+  if (st) {
+    if (st == CVAR_ENOMEM) cv_set_msg(s->msg, sizeof s->msg, "out of memory building the mesh");
+    return st;
+  }
+  s->y = cv_malloc((size_t)s->disc.ndof * sizeof *s->y);
+  s->mult = cv_calloc((size_t)s->disc.nodes * p->nc + p->ni + 1, sizeof *s->mult);
+  if (!s->y || !s->mult) {
+    cv_set_msg(s->msg, sizeof s->msg, "out of memory for %d nodal values", s->disc.ndof);
+    return CVAR_ENOMEM;
+  }
+  st = initial_values(s, p, &s->disc, s->y);
+  if (st) return st;
+  s->have = 1;
+  detect_singular_ends(p, &s->disc, s->y);
+  st = cv_disc_build_singular_rules(&s->disc);
+  if (st) cv_set_msg(s->msg, sizeof s->msg, "out of memory for the singular-end quadrature");
+  return st;
+}
+
 /* One solve on the mesh of s->mesh (no adaptation). */
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
   cv_status st;
@@ -260,32 +289,30 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
   s->action = s->gnorm = NAN;
   s->t_assemble = s->t_factor = 0.0;
   s->csteps = 0;
+  s->note[0] = '\0';
   if (!p || !p->F) {
     st = CVAR_EINVAL;
     cv_set_msg(s->msg, sizeof s->msg, p ? "no integrand set" : "problem is NULL");
     goto done;
   }
   s->n = p->n;
-  st = cv_disc_init(&s->disc, p, s, s->msg, sizeof s->msg);
-  if (st) {
-    if (st == CVAR_ENOMEM) cv_set_msg(s->msg, sizeof s->msg, "out of memory building the mesh");
-    goto done;
-  }
-  s->y = cv_malloc((size_t)s->disc.ndof * sizeof *s->y);
-  s->mult = cv_calloc((size_t)s->disc.nodes * p->nc + p->ni + 1, sizeof *s->mult);
-  if (!s->y || !s->mult) {
-    st = CVAR_ENOMEM;
-    cv_set_msg(s->msg, sizeof s->msg, "out of memory for %d nodal values", s->disc.ndof);
-    goto done;
-  }
-  st = initial_values(s, p, &s->disc, s->y);
+  st = setup(s, p);
   if (st) goto done;
-  s->have = 1;
-  detect_singular_ends(p, &s->disc, s->y);
-  st = cv_disc_build_singular_rules(&s->disc);
-  if (st) {
-    cv_set_msg(s->msg, sizeof s->msg, "out of memory for the singular-end quadrature");
-    goto done;
+  /* An integrand singular at an end (Q-2) on a plain uniform mesh: grade the mesh towards
+   * that end, x_i = a + (b - a)(i/E)^k with k = min(4, 2 + p/2) (theory M-2). */
+  if ((s->disc.sing_a || s->disc.sing_b) && s->mesh.kind == CV_MESH_UNIFORM && !s->start) {
+    cv_meshspec keep = s->mesh;
+    int both = s->disc.sing_a && s->disc.sing_b, at_a = s->disc.sing_a;
+    double k = fmin(4.0, 2.0 + 0.5 * s->degree);
+    s->mesh.kind = CV_MESH_GRADED;
+    s->mesh.grading = k;
+    s->mesh.grade_end = both ? CVAR_GRADE_BOTH : at_a ? CVAR_GRADE_A : CVAR_GRADE_B;
+    st = setup(s, p);
+    s->mesh = keep;
+    if (st) goto done;
+    cv_set_msg(s->note, sizeof s->note,
+               "the integrand is singular at %s, so the mesh was graded towards it (k = %g); ",
+               both ? "both ends" : at_a ? "the start" : "the end", k);
   }
   if (s->method != CVAR_METHOD_NEWTON) {
     st = cv_nlopt_run(s, p, &s->disc, s->y);
@@ -301,16 +328,26 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
   }
   memcpy(Y0, s->y, (size_t)s->disc.ndof * sizeof *Y0);
   st = cv_newton_run(s, p, &s->disc, s->y, s->mult, NULL);
-  /* Globalisation failures only: not a singular Hessian (continuation cannot cure an
-   * invariance), not an integrand failing at the start itself, and not an iteration limit
-   * the caller chose below 20 (then the limit is what they asked for). */
+  /* Globalisation failures only: not a Hessian singular at the start itself (continuation
+   * cannot cure an invariance; one met on the way is the wandering iterate's), not an
+   * integrand failing at the start, and not an iteration limit the caller chose below 20
+   * (then the limit is what they asked for). */
   int lost = st == CVAR_ESTALL || st == CVAR_EDIVERGED ||
-             (st == CVAR_ENONFINITE && s->iterations > 0) ||
+             ((st == CVAR_ENONFINITE || st == CVAR_ESINGULAR) && s->iterations > 0) ||
              (st == CVAR_EMAXITER && s->maxit >= 20);
   if (lost && p->nc == 0 && p->ni == 0 && s->continuation)
     st = cv_continuation_run(s, p, &s->disc, s->y, s->mult, Y0);
   cv_free(Y0);
 done:
+  if (s->note[0]) {
+    char m[sizeof s->msg];
+    size_t ln = strlen(s->note), lm = strlen(s->msg);
+    if (ln + lm >= sizeof m) lm = sizeof m - 1 - ln;
+    memcpy(m, s->note, ln);
+    memcpy(m + ln, s->msg, lm);
+    m[ln + lm] = '\0';
+    memcpy(s->msg, m, sizeof m);
+  }
   s->status = st;
   return st;
 }
