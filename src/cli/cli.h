@@ -30,6 +30,10 @@ typedef struct {
 int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o);
 void cli_opts_free(cli_opts *o);
 
+/* cli_continue.c: `solve --continue name=from:to` (see there). */
+int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver **svp,
+                       cv_status *stp, char *cont_msg, size_t cmlen, char *err, size_t errlen);
+
 /* What `solve` reports; has_* flags say which keys apply (SCENES.md: keys that do not
  * apply are left out). report.c fills it from a solver and its scene. */
 typedef struct {
@@ -84,7 +88,43 @@ int cli_outfile_open(cli_outfile *o, const char *path);
 int cli_outfile_commit(cli_outfile *o);
 void cli_outfile_abandon(cli_outfile *o);
 
+/* plot.c: curves on panels stacked top to bottom, written with PLplot to the temporary
+ * file of an open cli_outfile (.svg or .png by its path) and renamed into place. */
+typedef struct {
+  int n;
+  const double *x, *y; /* non-finite points (and <= 0 on a log axis) break the line */
+  const char *label;   /* legend text */
+  int colour, style;   /* colour 0, 1, ... (-1: black); PLplot line style 1..8 (0: solid) */
+  int symbol;          /* nonzero: mark the points too */
+} cli_plot_line;
+typedef struct {
+  const char *title, *xlabel, *ylabel;
+  int logx, logy;
+  int nlines;
+  const cli_plot_line *lines;
+} cli_plot_panel;
+int cli_plot_path_ok(const char *path); /* ends in .svg or .png */
+int cli_plot_write(cli_outfile *o, int npanels, const cli_plot_panel *panels);
+
+int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv);
+
+/* `converge`: one row per mesh. The errors are against [exact] (estimated = 0) or, without
+ * it, estimates (cli_estimate_error). "_v" is the max over the element boundaries (mesh
+ * vertices), which converge as h^(2p), faster than the interior nodes (theory (E-4)). The
+ * orders compare with the previous row of the same degree. */
+typedef struct {
+  cli_report r;
+  int estimated;
+  int has_err, has_err_v, has_order, has_order_v;
+  double err, err_v, order, order_v;
+} cli_conv_row;
+int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows);
+int cli_converge_json(FILE *f, const cli_conv_row *rows, int nrows);
+int cli_plot_converge(cli_outfile *o, const cli_conv_row *rows, int nrows);
+struct json_t *cli_report_json_object(const cli_report *r);
+
 /* Subcommands. */
+int cli_converge(int argc, char **argv);
 int cli_gallery(void);
 int cli_solve(int argc, char **argv);
 int cli_check(int argc, char **argv);

@@ -6,6 +6,7 @@
  * opened before the solve (an unwritable path is bad input too, found before the work);
  * after the solve the reports are written whatever the status (exit 1 keeps its JSON).
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -30,20 +31,13 @@ static void usage(FILE *f)
         "exit status: 0 converged, 1 not solved, 2 bad input\n", f);
 }
 
-/* Features of SCENES.md whose machinery the core does not provide yet: refuse honestly
- * (exit 2, nothing written) instead of ignoring the request. */
+/* Combinations that cannot be honoured: refuse (exit 2, nothing written) rather than
+ * ignore a request. */
 static int unsupported(const cli_opts *o, const scene *s)
 {
-  if (o->adapt > 0) {
-    fprintf(stderr, "calcvar solve: --adapt is not supported by this build yet\n");
-    return EXIT_BADINPUT;
-  }
-  if (o->cont) {
-    fprintf(stderr, "calcvar solve: --continue is not supported by this build yet\n");
-    return EXIT_BADINPUT;
-  }
-  if (o->plot) {
-    fprintf(stderr, "calcvar solve: --plot is not supported by this build yet\n");
+  if (o->cont && (o->adapt > 0 || s->adapt > 0)) {
+    fprintf(stderr, "calcvar solve: --continue and adaptive refinement cannot be combined "
+            "(continuation keeps one mesh)\n");
     return EXIT_BADINPUT;
   }
   if ((s->method == SC_LBFGS || s->method == SC_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
@@ -54,11 +48,6 @@ static int unsupported(const cli_opts *o, const scene *s)
     else
       fprintf(stderr, "%s:%d: method %s cannot impose constraints; use mma, ccsaq, slsqp, "
               "auglag or newton\n", s->file, s->method_line, scene_method_name(s->method));
-    return EXIT_BADINPUT;
-  }
-  if (s->adapt > 0) {
-    fprintf(stderr, "%s:%d: adapt is not supported by this build yet\n", s->file,
-            s->adapt_line);
     return EXIT_BADINPUT;
   }
   return 0;
@@ -78,7 +67,7 @@ int cli_solve(int argc, char **argv)
   scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
   cv_problem *p = NULL;
   cv_solver *sv = NULL;
-  cli_outfile jf = {0}, cf = {0};
+  cli_outfile jf = {0}, cf = {0}, pf = {0};
   cli_report r;
   memset(&r, 0, sizeof r);
   if (!s) {
@@ -106,12 +95,36 @@ int cli_solve(int argc, char **argv)
     goto done;
   }
   if ((o.json && cli_outfile_open(&jf, o.json) < 0) ||
-      (o.csv && cli_outfile_open(&cf, o.csv) < 0)) {
+      (o.csv && cli_outfile_open(&cf, o.csv) < 0) ||
+      (o.plot && cli_outfile_open(&pf, o.plot) < 0)) {
     rc = EXIT_BADINPUT;
     goto done;
   }
 
-  cv_status st = cv_solve(sv, p);
+  /* Adaptive refinement: [mesh] adapt or --adapt, capped at 2e6 elements (theory AD-1). */
+  double adapt = o.adapt > 0 ? o.adapt : s->adapt;
+  if (adapt > 0 && cv_solver_set_adapt(sv, adapt, 2000000) != CVAR_OK) {
+    fprintf(stderr, "calcvar solve: invalid adaptive tolerance %g\n", adapt);
+    rc = EXIT_BADINPUT;
+    goto done;
+  }
+  cv_status st;
+  char cont_msg[256] = "";
+  if (o.cont) {
+    /* continuation replaces scene, problem and solver by those of its last step */
+    cv_solver_free(sv);
+    cv_problem_free(p);
+    scene_free(s);
+    s = NULL, p = NULL, sv = NULL;
+    if (cli_continue_solve(&o, &s, &p, &sv, &st, cont_msg, sizeof cont_msg, err,
+                           sizeof err) < 0) {
+      fprintf(stderr, "%s\n", err);
+      rc = EXIT_BADINPUT;
+      goto done;
+    }
+  } else {
+    st = cv_solve(sv, p);
+  }
   if (st == CVAR_EINVAL) {
     /* Input the core refused before solving (e.g. a dense NLopt Jacobian too large). */
     fprintf(stderr, "%s: %s\n", s->file, cv_solver_last_error(sv));
@@ -123,10 +136,22 @@ int cli_solve(int argc, char **argv)
     rc = EXIT_UNSOLVED;
     goto done;
   }
+  if (cont_msg[0]) {
+    size_t used = st == CVAR_OK ? strlen(r.message) : 0;
+    char c0 = cont_msg[0] >= 'a' && cont_msg[0] <= 'z' ? (char)(cont_msg[0] - 'a' + 'A')
+                                                      : cont_msg[0];
+    snprintf(r.message + used, sizeof r.message - used, "%s%c%s.", used ? " " : "", c0,
+             cont_msg + 1);
+  }
   int any_exact = 0;
   for (int i = 0; i < s->n; i++)
     any_exact |= s->exact[i] >= 0;
-  if (!any_exact && cli_report_estimate(&r, s, p) < 0) {
+  if (adapt > 0) {
+    /* the adaptive solve's own two-mesh estimate */
+    double est = cv_solver_get_error_estimate(sv);
+    r.has_err_est = !any_exact && isfinite(est);
+    r.err_est = est;
+  } else if (!any_exact && cli_report_estimate(&r, s, p) < 0) {
     fprintf(stderr, "calcvar solve: out of memory while estimating the error\n");
     rc = EXIT_UNSOLVED;
     goto done;
@@ -134,6 +159,10 @@ int cli_solve(int argc, char **argv)
   rc = st == CVAR_OK ? EXIT_SOLVED : EXIT_UNSOLVED;
   if (jf.f && (cli_report_json(jf.f, &r) < 0 || cli_outfile_commit(&jf) < 0)) {
     fprintf(stderr, "calcvar solve: the JSON report could not be written\n");
+    rc = EXIT_UNSOLVED;
+  }
+  if (pf.f && cli_plot_solution(&pf, &r, sv) < 0) {
+    fprintf(stderr, "calcvar solve: the plot could not be written\n");
     rc = EXIT_UNSOLVED;
   }
   if (cf.f && (cli_report_csv(cf.f, &r) < 0 || cli_outfile_commit(&cf) < 0)) {
@@ -149,6 +178,7 @@ int cli_solve(int argc, char **argv)
 done:
   cli_outfile_abandon(&jf);
   cli_outfile_abandon(&cf);
+  cli_outfile_abandon(&pf);
   cli_report_free(&r);
   cv_solver_free(sv);
   cv_problem_free(p);

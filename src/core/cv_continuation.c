@@ -47,17 +47,14 @@ static cv_status homotopy_weight(const cv_problem *p, const cv_disc *d, const do
  * turns back or ends: the problem may have no stationary path near the start. */
 cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y,
                               double *M, const double *Y0) {
-  char first[320];
   double w, t = 0.0, dt = 0.1;
   int steps = 0, total = s->iterations, maxit = s->maxit;
   size_t nd = (size_t)d->ndof * sizeof *Y;
   double *Yc = cv_malloc(nd), *Yt = cv_malloc(nd);
   cv_status st = (Yc && Yt) ? homotopy_weight(p, d, Y0, &w) : CVAR_ENOMEM;
-  memcpy(first, s->msg, sizeof first);
-  first[sizeof first - 1] = '\0';
   if (st) {
-    cv_set_msg(s->msg, sizeof s->msg, "%s; continuation could not start (%s)", first,
-               cv_strerror(st));
+    cv_set_msg(s->msg, sizeof s->msg, "Newton did not converge and continuation could not "
+               "start (%s)", cv_strerror(st));
     goto cleanup;
   }
   memcpy(Yc, Y0, nd);
@@ -81,10 +78,11 @@ cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, dou
       st = CVAR_ESTALL;
       memcpy(Y, Yc, nd);
       cv_set_msg(s->msg, sizeof s->msg,
-                 "no stationary path found: Newton from the start failed (%.120s) and "
-                 "continuation from the start stalled at t = %.3g of 1 after %d steps (its "
-                 "path turns back or ends: beyond a critical value there may be no solution)",
-                 first, t, steps);
+                 "no stationary path found: Newton from the start did not converge, and "
+                 "continuation from the start stalled at t = %.6g of 1 after %d steps (the "
+                 "path of solutions turns back or ends; beyond a critical value of the data "
+                 "there may be no solution)",
+                 t, steps);
       goto cleanup;
     }
   }
@@ -96,8 +94,8 @@ cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, dou
   if (st == CVAR_OK)
     cv_set_msg(s->msg, sizeof s->msg,
                "converged by continuation from the start in %d steps (%d Newton iterations "
-               "in all) after Newton alone failed: %.160s",
-               steps, total, first);
+               "in all) after Newton alone did not converge",
+               steps, total);
 cleanup:
   s->maxit = maxit;
   s->iterations = total;
