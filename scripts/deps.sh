@@ -8,4 +8,5 @@ $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends \
   build-essential meson ninja-build pkg-config \
   libsuitesparse-dev libnlopt-dev libinih-dev libjansson-dev liblapack-dev \
-  libplplot-dev plplot-driver-cairo >/dev/null
+  libplplot-dev plplot-driver-cairo \
+  doxygen groff-base >/dev/null   # the API reference and the man page (tests 'docs')

@@ -100,15 +100,28 @@ done:
   return rc;
 }
 
+/* The shortest decimal that reads back as v (as the expressions print their numbers). */
+static const char *shortest(double v, char *buf, size_t len)
+{
+  for (int prec = 1; prec <= 17; prec++) {
+    snprintf(buf, len, "%.*g", prec, v);
+    if (strtod(buf, NULL) == v)
+      break;
+  }
+  return buf;
+}
+
 static void write_text(FILE *f, const scene *s, const sc_equations *eq, const texts *t)
 {
   int n = s->n, ncyc = 0;
+  char num[32];
   fprintf(f, "%s (%s)\n", s->title, s->file);
   fprintf(f, "  F(%s, y, y') = %s\n", s->variable, t->F);
   if (s->nparams > 0) {
     fprintf(f, "  parameters   substituted as numbers:");
     for (int k = 0; k < s->nparams; k++)
-      fprintf(f, "%s %s = %.17g", k ? "," : "", s->params[k].name, s->params[k].value);
+      fprintf(f, "%s %s = %s", k ? "," : "", s->params[k].name,
+              shortest(s->params[k].value, num, sizeof num));
     fprintf(f, "\n");
   }
   for (int i = 0; i < n; i++) {

@@ -96,7 +96,8 @@ static void write_text(FILE *f, const scene *s, const sc_modes *md)
   if (md->gyroscopic > 0)
     fprintf(f, "  note         L has gyroscopic terms (L_y'y not symmetric, max |G| = %.3g); "
             "these modes leave them out\n", md->gyroscopic);
-  fprintf(f, "\n  %-4s %-22s %-9s %-28s %s\n", "mode", "omega^2", "kind", "", "shape (v'Mv = 1)");
+  fprintf(f, "\n  %-4s %-22s %-9s %-32s %s\n", "mode", "omega^2", "kind", "frequency or growth",
+          "shape (v'Mv = 1)");
   for (int k = 0; k < n; k++) {
     double w2 = md->omega2[k];
     char what[64];
@@ -106,7 +107,7 @@ static void write_text(FILE *f, const scene *s, const sc_modes *md)
       snprintf(what, sizeof what, "growth rate %.6g", sqrt(-w2));
     else
       snprintf(what, sizeof what, "free motion");
-    fprintf(f, "  %-4d %-22.15g %-9s %-28s", k + 1, w2, kind_name(md->kind[k]), what);
+    fprintf(f, "  %-4d %-22.15g %-9s %-32s", k + 1, w2, kind_name(md->kind[k]), what);
     for (int i = 0; i < n; i++)
       fprintf(f, " %s %.6g", s->unknowns[i], md->shape[k * n + i]);
     fprintf(f, "\n");

@@ -11,7 +11,7 @@ static void usage(FILE *f)
         "  calcvar                         run the built-in demo gallery\n"
         "  calcvar solve SCENE [options]   solve one scene (calcvar solve --help)\n"
         "  calcvar check SCENE             parse, degrees of freedom, derivative check\n"
-        "  calcvar converge SCENE          (not in this build yet)\n"
+        "  calcvar converge SCENE [opts]   error and run time over a sequence of meshes\n"
         "  calcvar equations SCENE         momenta, Euler-Lagrange equations, Hamiltonian\n"
         "  calcvar modes SCENE             equilibrium and small-oscillation frequencies\n"
         "  calcvar --help | --version\n"
@@ -43,7 +43,7 @@ int main(int argc, char **argv)
   if (strcmp(cmd, "modes") == 0)
     return cli_modes(argc - 2, argv + 2);
   if (strcmp(cmd, "converge") == 0)
-    return cli_unsupported(cmd);
+    return cli_converge(argc - 2, argv + 2);
   fprintf(stderr, "calcvar: unknown command '%s' (calcvar --help lists them)\n", cmd);
   return EXIT_BADINPUT;
 }

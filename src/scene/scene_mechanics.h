@@ -78,8 +78,8 @@ typedef struct {
                           K v = w2 M v ignore G (docs/theory.md (P-10)) */
 } sc_modes;
 
-/** Relative threshold below which |omega2| counts as zero (neutral), relative to the
- * largest |omega2| (or to ||K||/||M|| when every omega2 is tiny). */
+/** |omega2| <= SC_MODES_NEUTRAL_RTOL * max_k |omega2_k| counts as zero (neutral); when K
+ * is zero every mode is neutral. */
 #define SC_MODES_NEUTRAL_RTOL 1e-9
 
 /** Find the equilibrium from the guess at the start of the interval (Newton on

@@ -199,7 +199,7 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
   for (int i = 0; i < n; i++)
     for (int j = 0; j < n; j++) {
       md->mass[i * n + j] = Mv[i * n + j];
-      md->stiffness[i * n + j] = -J[i * n + j];
+      md->stiffness[i * n + j] = 0.0 - J[i * n + j]; /* no -0 in the output */
       md->gyroscopic = fmax(md->gyroscopic, fabs(C[i * n + j] - C[j * n + i]));
     }
 
@@ -223,7 +223,7 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
   }
   double big = maxabs(n, md->omega2);
   for (int k = 0; k < n; k++) {
-    double w2 = md->omega2[k];
+    double w2 = md->omega2[k] += 0.0;
     md->kind[k] = fabs(w2) <= SC_MODES_NEUTRAL_RTOL * big ? SC_MODE_NEUTRAL
                   : w2 > 0                                ? SC_MODE_STABLE
                                                           : SC_MODE_UNSTABLE;
@@ -235,7 +235,7 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
         imax = i;
     double sg = v[imax] < 0 ? -1.0 : 1.0;
     for (int i = 0; i < n; i++)
-      md->shape[k * n + i] = sg * v[i];
+      md->shape[k * n + i] = sg * v[i] + 0.0;
   }
   rc = SC_MODES_OK;
 cleanup:

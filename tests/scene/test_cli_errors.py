@@ -78,11 +78,13 @@ with tempfile.TemporaryDirectory() as tmp:
         (["solve", cat, "--set", "c=abc"], "unknown name 'abc'"),
         (["solve", cat, "--set", "c=1/0"], "not a finite number"),
         (["solve", cat, "--set", "c=0.1"], None),  # a valid override: must not be exit 2
-        (["solve", cat, "--adapt", "1e-8"], "--adapt is not supported by this build yet"),
+        (["solve", cat, "--adapt", "1e-8"], None),  # valid: must not be exit 2
+        (["solve", cat, "--adapt", "1e-8", "--continue", "c=1.6:2"], "cannot be combined"),
+        (["solve", cat, "--continue", "nosuch=1:2"], "not a parameter"),
         (["solve", cat, "--adapt", "-1"], "--adapt"),
-        (["solve", cat, "--continue", "c=1:2"], "--continue is not supported by this build yet"),
+        (["solve", cat, "--continue", "c=1.6:2"], None),  # valid: must not be exit 2
         (["solve", cat, "--continue", "c=1"], "name=from:to"),
-        (["solve", cat, "--plot", "out.png"], "--plot is not supported by this build yet"),
+        (["solve", cat, "--plot", os.path.join(tmp, "no_dir", "x.png")], "cannot write"),
         (["solve", cat, "--plot", "out.jpg"], ".png or .svg"),
         (["solve", cat, "--json", "-", "--csv", "-"], "stdout"),
         (["solve", cat, "--bogus"], "unknown option"),
@@ -92,9 +94,9 @@ with tempfile.TemporaryDirectory() as tmp:
         (["solve", os.path.join(tmp, "no_such.scene")], "cannot open"),
         (["solve", cat, "--json", os.path.join(tmp, "no_dir", "x.json")], "cannot write"),
         (["frobnicate"], "unknown command"),
-        (["converge", cat], "not supported by this build yet"),
-        (["equations", cat], "not supported by this build yet"),
-        (["modes", cat], "not supported by this build yet"),
+        (["converge", cat, "--levels", "0"], "--levels"),
+        (["equations", cat, "--csv", "-"], "only --set, --json and --quiet apply"),
+        (["modes", cat, "--degree", "2"], "only --set, --json and --quiet apply"),
     ]
     for args, expect in flag_cases:
         before = set(os.listdir(tmp))

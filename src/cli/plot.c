@@ -1,0 +1,224 @@
+/* src/cli/plot.c — pictures with PLplot: panels of labelled curves written to SVG or PNG.
+ * SPDX-License-Identifier: MIT
+ *
+ * The only file that includes plplot.h. The device follows the file's ending: ".svg" is
+ * PLplot's own "svg" driver (text stays <text>, so a browser renders and searches it),
+ * ".png" is "pngcairo" (Debian plplot-driver-cairo). The picture is drawn into the
+ * temporary file of a cli_outfile and renamed into place at the end, so a failure never
+ * leaves half a picture behind. PLplot ends the process on an internal error (plexit);
+ * the handler below removes the temporary file first.
+ */
+#include <math.h>
+#include <plplot.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli/cli.h"
+
+/* cmap0: 0 background, 1 axes and text, 2 grid, 3.. line colours (a qualitative palette
+ * that stays distinguishable in grey print). */
+static const PLINT pal_r[] = {255, 0, 215, 31, 255, 44, 214, 148, 140, 227, 127, 188, 23};
+static const PLINT pal_g[] = {255, 0, 215, 119, 127, 160, 39, 103, 86, 119, 127, 189, 190};
+static const PLINT pal_b[] = {255, 0, 215, 180, 14, 44, 40, 189, 75, 194, 127, 34, 207};
+enum { NPAL = (int)(sizeof pal_r / sizeof pal_r[0]), FIRST_LINE_COLOUR = 3 };
+
+#define MARK "#(728)" /* a filled circle, as a PLplot Hershey escape */
+
+static const char *exit_tmp; /* the temporary file to remove if PLplot gives up */
+
+static int plplot_exit(PLCHAR_VECTOR msg)
+{
+  fprintf(stderr, "calcvar: the plotting library failed: %s\n", msg);
+  if (exit_tmp)
+    unlink(exit_tmp);
+  return EXIT_UNSOLVED;
+}
+
+int cli_plot_path_ok(const char *path)
+{
+  size_t n = strlen(path);
+  return n >= 5 && (strcmp(path + n - 4, ".svg") == 0 || strcmp(path + n - 4, ".png") == 0);
+}
+
+/* cmap0 index of a line colour; negative is the text colour (black). */
+static PLINT colour_index(int colour)
+{
+  return colour < 0 ? 1 : FIRST_LINE_COLOUR + colour % (NPAL - FIRST_LINE_COLOUR);
+}
+
+/* Value as drawn: log10 on a logarithmic axis; NaN where it cannot be drawn. */
+static double coord(double v, int logscale)
+{
+  if (!isfinite(v))
+    return NAN;
+  if (logscale)
+    return v > 0 ? log10(v) : NAN;
+  return v;
+}
+
+/* Data range of a panel along x (which = 0) or y (1), in drawn coordinates, padded. */
+static void panel_range(const cli_plot_panel *p, int which, double *lo, double *hi)
+{
+  int logscale = which ? p->logy : p->logx;
+  *lo = INFINITY;
+  *hi = -INFINITY;
+  for (int l = 0; l < p->nlines; l++)
+    for (int k = 0; k < p->lines[l].n; k++) {
+      double v = coord(which ? p->lines[l].y[k] : p->lines[l].x[k], logscale);
+      if (isfinite(v) && isfinite(coord(which ? p->lines[l].x[k] : p->lines[l].y[k],
+                                        which ? p->logx : p->logy))) {
+        *lo = fmin(*lo, v);
+        *hi = fmax(*hi, v);
+      }
+    }
+  if (!(*lo <= *hi)) { /* nothing drawable */
+    *lo = 0;
+    *hi = 1;
+  }
+  double span = *hi - *lo;
+  if (logscale) {
+    /* whole decades keep the logarithmic tick labels readable */
+    *lo = floor(*lo - 0.05);
+    *hi = ceil(*hi + 0.05);
+    if (*hi - *lo < 1)
+      *hi = *lo + 1;
+  } else {
+    double pad = span > 0 ? 0.05 * span : (fabs(*lo) > 0 ? 0.1 * fabs(*lo) : 1);
+    if (which == 0 && span > 0)
+      pad = 0; /* the variable's interval is drawn exactly */
+    *lo -= pad;
+    *hi += pad;
+  }
+}
+
+/* Draw one curve as its runs of drawable points (a NaN or a non-positive value on a
+ * logarithmic axis breaks the line instead of ending the picture). */
+static void draw_line(const cli_plot_panel *p, const cli_plot_line *ln)
+{
+  PLFLT *x = malloc((size_t)(ln->n > 0 ? ln->n : 1) * sizeof *x);
+  PLFLT *y = malloc((size_t)(ln->n > 0 ? ln->n : 1) * sizeof *y);
+  if (!x || !y) {
+    free(x);
+    free(y);
+    return;
+  }
+  plcol0(colour_index(ln->colour));
+  pllsty(ln->style > 0 ? ln->style : 1);
+  plwidth(ln->colour < 0 ? 1.5 : 2.0);
+  int m = 0;
+  for (int k = 0; k <= ln->n; k++) {
+    double u = k < ln->n ? coord(ln->x[k], p->logx) : NAN;
+    double v = k < ln->n ? coord(ln->y[k], p->logy) : NAN;
+    if (isfinite(u) && isfinite(v)) {
+      x[m] = u;
+      y[m] = v;
+      m++;
+      continue;
+    }
+    if (m > 1)
+      plline(m, x, y);
+    if (m > 0 && (ln->symbol || m == 1)) /* a lone point would be invisible as a line */
+      plstring(m, x, y, MARK);
+    m = 0;
+  }
+  pllsty(1);
+  plwidth(1.0);
+  free(x);
+  free(y);
+}
+
+static void draw_panel(const cli_plot_panel *p)
+{
+  double x0, x1, y0, y1;
+  panel_range(p, 0, &x0, &x1);
+  panel_range(p, 1, &y0, &y1);
+  pladv(0);
+  plvpor(0.09, 0.76, 0.13, 0.90); /* the legend goes to the right, outside */
+  plwind(x0, x1, y0, y1);
+  char xo[16] = "bcnst", yo[16] = "bcnstv";
+  if (p->logx)
+    strcat(xo, "l");
+  if (p->logy)
+    strcat(yo, "l");
+  plcol0(2);
+  plbox("g", 0, 0, "g", 0, 0);
+  plcol0(1);
+  plbox(xo, 0, 0, yo, 0, 0);
+  pllab(p->xlabel, p->ylabel, p->title);
+  for (int l = 0; l < p->nlines; l++)
+    draw_line(p, &p->lines[l]);
+
+  /* legend: one entry per curve, line and (where drawn) symbol */
+  int n = p->nlines;
+  if (n <= 0)
+    return;
+  PLINT *opt = calloc((size_t)n, sizeof *opt), *tc = calloc((size_t)n, sizeof *tc);
+  PLINT *lc = calloc((size_t)n, sizeof *lc), *ls = calloc((size_t)n, sizeof *ls);
+  PLINT *sc = calloc((size_t)n, sizeof *sc), *sn = calloc((size_t)n, sizeof *sn);
+  PLFLT *lw = calloc((size_t)n, sizeof *lw), *ss = calloc((size_t)n, sizeof *ss);
+  const char **text = calloc((size_t)n, sizeof *text), **sym = calloc((size_t)n, sizeof *sym);
+  if (opt && tc && lc && ls && sc && sn && lw && ss && text && sym) {
+    for (int l = 0; l < n; l++) {
+      const cli_plot_line *ln = &p->lines[l];
+      opt[l] = PL_LEGEND_LINE | (ln->symbol ? PL_LEGEND_SYMBOL : 0);
+      tc[l] = 1;
+      lc[l] = sc[l] = colour_index(ln->colour);
+      ls[l] = ln->style > 0 ? ln->style : 1;
+      lw[l] = ln->colour < 0 ? 1.5 : 2.0;
+      ss[l] = 1.0;
+      sn[l] = 3;
+      text[l] = ln->label ? ln->label : "";
+      sym[l] = MARK;
+    }
+    PLFLT w, h;
+    pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
+             PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, 0.02, 0.0, 0.06, 0, 1, 1, 0, 0, n, opt, 0.8, 0.85, 2.0, 0.0, tc, text, NULL, NULL,
+             NULL, NULL, lc, ls, lw, sc, ss, sn, sym);
+  }
+  free(opt);
+  free(tc);
+  free(lc);
+  free(ls);
+  free(sc);
+  free(sn);
+  free(lw);
+  free(ss);
+  free(text);
+  free(sym);
+}
+
+int cli_plot_write(cli_outfile *o, int npanels, const cli_plot_panel *panels)
+{
+  if (!o->f || o->f == stdout || !o->tmp || npanels < 1)
+    return -1;
+  /* PLplot opens the file itself, by name: hand it the temporary file. */
+  fclose(o->f);
+  o->f = NULL;
+  size_t n = strlen(o->path);
+  int svg = n >= 4 && strcmp(o->path + n - 4, ".svg") == 0;
+  exit_tmp = o->tmp;
+  plsexit(plplot_exit);
+  plsdev(svg ? "svg" : "pngcairo");
+  plsfnam(o->tmp);
+  plspage(0, 0, 960, 100 + 460 * npanels, 0, 0);
+  plscmap0(pal_r, pal_g, pal_b, NPAL);
+  plssub(1, npanels);
+  plinit();
+  plschr(0, 0.95);
+  for (int k = 0; k < npanels; k++)
+    draw_panel(&panels[k]);
+  plend();
+  exit_tmp = NULL;
+  if (access(o->tmp, F_OK) != 0 || rename(o->tmp, o->path) != 0) {
+    fprintf(stderr, "calcvar: cannot write %s\n", o->path);
+    unlink(o->tmp);
+    free(o->tmp);
+    o->tmp = NULL;
+    return -1;
+  }
+  free(o->tmp);
+  o->tmp = NULL;
+  return 0;
+}
