@@ -246,7 +246,8 @@ static void detect_singular_ends(const cv_problem *p, cv_disc *d, const double *
     x = end ? d->b : d->a;
     cv_partials o = {buf + 2 * n, NULL, NULL, NULL, NULL, NULL};
     int rc = p->F(1, &x, buf, buf + n, CVAR_NEED_F, &o, p->user);
-    int singular = rc > 0 || (rc == 0 && !isfinite(o.F[0]));
+    /* infinite (or "cannot evaluate here"), not NaN: a NaN end is undefined, not singular */
+    int singular = rc > 0 || (rc == 0 && isinf(o.F[0]));
     if (end) d->sing_b = singular;
     else d->sing_a = singular;
   }
