@@ -2,7 +2,8 @@
  * Newton iteration for assembly and for the LDL^T factor+solve, and total time, next to the
  * floor of DESIGN.md measured in the same run: a hand-written Newton for the same
  * discretisation (2-point Gauss, analytic tridiagonal Hessian, Thomas algorithm).
- * Usage: bench_newton [max_exponent (default 7)] [degree (default 1)]
+ * Usage: bench_newton [max_exponent (default 7)] [degree (default 1)] [min_exponent (3)]
+ * Peak memory: run one size under /usr/bin/time -v (docs/robustness.md has the figures).
  * SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <stdio.h>
@@ -67,11 +68,12 @@ static int catenary(int m, const double *x, const double *y, const double *dy, u
 
 int main(int argc, char **argv) {
   int maxexp = argc > 1 ? atoi(argv[1]) : 7, deg = argc > 2 ? atoi(argv[2]) : 1;
+  int minexp = argc > 3 ? atoi(argv[3]) : 3;
   double c = 2 * cosh(0.5);
   printf("catenary, degree %d: per element per Newton iteration\n", deg);
   printf("%10s %6s %12s %12s %12s %10s %12s %10s %7s\n", "elements", "iters", "assemble_ns",
          "ldlt_ns", "total_ns", "total_s", "max_err", "floor_ns", "ratio");
-  for (int e = 3; e <= maxexp; e++) {
+  for (int e = minexp; e <= maxexp; e++) {
     int E = (int)lround(pow(10, e));
     cv_problem *p = cv_problem_new(1, -1, 1, NULL);
     cv_problem_set_integrand(p, catenary, NULL);
