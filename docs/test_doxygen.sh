@@ -13,4 +13,4 @@ if [ -s "$out/log" ]; then
   cat "$out/log"; echo "FAIL: doxygen printed warnings"; exit 1
 fi
 [ -f "$out/html/calcvar_8h.html" ] || { echo "FAIL: no page for calcvar.h"; exit 1; }
-echo "doxygen $(doxygen --version): no warnings; $(ls "$out/html" | wc -l) files"
+echo "doxygen $(doxygen --version): no warnings; $(find "$out/html" -type f | wc -l) files"

@@ -24,8 +24,9 @@ man=$(find "$dest" -path '*/man1/calcvar.1*' | head -n 1)
 shared=$(find "$dest" -name 'libcalcvar.so*' | head -n 1)
 static=$(find "$dest" -name libcalcvar.a | head -n 1)
 for f in "$hdr" "$exe" "$man" "$shared" "$static"; do [ -n "$f" ] || fail "missing file"; done
-echo "installed: ${pc#$dest} ${hdr#$dest} ${exe#$dest} ${man#$dest}"
-echo "           ${shared%/*}/libcalcvar.{so,a} (under ${dest})"
+echo "installed: ${pc#"$dest"} ${hdr#"$dest"} ${exe#"$dest"} ${man#"$dest"}"
+libdir=${shared%/*}
+echo "           ${libdir#"$dest"}/libcalcvar.so, libcalcvar.a (DESTDIR $dest)"
 
 # pkg-config sees the staged tree as the system root: -I and -L point into $dest.
 export PKG_CONFIG_PATH="${pc%/*}" PKG_CONFIG_SYSROOT_DIR="$dest"
@@ -37,7 +38,6 @@ echo "pkg-config: calcvar $version"
 echo "  --cflags:        $cflags"
 echo "  --libs:          $libs"
 echo "  --static --libs: $libs_static"
-libdir=${shared%/*}
 
 for ex in ball catenary hanging_chain; do
   # Shared: the library found at run time through LD_LIBRARY_PATH (it is not installed).
