@@ -105,8 +105,8 @@ int scene_method_from_name(const char *name);
 unsigned scene_method_need(sc_method m);
 
 /** A problem for the scene's integrand, ends, guess, [constraints] and [integrals]. max_need:
- * CVAR_NEED_* bits the integrand and constraints compile. A pointwise constraint that fails
- * at an end whose values are all fixed is reported as FILE:LINE (SCENES.md). */
+ * CVAR_NEED_* bits the integrand and constraints compile. (A pointwise constraint that
+ * fails at an end whose values are fixed was already rejected by the loader.) */
 cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size_t errlen);
 /** Apply [mesh] and [solver] to a solver (elements, degree, grading, breakpoints,
  * tolerances, maximum iterations). */

@@ -1,6 +1,5 @@
 /* src/scene/scene_problem.c — a cv_problem and solver settings from a loaded scene.
  * SPDX-License-Identifier: MIT */
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -12,44 +11,6 @@
 static int guess_cb(int m, const double *x, double *y, void *user)
 {
   return scene_eval_guess(user, m, x, y) < 0 ? -1 : 0;
-}
-
-/* SCENES.md: a pointwise constraint that does not hold at the fixed end values is rejected
- * before solving. The test is relative to the size of the terms of G, |grad G| |y|. */
-static int constraint_ends(const scene *s, int k, char *err, size_t errlen)
-{
-  int n = s->n;
-  for (int end = 0; end < 2; end++) {
-    int all_fixed = 1;
-    for (int i = 0; i < n; i++)
-      all_fixed &= !s->bc[i].free_end[end];
-    if (!all_fixed)
-      continue;
-    double slots[1 + 2 * 64], g, sc = 1.0;
-    if (n > 64)
-      return 0; /* the core checks as well */
-    slots[0] = end ? s->b : s->a;
-    for (int i = 0; i < n; i++) {
-      slots[1 + i] = s->bc[i].value[end];
-      slots[1 + n + i] = 0.0;
-    }
-    if (ex_eval(s->dag, s->cons[k].expr, slots, &g) < 0)
-      return 0;
-    for (int i = 0; i < n; i++) {
-      ex_id d = ex_diff(s->dag, s->cons[k].expr, 1 + i);
-      double gi;
-      if (d >= 0 && ex_eval(s->dag, d, slots, &gi) == 0 && isfinite(gi))
-        sc += fabs(gi * slots[1 + i]);
-    }
-    if (!(fabs(g) <= 1e-9 * sc)) {
-      sc_err(err, errlen, s->file, s->cons[k].line,
-             "[constraints] %s does not hold at the fixed end %s = %g (G = %.6g); the end "
-             "values must satisfy it",
-             s->cons[k].name, s->variable, slots[0], g);
-      return -1;
-    }
-  }
-  return 0;
 }
 
 cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size_t errlen)
@@ -99,8 +60,6 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
       sc_err(err, errlen, s->file, it->line, "[constraints] %s: %s", it->name, cv_strerror(why));
       goto fail;
     }
-    if (constraint_ends(s, k, err, errlen) < 0)
-      goto fail;
   }
   for (int k = 0; k < s->nints; k++) {
     const sc_item *it = &s->ints[k];
