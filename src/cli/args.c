@@ -174,3 +174,14 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     return bad(cmd, "--json and --csv name the same file '%s'", o->json);
   return 0;
 }
+
+/* For commands that only read a scene (equations, modes): reject solve-only options. */
+int cli_only_scene_options(const char *cmd, const cli_opts *o)
+{
+  if (o->csv || o->plot || o->adapt > 0 || o->cont || o->elements || o->degree ||
+      o->method >= 0 || o->tolerance > 0 || o->max_iterations) {
+    fprintf(stderr, "calcvar %s: only --set, --json and --quiet apply to %s\n", cmd, cmd);
+    return EXIT_BADINPUT;
+  }
+  return 0;
+}

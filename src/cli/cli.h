@@ -29,6 +29,9 @@ typedef struct {
  * the reason. `cmd` names the command in messages. */
 int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o);
 void cli_opts_free(cli_opts *o);
+/* For commands that only read a scene: EXIT_BADINPUT (after a message) if a solve-only
+ * option was given, else 0. */
+int cli_only_scene_options(const char *cmd, const cli_opts *o);
 
 /* cli_continue.c: `solve --continue name=from:to` (see there). */
 int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver **svp,

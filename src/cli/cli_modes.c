@@ -125,11 +125,9 @@ int cli_modes(int argc, char **argv)
     cli_opts_free(&o);
     return rc;
   }
-  if (o.csv || o.plot || o.adapt > 0 || o.cont || o.elements || o.degree || o.method >= 0 ||
-      o.tolerance > 0 || o.max_iterations) {
-    fprintf(stderr, "calcvar modes: only --set, --json and --quiet apply to modes\n");
+  if ((rc = cli_only_scene_options("modes", &o)) != 0) {
     cli_opts_free(&o);
-    return EXIT_BADINPUT;
+    return rc;
   }
   scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
   sc_modes md;

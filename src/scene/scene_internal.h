@@ -114,4 +114,8 @@ int sc_first_slot(const scene *s, ex_id e, int from, int to);
 int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const double *x,
                   const double *y, const double *dy, double *out);
 
+/* Every key of a fixed-key section must be one of `keys` (NULL-terminated); `list` names
+ * them for the message. Returns 0, or -1 with FILE:LINE in L->err. */
+int sc_check_keys(sc_loader *L, int sec, const char *const *keys, const char *list);
+
 #endif /* CV_SCENE_INTERNAL_H */

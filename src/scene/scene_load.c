@@ -56,7 +56,7 @@ static const sc_entry *find_entry(const sc_loader *L, int sec, const char *key)
 }
 
 /* Keys of a fixed-key section must come from `keys` (NULL-terminated). */
-static int check_keys(sc_loader *L, int sec, const char *const *keys, const char *list)
+int sc_check_keys(sc_loader *L, int sec, const char *const *keys, const char *list)
 {
   for (int i = 0; i < L->raw.ne[sec]; i++) {
     const sc_entry *e = &L->raw.e[sec][i];
@@ -121,7 +121,7 @@ static int load_scene_section(sc_loader *L)
     sc_err(L->err, L->errlen, L->file, 1, "the section [scene] is missing");
     return -1;
   }
-  if (check_keys(L, SEC_SCENE, keys, "title, variable, interval, unknowns, integrand") < 0)
+  if (sc_check_keys(L, SEC_SCENE, keys, "title, variable, interval, unknowns, integrand") < 0)
     return -1;
   const sc_entry *e = find_entry(L, SEC_SCENE, "title");
   s->title = sc_strdup(e ? e->value : L->file);

@@ -50,22 +50,6 @@ static int parse_count(sc_loader *L, const sc_entry *e, long lo, long hi, int *o
   return 0;
 }
 
-static int check_keys(sc_loader *L, int sec, const char *const *keys, const char *list)
-{
-  for (int i = 0; i < L->raw.ne[sec]; i++) {
-    const sc_entry *e = &L->raw.e[sec][i];
-    int ok = 0;
-    for (int k = 0; keys[k]; k++)
-      ok |= strcmp(e->key, keys[k]) == 0;
-    if (!ok) {
-      sc_err(L->err, L->errlen, L->file, e->line, "unknown key '%s' in [%s] (known: %s)",
-             e->key, sc_section_name(sec), list);
-      return -1;
-    }
-  }
-  return 0;
-}
-
 static int cmp_double(const void *a, const void *b)
 {
   double x = *(const double *)a, y = *(const double *)b;
@@ -115,7 +99,7 @@ int sc_load_mesh(sc_loader *L)
   s->elements = 100;
   s->degree = 1;
   s->graded_end = CVAR_GRADE_A;
-  if (check_keys(L, SEC_MESH, keys,
+  if (sc_check_keys(L, SEC_MESH, keys,
                  "elements, degree, breakpoints, adapt, grading, grading_at") < 0)
     return -1;
   for (int i = 0; i < L->raw.ne[SEC_MESH]; i++) {
@@ -173,7 +157,7 @@ int sc_load_solver(sc_loader *L)
   s->method = SC_NEWTON;
   s->tolerance = 1e-10;
   s->max_iterations = 50;
-  if (check_keys(L, SEC_SOLVER, keys, "method, tolerance, max_iterations") < 0)
+  if (sc_check_keys(L, SEC_SOLVER, keys, "method, tolerance, max_iterations") < 0)
     return -1;
   for (int i = 0; i < L->raw.ne[SEC_SOLVER]; i++) {
     const sc_entry *e = &L->raw.e[SEC_SOLVER][i];
