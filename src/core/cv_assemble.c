@@ -99,7 +99,9 @@ static cv_status call_integrand(cv_assembler *as, cv_integrand_fn Fn, void *user
  * Same sums as the general loops in cv_assemble, (A-1)-(A-3). */
 static inline __attribute__((always_inline)) double
 element_scalar(const int P1, const cv_rule *r, int q, int idx0, double J, double rh,
-               const cv_partials *o, double *gl, double *K) {
+               const cv_partials *o, const int *fl, double *g, const long *colptr,
+               double *Ax, double hscale) {
+  double *gl = g, *K = Ax;
   double S = 0.0, gacc[CV_MAX_DEGREE + 1] = {0}, Kacc[(CV_MAX_DEGREE + 1) * (CV_MAX_DEGREE + 1)];
   if (K)
     for (int a = 0; a < P1 * P1; a++) Kacc[a] = 0.0;
@@ -120,18 +122,29 @@ element_scalar(const int P1, const cv_rule *r, int q, int idx0, double J, double
       }
     }
   }
-  if (gl)
-    for (int l = 0; l < P1; l++) gl[l] = gacc[l];
-  if (K)
+  /* scatter (E-2): gradient rows, and the upper triangle column by column */
+  if (g)
     for (int l = 0; l < P1; l++)
-      for (int rr = l; rr < P1; rr++) K[l * P1 + rr] = Kacc[l * P1 + rr];
+      if (fl[l] >= 0) g[fl[l]] += gacc[l];
+  if (Ax)
+    for (int bcol = 0; bcol < P1; bcol++) {
+      int fb = fl[bcol];
+      if (fb < 0) continue;
+      long c0 = colptr[fb], rs = fb + 1 - (colptr[fb + 1] - c0);
+      for (int arow = 0; arow <= bcol; arow++)
+        if (fl[arow] >= 0) Ax[c0 + fl[arow] - rs] += hscale * Kacc[arow * P1 + bcol];
+    }
   return S;
 }
 
-static double element_scalar_dispatch(int P1, const cv_rule *r, int q, int idx0, double J,
-                                      double rh, const cv_partials *o, double *gl, double *K) {
+static inline __attribute__((always_inline)) double
+element_scalar_dispatch(int P1, const cv_rule *r, int q, int idx0, double J, double rh,
+                        const cv_partials *o, const int *fl, double *g, const long *colptr,
+                        double *Ax, double hscale) {
   switch (P1) {
-#define CASE(c) case c: return element_scalar(c, r, q, idx0, J, rh, o, gl, K);
+#define CASE(c)                                                                            \
+  case c:                                                                                  \
+    return element_scalar(c, r, q, idx0, J, rh, o, fl, g, colptr, Ax, hscale);
     CASE(2) CASE(3) CASE(4) CASE(5) CASE(6) CASE(7) CASE(8) CASE(9)
 #undef CASE
   }
@@ -179,8 +192,9 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
       if (n == 1) {
         cv_partials o = {F, (double *)Fy, (double *)Fp, (double *)Fyy, (double *)Fyp,
                          (double *)Fpp};
-        Ssum += element_scalar_dispatch(P1, r, q, el * q, J, rh, &o, g ? gl : NULL,
-                                        Ax ? K : NULL);
+        Ssum += element_scalar_dispatch(P1, r, q, el * q, J, rh, &o, flp, g, colptr, Ax,
+                                        hscale);
+        continue; /* scattered by the kernel */
       } else {
       if (Ax) memset(K, 0, (size_t)nl * nl * sizeof *K);
       if (g) memset(gl, 0, (size_t)nl * sizeof *gl);

@@ -11,6 +11,7 @@ void cv_disc_free(cv_disc *d) {
   cv_free(d->fix0);
   cv_free(d->fix1);
   cv_free(d->mass);
+  cv_free(d->imass);
   cv_free(d->srule);
   memset(d, 0, sizeof *d);
 }
@@ -101,6 +102,12 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
     }
   }
   for (int r = 0; r < d->ni; r++) d->mass[d->nu0 + r] = d->b - d->a;
+  d->imass = cv_malloc((size_t)(f ? f : 1) * sizeof *d->imass);
+  if (!d->imass) {
+    cv_disc_free(d);
+    return CVAR_ENOMEM;
+  }
+  for (int k = 0; k < f; k++) d->imass[k] = 1.0 / d->mass[k];
   return CVAR_OK;
 }
 
@@ -158,8 +165,9 @@ cv_status cv_disc_build_singular_rules(cv_disc *d) {
 void cv_disc_pattern(const cv_disc *d, long *colptr, int *gof) {
   int n = d->n, p = d->p, nc = d->nc;
   colptr[0] = 0;
+  long since = 0; /* nodes since the last element boundary, without % */
   for (long J = 0, e = 0; J < d->nodes; J++) {
-    if (J > 1 && (J - 1) % p == 0) e++; /* e = first element containing node J */
+    if (J > 1 && ++since == p) e++, since = 0; /* e = first element containing node J */
     long r0 = cv_disc_elem_first(d, e);
     /* the node's unknowns in increasing order: y components, then multipliers */
     for (int t = 0; t < n + nc; t++) {

@@ -99,6 +99,7 @@ typedef struct {
   int *fix0, *fix1;    /* index of each y component at node 0 / last, or -1 */
   int lam0, lamL, nu0; /* first multiplier at node 0 / last node (-1: none), integrals */
   double *mass;        /* lumped nodal weight of each unknown (theory N-3) */
+  double *imass;       /* 1 / mass */
   int sing_a, sing_b;  /* integrand singular at that end: rules Q-2 on every element */
   double *srule;       /* per-element rules (tau, omega, B, D) when singular, else NULL */
 } cv_disc;
@@ -108,7 +109,7 @@ cv_status cv_disc_build_singular_rules(cv_disc *d);
 
 /* index of y dof g = node*n + i, or -1 when fixed */
 static inline int cv_disc_fidx(const cv_disc *d, long g) {
-  long node = g / d->n;
+  long node = d->n == 1 ? g : g / d->n; /* integer division is slow; n = 1 is common */
   int i = (int)(g - node * d->n);
   if (node == 0) return d->fix0[i];
   if (node == d->nodes - 1) return d->fix1[i];

@@ -58,22 +58,18 @@ static cv_status ws_init(newton_ws *w, const cv_disc *d, size_t nmult) {
   return w->L ? CVAR_OK : CVAR_ENOMEM;
 }
 
-/* Mesh-independent residual: max |g_f| / m_f with lumped nodal weights m_f (N-3). */
-static double residual_norm(const cv_disc *d, const double *g) {
-  double r = 0.0;
+/* The scaled residual r_f = g_f / m_f with lumped nodal weights m_f (N-3): returns the
+ * merit phi = |r|^2 / 2 of the line search (N-2) and sets *norm = max |r_f|, the
+ * mesh-independent residual that is reported. One pass, multiplications only. */
+static double residual(const cv_disc *d, const double *g, double *norm) {
+  double s = 0.0, r = 0.0;
   for (int f = 0; f < d->nfree; f++) {
-    double v = fabs(g[f]) / d->mass[f];
+    double v = g[f] * d->imass[f];
+    s += v * v;
+    v = fabs(v);
     if (!(v <= r)) r = v;
   }
-  return r;
-}
-
-static double residual_merit(const cv_disc *d, const double *g) {
-  double s = 0.0;
-  for (int f = 0; f < d->nfree; f++) {
-    double v = g[f] / d->mass[f];
-    s += v * v;
-  }
+  *norm = r;
   return 0.5 * s;
 }
 
@@ -120,15 +116,13 @@ static cv_status solve_refined(newton_ws *w, int nf, int regularised) {
   return st;
 }
 
-static void apply_step(newton_ws *w, const double *Y, const double *M, size_t nmult,
-                       double alpha) {
+/* Yt = Y + alpha delta on the free unknowns; the fixed values of Yt were set once. */
+static void apply_step(newton_ws *w, const double *Y, const double *M, double alpha) {
   const cv_disc *d = w->d;
-  memcpy(w->Yt, Y, (size_t)d->ndof * sizeof *Y);
-  if (nmult) memcpy(w->Mt, M, nmult * sizeof *M);
   for (int f = 0; f < d->nfree; f++) {
     int gi = w->gof[f];
-    if (gi >= 0) w->Yt[gi] += alpha * w->delta[f];
-    else w->Mt[-1 - gi] += alpha * w->delta[f];
+    if (gi >= 0) w->Yt[gi] = Y[gi] + alpha * w->delta[f];
+    else w->Mt[-1 - gi] = M[-1 - gi] + alpha * w->delta[f];
   }
 }
 
@@ -140,6 +134,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   int nf = d->nfree, ncon = 0;
   size_t nmult = (size_t)d->nodes * d->nc + d->ni;
   double S = 0.0, scale = 0.0;
+  double *Yc = Y, *Mc = M; /* the current iterate (see the swap below) */
   char detail[200] = "";
 
   s->iterations = 0;
@@ -156,6 +151,9 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   }
   for (int f = 0; f < nf; f++) ncon += w.gof[f] < 0;
   int constrained = ncon > 0;
+  /* Two buffers swap roles as iterate and trial; the trial's fixed values are set once. */
+  memcpy(w.Yt, Y, (size_t)d->ndof * sizeof *Y);
+  if (nmult) memcpy(w.Mt, M, nmult * sizeof *M);
   if (d->nc > 0) {
     st = cv_kkt_check_ends(&kkt, Y, s->msg, sizeof s->msg);
     if (st) goto cleanup;
@@ -183,7 +181,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     goto cleanup;
   }
   s->action = S;
-  s->gnorm = residual_norm(d, w.g);
+  double phi = residual(d, w.g, &s->gnorm);
   if (nf == 0) {
     s->morse = 0;
     cv_set_msg(s->msg, sizeof s->msg, "no free unknowns: the path is fixed by its end values");
@@ -225,14 +223,23 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     }
     s->iterations++;
     /* Weighted RMS norm of the step in y, weights 1/(rtol |y| + atol) (N-4). */
-    double wn = 0.0, slope = 0.0;
+    double wn = 0.0, slope = 0.0, ymax = 0.0;
     int ny = 0;
     for (int f = 0; f < nf; f++) {
       slope += w.g[f] * w.delta[f];
       if (w.gof[f] < 0) continue;
-      double v = w.delta[f] / (s->rtol * fabs(Y[w.gof[f]]) + atol);
+      double ay = fabs(Yc[w.gof[f]]), v = w.delta[f] / (s->rtol * ay + atol);
       wn += v * v;
       ny++;
+      if (!(ay <= ymax)) ymax = ay;
+    }
+    if (!(ymax <= 1e12 * scale)) {
+      st = CVAR_EDIVERGED;
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "the iterates diverged (|y| above 1e12 times its initial size at iteration "
+                 "%d); there may be no stationary path, or the guess is too far from it",
+                 s->iterations);
+      goto cleanup;
     }
     wn = sqrt(wn / (ny ? ny : 1));
     if (!isfinite(wn)) {
@@ -243,10 +250,10 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     /* Line search: on S where the Hessian is positive definite and nothing is constrained
      * (the step descends S), else on the scaled residual merit phi = |g/m|^2 / 2, for
      * which the Newton step is always a descent direction (N-2). */
-    double phi = residual_merit(d, w.g), alpha = 1.0, St = 0.0;
+    double alpha = 1.0, St = 0.0, phit = 0.0, rnt = 0.0;
     int accepted = 0, use_S = neg == 0 && !constrained && slope < 0;
     for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
-      apply_step(&w, Y, M, nmult, alpha);
+      apply_step(&w, Yc, Mc, alpha);
       ta = cv_now();
       cv_status ast = eval_system(&kkt, h, &w, w.Yt, w.Mt, &St, w.gt, Ax, w.dreg);
       s->t_assemble += cv_now() - ta;
@@ -257,7 +264,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
         goto cleanup;
       }
       if (ast == CVAR_OK) {
-        double phit = residual_merit(d, w.gt);
+        phit = residual(d, w.gt, &rnt);
         int ok_res = phit <= (1.0 - 2.0 * ARMIJO * alpha) * phi;
         int ok_S = use_S && St <= S + ARMIJO * alpha * slope;
         /* Near the solution S changes by less than its round-off; a step within the
@@ -271,7 +278,6 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     }
     if (!accepted) {
       st = CVAR_ESTALL;
-      s->gnorm = residual_norm(d, w.g);
       cv_set_msg(s->msg, sizeof s->msg,
                  "no progress: the line search found no decrease along the Newton step at "
                  "iteration %d (scaled residual %.3g); try a better [guess], more elements, or "
@@ -282,25 +288,16 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     double *tmp = w.g;
     w.g = w.gt;
     w.gt = tmp;
-    memcpy(Y, w.Yt, (size_t)d->ndof * sizeof *Y);
-    if (nmult) memcpy(M, w.Mt, nmult * sizeof *M);
+    tmp = Yc, Yc = w.Yt, w.Yt = tmp;
+    tmp = Mc, Mc = w.Mt, w.Mt = tmp;
     S = St;
+    phi = phit;
     s->action = S;
-    s->gnorm = residual_norm(d, w.g);
+    s->gnorm = rnt;
     if (wn <= 1.0 && alpha == 1.0) {
       st = CVAR_OK;
       cv_set_msg(s->msg, sizeof s->msg, "converged in %d iterations", s->iterations);
       goto cleanup;
-    }
-    for (long i = 0; i < d->ndof; i++) {
-      if (!(fabs(Y[i]) <= 1e12 * scale)) {
-        st = CVAR_EDIVERGED;
-        cv_set_msg(s->msg, sizeof s->msg,
-                   "the iterates diverged (|y| above 1e12 times its initial size at iteration "
-                   "%d); there may be no stationary path, or the guess is too far from it",
-                   s->iterations);
-        goto cleanup;
-      }
     }
     if (s->iterations >= s->maxit) {
       st = CVAR_EMAXITER;
@@ -312,6 +309,14 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     }
   }
 cleanup:
+  if (w.Yt && Yc != Y) { /* the latest iterate lives in our buffer: hand it back */
+    memcpy(Y, Yc, (size_t)d->ndof * sizeof *Y);
+    w.Yt = Yc;
+  }
+  if (w.Mt && Mc != M) {
+    if (nmult) memcpy(M, Mc, nmult * sizeof *M);
+    w.Mt = Mc;
+  }
   cv_kkt_free(&kkt);
   ws_free(&w);
   return st;
