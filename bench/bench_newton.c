@@ -23,17 +23,20 @@ static double floor_ns(long E) {
   int it;
   for (it = 1; it <= 50; it++) {
     for (long j = 0; j < N; j++) g[j] = dg[j] = od[j] = 0;
+    const double ih = 1.0 / h, w = 0.5 * h;
     for (long k = 0; k < E; k++) { /* element k: nodes k, k+1 */
-      double p = (y[k + 1] - y[k]) / h;
+      double p = (y[k + 1] - y[k]) * ih, s = sqrt(1 + p * p), is = 1.0 / s;
+      double Fy = s, Fyp = p * is, Fppy = is * is * is, ga = 0, gb = 0, da = 0, db = 0, o = 0;
       for (int q = 0; q < 2; q++) {
-        double t = q ? g2 : g1, yq = y[k] * (1 - t) + y[k + 1] * t, s = sqrt(1 + p * p);
-        double w = 0.5 * h, Fy = s, Fp = yq * p / s, Fyp = p / s, Fpp = yq / (s * s * s);
-        g[k] += w * (Fy * (1 - t) - Fp / h);
-        g[k + 1] += w * (Fy * t + Fp / h);
-        dg[k] += w * (-2 * Fyp * (1 - t) / h + Fpp / (h * h));
-        dg[k + 1] += w * (2 * Fyp * t / h + Fpp / (h * h));
-        od[k] += w * (Fyp * (1 - t) / h - Fyp * t / h - Fpp / (h * h));
+        double t = q ? g2 : g1, yq = y[k] * (1 - t) + y[k + 1] * t;
+        double Fp = yq * Fyp, Fpp = yq * Fppy;
+        ga += w * (Fy * (1 - t) - Fp * ih);
+        gb += w * (Fy * t + Fp * ih);
+        da += w * (-2 * Fyp * (1 - t) * ih + Fpp * ih * ih);
+        db += w * (2 * Fyp * t * ih + Fpp * ih * ih);
+        o += w * (Fyp * (1 - 2 * t) * ih - Fpp * ih * ih);
       }
+      g[k] += ga, g[k + 1] += gb, dg[k] += da, dg[k + 1] += db, od[k] += o;
     }
     double step = 0; /* Thomas on the interior nodes 1..N-2: H d = -g */
     for (long j = 2; j < N - 1; j++) {
