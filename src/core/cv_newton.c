@@ -255,7 +255,10 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
       apply_step(&w, Yc, Mc, alpha);
       ta = cv_now();
-      cv_status ast = eval_system(&kkt, h, &w, w.Yt, w.Mt, &St, w.gt, Ax, w.dreg);
+      /* A step within the tolerance is the last one (taken in full below): the Hessian
+       * there would not be used, so only F and the gradient are evaluated. */
+      double *Axt = wn <= 1.0 ? NULL : Ax;
+      cv_status ast = eval_system(&kkt, h, &w, w.Yt, w.Mt, &St, w.gt, Axt, w.dreg);
       s->t_assemble += cv_now() - ta;
       if (ast == CVAR_ECALLBACK || ast == CVAR_ENOMEM) {
         st = ast;
