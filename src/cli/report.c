@@ -246,7 +246,9 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
                  cv_solver_get_values(sv, r->y) != CVAR_OK))
     r->nodes = nn = 0;
 
-  if (m == SC_NEWTON) {
+  /* The Morse index describes a stationary point: reported only when Newton converged to
+   * one (an unconverged iterate's inertia says nothing about the answer). */
+  if (m == SC_NEWTON && st == CVAR_OK) {
     int morse = cv_solver_get_morse_index(sv), nfree = cv_solver_get_num_free(sv);
     if (morse >= 0) {
       r->has_morse = 1;
