@@ -47,22 +47,26 @@ static int all_finite(const double *v, size_t len) {
 }
 
 /* Fill the batch of quadrature points of elements e0 .. e0+ne-1: x, and y, y' from the
- * nodal values through the basis tables, theory (E-3). */
-static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int e0, int ne) {
+ * nodal values through the basis tables, theory (E-3). Inlined with constant P1 and N
+ * where they are small (the common scalar case), so the basis loops unroll. */
+static inline __attribute__((always_inline)) void
+fill_batch(const int N, const int P1, cv_assembler *as, const double *Y, const cv_rule *r,
+           int e0, int ne) {
   const cv_disc *d = as->disc;
-  int n = d->n, p = d->p, q = r->q, P1 = p + 1, m = ne * q;
+  int p = P1 - 1, q = r->q, m = ne * q;
   for (int el = 0; el < ne; el++) {
     int e = e0 + el;
     double x0 = d->xe[e], h = d->xe[e + 1] - x0, rh = 2.0 / h;
-    const double *Ye = Y + (size_t)e * p * n;
+    const double *Ye = Y + (size_t)e * p * N;
     for (int k = 0; k < q; k++) {
       int idx = el * q + k;
       const double *Bk = r->B + k * P1, *Dk = r->D + k * P1;
       as->x[idx] = x0 + 0.5 * (r->tau[k] + 1.0) * h;
-      for (int i = 0; i < n; i++) {
+      for (int i = 0; i < N; i++) {
         double yv = 0.0, dv = 0.0;
+#pragma GCC unroll 9
         for (int l = 0; l < P1; l++) {
-          double c = Ye[l * n + i];
+          double c = Ye[l * N + i];
           yv += c * Bk[l];
           dv += c * Dk[l];
         }
@@ -71,6 +75,20 @@ static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int
       }
     }
   }
+}
+
+static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int e0, int ne) {
+  const cv_disc *d = as->disc;
+  if (d->n == 1) {
+    switch (d->p) {
+    case 1: fill_batch(1, 2, as, Y, r, e0, ne); return;
+    case 2: fill_batch(1, 3, as, Y, r, e0, ne); return;
+    case 3: fill_batch(1, 4, as, Y, r, e0, ne); return;
+    case 4: fill_batch(1, 5, as, Y, r, e0, ne); return;
+    default: break;
+    }
+  }
+  fill_batch(d->n, d->p + 1, as, Y, r, e0, ne);
 }
 
 /* Call the integrand for m points; NaN-fill first so forgotten outputs are caught. */
@@ -102,8 +120,11 @@ element_scalar(const int P1, const cv_rule *r, int q, int idx0, double J, double
                const cv_partials *o, const int *fl, double *g, const long *colptr,
                double *Ax, double hscale) {
   double *gl = g, *K = Ax;
-  double S = 0.0, gacc[CV_MAX_DEGREE + 1] = {0}, Kacc[(CV_MAX_DEGREE + 1) * (CV_MAX_DEGREE + 1)];
+  double S = 0.0, gacc[CV_MAX_DEGREE + 1], Kacc[(CV_MAX_DEGREE + 1) * (CV_MAX_DEGREE + 1)];
+#pragma GCC unroll 9
+  for (int a = 0; a < P1; a++) gacc[a] = 0.0;
   if (K)
+#pragma GCC unroll 81
     for (int a = 0; a < P1 * P1; a++) Kacc[a] = 0.0;
   for (int k = 0; k < q; k++) {
     int idx = idx0 + k;
@@ -112,12 +133,15 @@ element_scalar(const int P1, const cv_rule *r, int q, int idx0, double J, double
     S += wk * o->F[idx];
     if (gl) {
       double fy = wk * o->Fy[idx], fp = wk * rh * o->Fp[idx];
+#pragma GCC unroll 9
       for (int l = 0; l < P1; l++) gacc[l] += fy * Bk[l] + fp * Dk[l];
     }
     if (K) {
       double yy = wk * o->Fyy[idx], yp = wk * rh * o->Fyp[idx], pp = wk * rh * rh * o->Fpp[idx];
+#pragma GCC unroll 9
       for (int l = 0; l < P1; l++) {
         double cy = yy * Bk[l] + yp * Dk[l], cp = yp * Bk[l] + pp * Dk[l];
+#pragma GCC unroll 9
         for (int rr = l; rr < P1; rr++) Kacc[l * P1 + rr] += cy * Bk[rr] + cp * Dk[rr];
       }
     }
