@@ -29,6 +29,14 @@ static int run_one(const cli_gallery_scene *g)
     cli_report_free(&r);
     goto done;
   }
+  int any_exact = 0;
+  for (int i = 0; i < s->n; i++)
+    any_exact |= s->exact[i] >= 0;
+  if (!any_exact && !r.has_err_action && cli_report_estimate(&r, s, p) < 0) {
+    printf("%-40s  out of memory\n", s->title);
+    cli_report_free(&r);
+    goto done;
+  }
   char act[32] = "-", errs[32] = "-", morse[8] = "-", tm[16] = "-";
   if (r.has_action)
     snprintf(act, sizeof act, "%.12f", r.action);
@@ -36,6 +44,8 @@ static int run_one(const cli_gallery_scene *g)
     snprintf(errs, sizeof errs, "%.1e nodal", r.err_nodal);
   else if (r.has_err_action)
     snprintf(errs, sizeof errs, "%.1e action", r.err_action);
+  else if (r.has_err_est)
+    snprintf(errs, sizeof errs, "~%.1e est.", r.err_est); /* an estimate, marked as such */
   if (r.has_morse)
     snprintf(morse, sizeof morse, "%d", r.morse);
   if (r.has_time)

@@ -28,7 +28,7 @@ void cli_report_text(FILE *f, const cli_report *r)
     fprintf(f, "  error       %.3g in the action (against [exact] action = %.17g)\n",
             r->err_action, s->exact_action);
   if (r->has_err_est)
-    fprintf(f, "  estimate    %.3g max nodal error (from a mesh twice as fine)\n", r->err_est);
+    fprintf(f, "  estimate    %.3g max nodal error (reference solve on a finer mesh)\n", r->err_est);
   if (r->has_energy)
     fprintf(f, "  energy      H from %.15g to %.15g (drift %.3g)\n", r->emin, r->emax,
             r->emax - r->emin);

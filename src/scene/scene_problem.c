@@ -114,6 +114,10 @@ cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_
     what = "max_iterations";
     st = cv_solver_set_max_iterations(sv, s->max_iterations);
   }
+  if (st == CVAR_OK && s->adapt > 0) {
+    what = "adapt"; /* [mesh] adapt; the command caps the mesh at 2e6 elements */
+    st = cv_solver_set_adapt(sv, s->adapt, 2000000);
+  }
   if (st == CVAR_OK) {
     what = "method";
     st = cv_solver_set_method(sv, (cv_method)s->method); /* same order as cv_method */
