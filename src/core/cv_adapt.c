@@ -43,10 +43,11 @@ static cv_status warm_start(cv_solver *s, const cv_problem *p, const cv_solver *
   return st;
 }
 
-/* (AD-1) Solve on the current mesh and on the mesh with every element halved; the error of
- * element e is estimated as max over its nodes of |y_h - y_{h/2}| / (1 - 2^-(p+1)), the
- * Richardson factor of the interior nodes' order p+1 (the element ends converge faster,
- * O(h^2p), so this errs on the safe side). Elements above tol/4 are bisected. */
+/* (AD-1) Solve on the current mesh and on a reference mesh whose element boundaries are
+ * all its nodes (degree 1: every element halved). Element boundaries converge as O(h^2p),
+ * so at the nodes the reference is far more accurate than the solution judged, and the
+ * error of element e is estimated as max over its nodes of |y_h - y_ref| (degree 1: times
+ * 4/3, Richardson for order 2). Elements above tol/4 are bisected. */
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   cv_status st;
   cv_solver *f = cv_solver_new(&st);
@@ -86,27 +87,33 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
                  s->rounds, E, why);
       goto cleanup;
     }
-    /* the halved mesh */
-    double *xf = cv_malloc((size_t)(2 * E + 1) * sizeof *xf);
-    if (!xf) {
+    /* the reference mesh: every node an element boundary (degree 1: halved) */
+    int pd = s->disc.p, Nc = s->disc.nodes, Ef = pd == 1 ? 2 * E : Nc - 1;
+    double *xf = cv_malloc((size_t)(Ef + 1) * sizeof *xf), *xc = cv_malloc((size_t)Nc * sizeof *xc);
+    cv_free(t);
+    t = cv_malloc((size_t)(Ef + 1) * sizeof *t);
+    if (!xf || !xc || !t) {
+      cv_free(xf);
+      cv_free(xc);
       st = CVAR_ENOMEM;
       goto cleanup;
     }
-    for (int e = 0; e < E; e++) {
-      xf[2 * e] = xe[e];
-      xf[2 * e + 1] = 0.5 * (xe[e] + xe[e + 1]);
+    cv_disc_fill_nodes(&s->disc, xc);
+    for (int j = 0, k = 0; j < Nc; j++) {
+      xf[k++] = xc[j];
+      if (pd == 1 && j + 1 < Nc) xf[k++] = 0.5 * (xc[j] + xc[j + 1]);
     }
-    xf[2 * E] = xe[E];
-    st = use_mesh(f, xf, 2 * E, t);
+    cv_free(xc);
+    st = use_mesh(f, xf, Ef, t);
     cv_free(xf);
     if (!st) st = warm_start(f, p, s);
     if (!st) st = cv_solve_mesh(f, p);
     cv_solver_set_start(f, 0, NULL);
     if (st) {
       cv_set_msg(s->msg, sizeof s->msg,
-                 "adaptive refinement, round %d: the solve on the halved mesh (%d elements) "
-                 "failed: %s",
-                 s->rounds, 2 * E, f->msg);
+                 "adaptive refinement, round %d: the solve on the reference mesh (%d "
+                 "elements) failed: %s",
+                 s->rounds, Ef, f->msg);
       s->status = st;
       goto cleanup;
     }
@@ -125,7 +132,9 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     cv_disc_fill_nodes(&s->disc, xn);
     st = cv_solver_eval(f, N, xn, yf, NULL);
     if (st) goto cleanup;
-    double factor = 1.0 / (1.0 - pow(2.0, -(pdeg + 1))), est = 0.0;
+    /* degree >= 2: the reference's error at these points is O((h/p)^2p), negligible;
+     * degree 1: Richardson for order 2 against the halved mesh */
+    double factor = pdeg == 1 ? 4.0 / 3.0 : 1.0, est = 0.0;
     for (int e = 0; e < E; e++)
       for (int l = 0; l <= pdeg; l++) {
         long j = (long)e * pdeg + l;
