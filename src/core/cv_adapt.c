@@ -69,7 +69,8 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   s->mesh.nbreak = 0; /* breakpoints are already boundaries of xe, and stay so */
   for (s->rounds = 1; s->rounds <= MAX_ROUNDS; s->rounds++) {
     cv_free(t);
-    t = cv_malloc((size_t)(2 * E + 1) * sizeof *t);
+    /* room for the reference mesh too: E p elements (degree 1: 2E) >= E */
+    t = cv_malloc((size_t)((s->degree == 1 ? 2 : s->degree) * E + 1) * sizeof *t);
     if (!t) {
       st = CVAR_ENOMEM;
       goto cleanup;
@@ -90,9 +91,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     /* the reference mesh: every node an element boundary (degree 1: halved) */
     int pd = s->disc.p, Nc = s->disc.nodes, Ef = pd == 1 ? 2 * E : Nc - 1;
     double *xf = cv_malloc((size_t)(Ef + 1) * sizeof *xf), *xc = cv_malloc((size_t)Nc * sizeof *xc);
-    cv_free(t);
-    t = cv_malloc((size_t)(Ef + 1) * sizeof *t);
-    if (!xf || !xc || !t) {
+    if (!xf || !xc) {
       cv_free(xf);
       cv_free(xc);
       st = CVAR_ENOMEM;
