@@ -117,7 +117,7 @@ static cv_status call_integrand(cv_assembler *as, cv_integrand_fn Fn, void *user
  * Same sums as the general loops in cv_assemble, (A-1)-(A-3). */
 static inline __attribute__((always_inline)) double
 element_scalar(const int P1, const cv_rule *r, int q, int idx0, double J, double rh,
-               const cv_partials *o, const int *fl, double *g, const long *colptr,
+               const cv_partials *o, const int *fl, double *g, const int *colptr,
                double *Ax, double hscale) {
   double *gl = g, *K = Ax;
   double S = 0.0, gacc[CV_MAX_DEGREE + 1], Kacc[(CV_MAX_DEGREE + 1) * (CV_MAX_DEGREE + 1)];
@@ -163,7 +163,7 @@ element_scalar(const int P1, const cv_rule *r, int q, int idx0, double J, double
 
 static inline __attribute__((always_inline)) double
 element_scalar_dispatch(int P1, const cv_rule *r, int q, int idx0, double J, double rh,
-                        const cv_partials *o, const int *fl, double *g, const long *colptr,
+                        const cv_partials *o, const int *fl, double *g, const int *colptr,
                         double *Ax, double hscale) {
   switch (P1) {
 #define CASE(c)                                                                            \
@@ -181,7 +181,7 @@ element_scalar_dispatch(int P1, const cv_rule *r, int q, int idx0, double J, dou
  *     + F_yiy'j phi_l phi_r' (2/h) + F_yjy'i phi_l' phi_r (2/h) + F_y'iy'j phi_l' phi_r' (2/h)^2)
  *                                                                              (A-3)  */
 cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y,
-                      double *S, double *g, const long *colptr, double *Ax, double hscale) {
+                      double *S, double *g, const int *colptr, double *Ax, double hscale) {
   const cv_disc *d = as->disc;
   int n = d->n, p = d->p, P1 = p + 1, nl = P1 * n;
   unsigned need = CVAR_NEED_F | (g ? CVAR_NEED_GRAD : 0u) | (Ax ? CVAR_NEED_HESS : 0u);

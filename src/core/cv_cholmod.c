@@ -1,6 +1,7 @@
 /* src/core/cv_cholmod.c — sparse symmetric LDL^T with CHOLMOD: analysis once, numeric
  * refactorisation per Newton step, inertia from the pivots. The only file with cholmod.h.
  * SPDX-License-Identifier: MIT */
+#include <limits.h>
 #include <math.h>
 #include <string.h>
 
@@ -12,14 +13,25 @@ struct cv_ldlt {
   cholmod_common c;
   cholmod_sparse *A;
   cholmod_factor *L;
-  cholmod_dense *X, *Y, *E; /* solve workspace reused across iterations (cholmod_solve2) */
   long n;
 };
 
-cv_ldlt *cv_ldlt_new(int nfree, const long *colptr) {
+/* CHOLMOD's int interface: half the index memory of the long one, and every byte of a
+ * large solve is a fresh page to fault in (docs/performance.md). 2^31 - 1 entries is far
+ * beyond what fits in memory next to them (24 GB of values and indices alone). */
+cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size_t len) {
+  int nfree = d->nfree;
+  long nnz = cv_disc_pattern(d, NULL, NULL);
+  *out = NULL;
+  if (nnz > INT_MAX) {
+    cv_set_msg(msg, len, "the Hessian would have %ld entries, more than the 2^31 - 1 of the "
+               "32-bit sparse matrix calcvar factors; use fewer elements or a lower degree",
+               nnz);
+    return CVAR_EINVAL;
+  }
   cv_ldlt *L = cv_calloc(1, sizeof *L);
-  if (!L) return NULL;
-  cholmod_l_start(&L->c);
+  if (!L) return CVAR_ENOMEM;
+  cholmod_start(&L->c);
   /* The Hessian is block-banded in node-major order, so the natural ordering has no
    * fill beyond the band; AMD would scramble it (DESIGN.md performance model). */
   L->c.nmethods = 1;
@@ -31,46 +43,46 @@ cv_ldlt *cv_ldlt_new(int nfree, const long *colptr) {
   L->c.print = 0;
   L->c.error_handler = NULL;
   L->n = nfree;
-  long nnz = colptr[nfree];
-  L->A = cholmod_l_allocate_sparse((size_t)nfree, (size_t)nfree, (size_t)(nnz ? nnz : 1), 1,
-                                   1, 1, CHOLMOD_REAL, &L->c);
+  size_t nz = (size_t)(nnz ? nnz : 1);
+  L->A = cholmod_allocate_sparse((size_t)nfree, (size_t)nfree, nz, 1, 1, 1, CHOLMOD_REAL,
+                                 &L->c);
   if (!L->A) {
     cv_ldlt_free(L);
-    return NULL;
+    return CVAR_ENOMEM;
   }
-  SuiteSparse_long *Ap = L->A->p, *Ai = L->A->i;
-  for (long c = 0; c <= nfree; c++) Ap[c] = colptr[c];
-  for (long c = 0; c < nfree; c++) {
-    long len = colptr[c + 1] - colptr[c], r0 = c + 1 - len;
-    for (long k = 0; k < len; k++) Ai[colptr[c] + k] = r0 + k;
+  int *Ap = L->A->p, *Ai = L->A->i;
+  cv_disc_pattern(d, Ap, gof);
+  for (int c = 0; c < nfree; c++) {
+    int len = Ap[c + 1] - Ap[c], r0 = c + 1 - len;
+    for (int k = 0; k < len; k++) Ai[Ap[c] + k] = r0 + k;
   }
-  memset(L->A->x, 0, (size_t)(nnz ? nnz : 1) * sizeof(double));
-  return L;
+  memset(L->A->x, 0, nz * sizeof(double));
+  *out = L;
+  return CVAR_OK;
 }
 
 void cv_ldlt_free(cv_ldlt *L) {
   if (!L) return;
-  cholmod_l_free_sparse(&L->A, &L->c);
-  cholmod_l_free_factor(&L->L, &L->c);
-  cholmod_l_free_dense(&L->X, &L->c);
-  cholmod_l_free_dense(&L->Y, &L->c);
-  cholmod_l_free_dense(&L->E, &L->c);
-  cholmod_l_finish(&L->c);
+  cholmod_free_sparse(&L->A, &L->c);
+  cholmod_free_factor(&L->L, &L->c);
+  cholmod_finish(&L->c);
   cv_free(L);
 }
+
+const int *cv_ldlt_colptr(const cv_ldlt *L) { return L->A->p; }
 
 double *cv_ldlt_values(cv_ldlt *L) { return L->A->x; }
 
 cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg,
                          size_t len) {
   if (!L->L) {
-    L->L = cholmod_l_analyze(L->A, &L->c);
+    L->L = cholmod_analyze(L->A, &L->c);
     if (!L->L) {
       cv_set_msg(msg, len, "CHOLMOD analysis failed (status %d)", L->c.status);
       return L->c.status == CHOLMOD_OUT_OF_MEMORY ? CVAR_ENOMEM : CVAR_EDEPENDENCY;
     }
   }
-  int ok = cholmod_l_factorize(L->A, L->L, &L->c);
+  int ok = cholmod_factorize(L->A, L->L, &L->c);
   if (!ok || L->c.status < CHOLMOD_OK) {
     cv_set_msg(msg, len, "CHOLMOD factorisation failed (status %d)", L->c.status);
     return L->c.status == CHOLMOD_OUT_OF_MEMORY ? CVAR_ENOMEM : CVAR_EDEPENDENCY;
@@ -79,7 +91,7 @@ cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char 
    * with the diagonal entry A(j,j) (the last entry of column j of the upper triangle):
    * |D(j)| / |A(j,j)| is dimensionless and independent of the mesh width, so a small value
    * marks a (nearly) degenerate direction, not merely a small element (theory N-5). */
-  const SuiteSparse_long *Lp = L->L->p, *Ap = L->A->p;
+  const int *Lp = L->L->p, *Ap = L->A->p;
   const double *Lx = L->L->x, *Ax = L->A->x;
   int nneg = 0;
   double lo = INFINITY, hi = 0.0;
@@ -103,29 +115,50 @@ cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char 
   return CVAR_OK;
 }
 
-static cv_status solve_sys(cv_ldlt *L, int sys, double *x) {
-  cholmod_dense B;
-  memset(&B, 0, sizeof B);
-  B.nrow = B.d = B.nzmax = (size_t)L->n;
-  B.ncol = 1;
-  B.x = x;
-  B.xtype = CHOLMOD_REAL;
-  B.dtype = CHOLMOD_DOUBLE;
-  if (!cholmod_l_solve2(sys, L->L, &B, NULL, &L->X, NULL, &L->Y, &L->E, &L->c))
-    return L->c.status == CHOLMOD_OUT_OF_MEMORY ? CVAR_ENOMEM : CVAR_EDEPENDENCY;
-  memcpy(x, L->X->x, (size_t)L->n * sizeof *x);
+/* Triangular solves on the simplicial LDL^T factor itself: column j of L holds D(j) first,
+ * then the sub-diagonal entries of the unit lower triangle (CHOLMOD user guide, "simplicial
+ * factor"). The natural ordering leaves no permutation. cholmod_solve2 would do the same
+ * but, for a simplicial factor, reallocates a 4-column workspace on every call (measured:
+ * 32 bytes per unknown per Newton step, each page a fresh fault) and copies x twice;
+ * these loops touch only L and x (docs/performance.md). */
+static void forward_L(const cv_ldlt *L, double *x) { /* x <- L^{-1} x, L unit lower */
+  const int *Lp = L->L->p, *Li = L->L->i, *Lnz = L->L->nz;
+  const double *Lx = L->L->x;
+  for (long j = 0; j < L->n; j++) {
+    double xj = x[j];
+    for (int k = Lp[j] + 1, ke = Lp[j] + Lnz[j]; k < ke; k++)
+      x[Li[k]] -= Lx[k] * xj;
+  }
+}
+
+static void backward_Lt(const cv_ldlt *L, double *x) { /* x <- L^{-T} x */
+  const int *Lp = L->L->p, *Li = L->L->i, *Lnz = L->L->nz;
+  const double *Lx = L->L->x;
+  for (long j = L->n - 1; j >= 0; j--) {
+    double xj = x[j];
+    for (int k = Lp[j] + 1, ke = Lp[j] + Lnz[j]; k < ke; k++)
+      xj -= Lx[k] * x[Li[k]];
+    x[j] = xj;
+  }
+}
+
+cv_status cv_ldlt_solve(cv_ldlt *L, double *x) {
+  const int *Lp = L->L->p;
+  const double *Lx = L->L->x;
+  forward_L(L, x);
+  for (long j = 0; j < L->n; j++) x[j] /= Lx[Lp[j]];
+  backward_Lt(L, x);
   return CVAR_OK;
 }
 
-cv_status cv_ldlt_solve(cv_ldlt *L, double *x) { return solve_sys(L, CHOLMOD_A, x); }
-
-/* The natural ordering leaves no permutation, so L and L^T solves act on x directly. */
 cv_status cv_ldlt_solve_L(cv_ldlt *L, int transpose, double *x) {
-  return solve_sys(L, transpose ? CHOLMOD_Lt : CHOLMOD_L, x);
+  if (transpose) backward_Lt(L, x);
+  else forward_L(L, x);
+  return CVAR_OK;
 }
 
 void cv_ldlt_diag(const cv_ldlt *L, double *D) {
-  const SuiteSparse_long *Lp = L->L->p;
+  const int *Lp = L->L->p;
   const double *Lx = L->L->x;
   for (long j = 0; j < L->n; j++) D[j] = Lx[Lp[j]];
 }

@@ -1,6 +1,7 @@
 /* src/core/cv_continuation.c — continuation from the starting path to the problem when Newton
  * alone fails, theory (HC-1), (HC-2).
  * SPDX-License-Identifier: MIT */
+#include <limits.h>
 #include <math.h>
 #include <string.h>
 
@@ -15,11 +16,14 @@
 static cv_status homotopy_weight(const cv_problem *p, const cv_disc *d, const double *Y0,
                                  double *w) {
   cv_kkt kkt;
-  long *cp = cv_malloc((size_t)(d->nfree + 1) * sizeof *cp);
+  /* unconstrained, so the pattern is the band: far below INT_MAX entries whenever the
+   * Newton solve before this one could be set up */
+  int *cp = cv_malloc((size_t)(d->nfree + 1) * sizeof *cp);
   double *g = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *g), *Ax = NULL, S;
   double M0 = 0.0;
   cv_status st = (cp && g) ? CVAR_OK : CVAR_ENOMEM;
   memset(&kkt, 0, sizeof kkt);
+  if (!st && cv_disc_pattern(d, NULL, NULL) > INT_MAX) st = CVAR_EINVAL;
   if (!st) {
     cv_disc_pattern(d, cp, NULL);
     Ax = cv_malloc((size_t)(cp[d->nfree] ? cp[d->nfree] : 1) * sizeof *Ax);

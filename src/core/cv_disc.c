@@ -162,9 +162,10 @@ cv_status cv_disc_build_singular_rules(cv_disc *d) {
 /* Column c of the upper triangle holds the rows from the first unknown of the first
  * element containing c's node up to c (block-banded pattern, theory E-2); an integral
  * multiplier's column is dense (C-3). */
-void cv_disc_pattern(const cv_disc *d, long *colptr, int *gof) {
+long cv_disc_pattern(const cv_disc *d, int *colptr, int *gof) {
   int n = d->n, p = d->p, nc = d->nc;
-  colptr[0] = 0;
+  long nnz = 0;
+  if (colptr) colptr[0] = 0;
   long since = 0; /* nodes since the last element boundary, without % */
   for (long J = 0, e = 0; J < d->nodes; J++) {
     if (J > 1 && ++since == p) e++, since = 0; /* e = first element containing node J */
@@ -174,12 +175,15 @@ void cv_disc_pattern(const cv_disc *d, long *colptr, int *gof) {
       int c = t < n ? cv_disc_fidx(d, J * n + t) : cv_disc_lidx(d, J, t - n);
       if (c < 0) continue;
       if (gof) gof[c] = t < n ? (int)(J * n + t) : -1 - (int)(J * nc + t - n);
-      colptr[c + 1] = colptr[c] + ((long)c - r0 + 1);
+      nnz += (long)c - r0 + 1;
+      if (colptr) colptr[c + 1] = (int)nnz;
     }
   }
   for (int r = 0; r < d->ni; r++) {
     int c = d->nu0 + r;
     if (gof) gof[c] = -1 - (int)((long)d->nodes * nc + r);
-    colptr[c + 1] = colptr[c] + c + 1;
+    nnz += (long)c + 1;
+    if (colptr) colptr[c + 1] = (int)nnz;
   }
+  return nnz;
 }

@@ -126,9 +126,11 @@ static inline int cv_disc_elem_first(const cv_disc *d, long e) {
   return e == 0 ? 0 : (int)(d->off0 + (e * d->p - 1) * d->stride);
 }
 
-/* Sparsity pattern of the Hessian / KKT matrix (E-2, C-3): colptr (nfree + 1) and, if gof
- * is not NULL, the y dof of each unknown or -1 - (index into the multipliers). */
-void cv_disc_pattern(const cv_disc *d, long *colptr, int *gof);
+/* Sparsity pattern of the Hessian / KKT matrix (E-2, C-3): colptr (nfree + 1; may be NULL
+ * to count only) and, if gof is not NULL, the y dof of each unknown or -1 - (index into
+ * the multipliers). Returns the number of entries of the upper triangle; colptr is filled
+ * only when that fits an int (the caller checks against INT_MAX first). */
+long cv_disc_pattern(const cv_disc *d, int *colptr, int *gof);
 
 /* The rule of element e (Gauss, or the singular-end rule on a flagged end element). */
 cv_rule cv_disc_rule(const cv_disc *d, long e);
@@ -140,10 +142,13 @@ void cv_disc_fill_nodes(const cv_disc *d, double *x);
 
 /* ---- sparse symmetric LDL^T (cv_cholmod.c: the only file that includes CHOLMOD) ---- */
 typedef struct cv_ldlt cv_ldlt;
-/* Upper triangle in compressed columns: column c holds rows rstart(c)..c, contiguous. */
-cv_ldlt *cv_ldlt_new(int nfree, const long *colptr);
+/* The matrix of disc's pattern (cv_disc_pattern; gof filled if not NULL), upper triangle in
+ * compressed columns: column c holds rows rstart(c)..c, contiguous. 32-bit indices:
+ * CVAR_EINVAL with a message beyond 2^31 - 1 entries, CVAR_ENOMEM without one. */
+cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size_t len);
 void cv_ldlt_free(cv_ldlt *L);
-double *cv_ldlt_values(cv_ldlt *L);      /* Ax, length colptr[nfree] */
+const int *cv_ldlt_colptr(const cv_ldlt *L); /* nfree + 1 column pointers */
+double *cv_ldlt_values(cv_ldlt *L);          /* Ax, length colptr[nfree] */
 /* Factor numerically (analysis happens on the first call). Returns CVAR_OK, or
  * CVAR_ESINGULAR with *minor set when a pivot is exactly zero/NaN. *neg = number of
  * negative pivots, *dmin the smallest |D(j)| / |A(j,j)|, *dmax the largest |D(j)|. */
@@ -176,19 +181,19 @@ void cv_assembler_free(cv_assembler *as);
  * layout colptr), at nodal values Y (length nodes*n). Nothing is zeroed here. Returns
  * CVAR_OK, CVAR_ENONFINITE (non-finite output or > 0 from the callback), CVAR_ECALLBACK. */
 cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y,
-                      double *S, double *g, const long *colptr, double *Ax, double hscale);
+                      double *S, double *g, const int *colptr, double *Ax, double hscale);
 
 /* ---- the Lagrangian system with constraints (cv_kkt.c) ---- */
 typedef struct {
   const cv_problem *prob;
   const cv_disc *d;
   cv_assembler as;
-  const long *colptr;
+  const int *colptr;
   double *xn;    /* node abscissae (pointwise constraints) */
   double *cbuf;  /* batch buffers of constraint calls */
   double *gK;    /* gradient of one integral constraint */
 } cv_kkt;
-cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const long *colptr);
+cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const int *colptr);
 void cv_kkt_free(cv_kkt *k);
 /* Reject pointwise constraints that fail at an end whose unknowns are all fixed. */
 cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len);

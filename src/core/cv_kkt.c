@@ -7,7 +7,7 @@
 
 #include "cv_internal.h"
 
-cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const long *colptr) {
+cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const int *colptr) {
   size_t n = (size_t)d->n, B = CV_BATCH;
   memset(k, 0, sizeof *k);
   k->prob = p;
@@ -36,7 +36,7 @@ void cv_kkt_free(cv_kkt *k) {
 }
 
 /* Position of entry (r, c), r <= c, in the upper-triangle column layout (E-2). */
-static inline long pos(const long *colptr, long r, long c) {
+static inline long pos(const int *colptr, long r, long c) {
   return colptr[c] + r - (c + 1 - (colptr[c + 1] - colptr[c]));
 }
 
@@ -96,7 +96,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
                       double *Ax, double *dreg) {
   const cv_disc *d = k->d;
   const cv_problem *p = k->prob;
-  const long *cp = k->colptr;
+  const int *cp = k->colptr;
   int n = d->n, nc = d->nc, nf = d->nfree;
   cv_status st;
   memset(G, 0, (size_t)nf * sizeof *G);
@@ -105,7 +105,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
   st = cv_assemble(&k->as, p->F, p->user, Y, S, G, cp, Ax, 1.0);
   if (st) return st;
   double hmax = 0.0; /* largest diagonal entry of the action's Hessian, for delta */
-  if (Ax)
+  if (Ax && (nc > 0 || d->ni > 0))
     for (int c = 0; c < nf; c++) hmax = fmax(hmax, fabs(Ax[cp[c + 1] - 1]));
   if (!(hmax > 0)) hmax = 1.0;
 

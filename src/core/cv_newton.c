@@ -19,14 +19,13 @@
 typedef struct {
   const cv_disc *d;
   int *gof;      /* y dof of each unknown, or -1 - (index into the multipliers) */
-  long *colptr;
+  const int *colptr; /* the pattern, owned by L */
   cv_ldlt *L;
   double *g, *gt, *delta, *Yt, *Mt, *dreg, *corr;
 } newton_ws;
 
 static void ws_free(newton_ws *w) {
   cv_free(w->gof);
-  cv_free(w->colptr);
   cv_ldlt_free(w->L);
   cv_free(w->g);
   cv_free(w->gt);
@@ -37,25 +36,30 @@ static void ws_free(newton_ws *w) {
   cv_free(w->corr);
 }
 
-static cv_status ws_init(newton_ws *w, const cv_disc *d, size_t nmult) {
+/* Every array here is a fresh page range of a large solve, and faulting it in is a large
+ * part of the run time (docs/performance.md): the refinement arrays exist only with
+ * multipliers. */
+static cv_status ws_init(newton_ws *w, const cv_disc *d, size_t nmult, char *msg, size_t len) {
   size_t nf = (size_t)d->nfree, one = nf ? nf : 1;
   memset(w, 0, sizeof *w);
   w->d = d;
   w->gof = cv_malloc(one * sizeof *w->gof);
-  w->colptr = cv_malloc((nf + 1) * sizeof *w->colptr);
+  if (!w->gof) return CVAR_ENOMEM;
+  cv_status st = cv_ldlt_new(d, w->gof, &w->L, msg, len);
+  if (st) return st;
+  w->colptr = cv_ldlt_colptr(w->L);
   w->g = cv_malloc(one * sizeof *w->g);
   w->gt = cv_malloc(one * sizeof *w->gt);
   w->delta = cv_malloc(one * sizeof *w->delta);
-  w->dreg = cv_malloc(one * sizeof *w->dreg);
-  w->corr = cv_malloc(one * sizeof *w->corr);
   w->Yt = cv_malloc((size_t)d->ndof * sizeof *w->Yt);
   w->Mt = cv_malloc((nmult ? nmult : 1) * sizeof *w->Mt);
-  if (!w->gof || !w->colptr || !w->g || !w->gt || !w->delta || !w->Yt || !w->Mt ||
-      !w->dreg || !w->corr)
-    return CVAR_ENOMEM;
-  cv_disc_pattern(d, w->colptr, w->gof);
-  w->L = cv_ldlt_new(d->nfree, w->colptr);
-  return w->L ? CVAR_OK : CVAR_ENOMEM;
+  if (!w->g || !w->gt || !w->delta || !w->Yt || !w->Mt) return CVAR_ENOMEM;
+  if (nmult) {
+    w->dreg = cv_malloc(one * sizeof *w->dreg);
+    w->corr = cv_malloc(one * sizeof *w->corr);
+    if (!w->dreg || !w->corr) return CVAR_ENOMEM;
+  }
+  return CVAR_OK;
 }
 
 /* The scaled residual r_f = g_f / m_f with lumped nodal weights m_f (N-3): returns the
@@ -143,10 +147,11 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   s->gnorm = NAN;
   s->action = NAN;
   memset(&kkt, 0, sizeof kkt);
-  st = ws_init(&w, d, nmult);
+  st = ws_init(&w, d, nmult, s->msg, sizeof s->msg);
   if (!st) st = cv_kkt_init(&kkt, p, d, w.colptr);
   if (st) {
-    cv_set_msg(s->msg, sizeof s->msg, "out of memory setting up %d unknowns", nf);
+    if (st == CVAR_ENOMEM)
+      cv_set_msg(s->msg, sizeof s->msg, "out of memory setting up %d unknowns", nf);
     goto cleanup;
   }
   for (int f = 0; f < nf; f++) ncon += w.gof[f] < 0;

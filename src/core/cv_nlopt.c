@@ -164,13 +164,11 @@ static double stationarity(nl_ctx *c, cv_kkt *kkt, const double *Y) {
 
 /* Factor the model Hessian (stiffness + mass of each component, identity on multiplier
  * rows) in the solver's sparsity pattern; D is positive, so |D|^{-1/2} is plain D^{-1/2}. */
-static cv_status precondition(nl_ctx *c, const cv_disc *d, const long *colptr) {
+static cv_status precondition(nl_ctx *c, const cv_disc *d, const int *colptr) {
   int nn[2];
   double S, L2 = (d->b - d->a) * (d->b - d->a);
   nn[0] = d->n;
   nn[1] = (int)fmin(2e9, fmax(1.0, L2 * 1e6));
-  c->P = cv_ldlt_new(d->nfree, colptr);
-  if (!c->P) return CVAR_ENOMEM;
   double *Ax = cv_ldlt_values(c->P);
   cv_status st = cv_assemble(&c->kkt->as, model_F, nn, c->Y0, &S, NULL, colptr, Ax, 1.0);
   if (st) return st;
@@ -194,7 +192,7 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
   nl_ctx c;
   cv_kkt kkt;
   cv_status st = CVAR_OK;
-  long *colptr = NULL;
+  const int *colptr = NULL;
   double *x = NULL, *tol = NULL;
   nlopt_opt local = NULL;
   int constrained = d->nc > 0 || d->ni > 0, cmethod = s->method >= CVAR_METHOD_MMA;
@@ -207,15 +205,17 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
                cv_method_name(s->method));
     return CVAR_EINVAL;
   }
-  colptr = cv_calloc((size_t)d->nfree + 1, sizeof *colptr);
-  if (colptr) cv_disc_pattern(d, colptr, NULL);
+  /* The preconditioner's matrix owns the pattern the assembly scatters into. */
+  st = cv_ldlt_new(d, NULL, &c.P, s->msg, sizeof s->msg);
+  if (st) goto cleanup;
+  colptr = cv_ldlt_colptr(c.P);
   c.g = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.g);
   c.yof = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.yof);
   c.fof = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.fof);
   c.rows = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.rows);
   c.lrow = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.lrow);
   c.var = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.var);
-  if (!colptr || !c.g || !c.yof || !c.fof || !c.rows || !c.lrow || !c.var) {
+  if (!c.g || !c.yof || !c.fof || !c.rows || !c.lrow || !c.var) {
     st = CVAR_ENOMEM;
     goto cleanup;
   }
@@ -383,7 +383,6 @@ cleanup:
   nlopt_destroy(local);
   nlopt_destroy(c.opt);
   cv_kkt_free(&kkt);
-  cv_free(colptr);
   cv_free(c.g);
   cv_free(c.yof);
   cv_free(c.fof);
