@@ -40,12 +40,6 @@ void cv_assembler_free(cv_assembler *as) {
   as->fl = NULL;
 }
 
-static int all_finite(const double *v, size_t len) {
-  for (size_t i = 0; i < len; i++)
-    if (!isfinite(v[i])) return 0;
-  return 1;
-}
-
 /* Fill the batch of quadrature points of elements e0 .. e0+ne-1: x, and y, y' from the
  * nodal values through the basis tables, theory (E-3). Inlined with constant P1 and N
  * where they are small (the common scalar case), so the basis loops unroll. */
@@ -112,63 +106,95 @@ static cv_status call_integrand(cv_assembler *as, cv_integrand_fn Fn, void *user
   return CVAR_OK; /* finiteness is checked on the sums, see cv_assemble */
 }
 
-/* Element kernel for one unknown (n = 1), inlined with a constant number of basis
- * functions P1 so loops unroll and the element gradient and matrix stay in registers.
- * Same sums as the general loops in cv_assemble, (A-1)-(A-3). */
+/* Kernel for one unknown (n = 1) over the elements e0 .. e0+ne-1 of a batch, inlined with
+ * constant P1 basis functions and Q points (Q = 0: the rule's own q, not unrolled), so the
+ * loops unroll and the element gradient and matrix stay in registers. The rule is copied
+ * to locals and the outputs are restrict: a store into g or Ax then cannot force the
+ * tables to be reloaded. Same sums as the general loops in cv_assemble, (A-1)-(A-3).
+ * Returns the batch's part of S; *bad collects 0 * (each entry), which is 0 unless an
+ * entry is not finite. */
 static inline __attribute__((always_inline)) double
-element_scalar(const int P1, const cv_rule *r, int q, int idx0, double J, double rh,
-               const cv_partials *o, const int *fl, double *g, const int *colptr,
-               double *Ax, double hscale) {
-  double *gl = g, *K = Ax;
-  double S = 0.0, gacc[CV_MAX_DEGREE + 1], Kacc[(CV_MAX_DEGREE + 1) * (CV_MAX_DEGREE + 1)];
+batch_scalar(const int P1, const int Q, const cv_disc *d, const cv_rule *r, int e0, int ne,
+             const cv_partials *o, double *restrict g, const int *restrict colptr,
+             double *restrict Ax, double hscale, double *bad) {
+  enum { MAXB = CV_MAX_QUAD * (CV_MAX_DEGREE + 1) };
+  const int q = Q ? Q : r->q, p = P1 - 1;
+  double B[MAXB], D[MAXB], om[CV_MAX_QUAD];
+  for (int k = 0; k < q * P1; k++) B[k] = r->B[k], D[k] = r->D[k];
+  for (int k = 0; k < q; k++) om[k] = r->omega[k];
+  const double *restrict F = o->F, *restrict Fy = o->Fy, *restrict Fp = o->Fp;
+  const double *restrict Fyy = o->Fyy, *restrict Fyp = o->Fyp, *restrict Fpp = o->Fpp;
+  const double *restrict xe = d->xe;
+  double S = 0.0, chk = 0.0;
+  for (int el = 0; el < ne; el++) {
+    int e = e0 + el, fl[CV_MAX_DEGREE + 1];
+    double h = xe[e + 1] - xe[e], J = 0.5 * h, rh = 2.0 / h;
+    /* Free indices: a shift of the global ones except on the two end elements (E-2). */
+    if (e > 0 && e < d->E - 1) {
+      int base = cv_disc_elem_first(d, e), st = d->stride;
+      for (int l = 0; l < P1; l++) fl[l] = base + l * st;
+    } else {
+      for (int l = 0; l < P1; l++) fl[l] = cv_disc_fidx(d, (long)e * p + l);
+    }
+    double gacc[CV_MAX_DEGREE + 1], Kacc[(CV_MAX_DEGREE + 1) * (CV_MAX_DEGREE + 1)];
 #pragma GCC unroll 9
-  for (int a = 0; a < P1; a++) gacc[a] = 0.0;
-  if (K)
+    for (int a = 0; a < P1; a++) gacc[a] = 0.0;
 #pragma GCC unroll 81
     for (int a = 0; a < P1 * P1; a++) Kacc[a] = 0.0;
-  for (int k = 0; k < q; k++) {
-    int idx = idx0 + k;
-    double wk = J * r->omega[k];
-    const double *Bk = r->B + k * P1, *Dk = r->D + k * P1;
-    S += wk * o->F[idx];
-    if (gl) {
-      double fy = wk * o->Fy[idx], fp = wk * rh * o->Fp[idx];
+#pragma GCC unroll 16
+    for (int k = 0; k < q; k++) {
+      int idx = el * q + k;
+      double wk = J * om[k];
+      const double *Bk = B + k * P1, *Dk = D + k * P1;
+      S += wk * F[idx];
+      if (g) {
+        double fy = wk * Fy[idx], fp = wk * rh * Fp[idx];
 #pragma GCC unroll 9
-      for (int l = 0; l < P1; l++) gacc[l] += fy * Bk[l] + fp * Dk[l];
-    }
-    if (K) {
-      double yy = wk * o->Fyy[idx], yp = wk * rh * o->Fyp[idx], pp = wk * rh * rh * o->Fpp[idx];
+        for (int l = 0; l < P1; l++) gacc[l] += fy * Bk[l] + fp * Dk[l];
+      }
+      if (Ax) {
+        double yy = wk * Fyy[idx], yp = wk * rh * Fyp[idx], pp = wk * rh * rh * Fpp[idx];
 #pragma GCC unroll 9
-      for (int l = 0; l < P1; l++) {
-        double cy = yy * Bk[l] + yp * Dk[l], cp = yp * Bk[l] + pp * Dk[l];
+        for (int l = 0; l < P1; l++) {
+          double cy = yy * Bk[l] + yp * Dk[l], cp = yp * Bk[l] + pp * Dk[l];
 #pragma GCC unroll 9
-        for (int rr = l; rr < P1; rr++) Kacc[l * P1 + rr] += cy * Bk[rr] + cp * Dk[rr];
+          for (int rr = l; rr < P1; rr++) Kacc[l * P1 + rr] += cy * Bk[rr] + cp * Dk[rr];
+        }
       }
     }
+    /* scatter (E-2): gradient rows, and the upper triangle column by column */
+    if (g)
+#pragma GCC unroll 9
+      for (int l = 0; l < P1; l++) {
+        chk += 0.0 * gacc[l];
+        if (fl[l] >= 0) g[fl[l]] += gacc[l];
+      }
+    if (Ax)
+#pragma GCC unroll 9
+      for (int bcol = 0; bcol < P1; bcol++) {
+        int fb = fl[bcol];
+        if (fb < 0) continue;
+        long c0 = colptr[fb], rs = fb + 1 - (colptr[fb + 1] - c0);
+#pragma GCC unroll 9
+        for (int arow = 0; arow <= bcol; arow++) {
+          chk += 0.0 * Kacc[arow * P1 + bcol];
+          if (fl[arow] >= 0) Ax[c0 + fl[arow] - rs] += hscale * Kacc[arow * P1 + bcol];
+        }
+      }
   }
-  /* scatter (E-2): gradient rows, and the upper triangle column by column */
-  if (g)
-    for (int l = 0; l < P1; l++)
-      if (fl[l] >= 0) g[fl[l]] += gacc[l];
-  if (Ax)
-    for (int bcol = 0; bcol < P1; bcol++) {
-      int fb = fl[bcol];
-      if (fb < 0) continue;
-      long c0 = colptr[fb], rs = fb + 1 - (colptr[fb + 1] - c0);
-      for (int arow = 0; arow <= bcol; arow++)
-        if (fl[arow] >= 0) Ax[c0 + fl[arow] - rs] += hscale * Kacc[arow * P1 + bcol];
-    }
+  *bad += chk;
   return S;
 }
 
-static inline __attribute__((always_inline)) double
-element_scalar_dispatch(int P1, const cv_rule *r, int q, int idx0, double J, double rh,
-                        const cv_partials *o, const int *fl, double *g, const int *colptr,
-                        double *Ax, double hscale) {
+static double batch_scalar_dispatch(const cv_disc *d, const cv_rule *r, int e0, int ne,
+                                    const cv_partials *o, double *g, const int *colptr,
+                                    double *Ax, double hscale, double *bad) {
+  int P1 = d->p + 1, same = r->q == P1;
   switch (P1) {
 #define CASE(c)                                                                            \
   case c:                                                                                  \
-    return element_scalar(c, r, q, idx0, J, rh, o, fl, g, colptr, Ax, hscale);
+    return same ? batch_scalar(c, c, d, r, e0, ne, o, g, colptr, Ax, hscale, bad)          \
+                : batch_scalar(c, 0, d, r, e0, ne, o, g, colptr, Ax, hscale, bad);
     CASE(2) CASE(3) CASE(4) CASE(5) CASE(6) CASE(7) CASE(8) CASE(9)
 #undef CASE
   }
@@ -181,11 +207,12 @@ element_scalar_dispatch(int P1, const cv_rule *r, int q, int idx0, double J, dou
  *     + F_yiy'j phi_l phi_r' (2/h) + F_yjy'i phi_l' phi_r (2/h) + F_y'iy'j phi_l' phi_r' (2/h)^2)
  *                                                                              (A-3)  */
 cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y,
-                      double *S, double *g, const int *colptr, double *Ax, double hscale) {
+                      double *S, double *g, const int *colptr, double *Ax, double hscale,
+                      int overwrite) {
   const cv_disc *d = as->disc;
   int n = d->n, p = d->p, P1 = p + 1, nl = P1 * n;
   unsigned need = CVAR_NEED_F | (g ? CVAR_NEED_GRAD : 0u) | (Ax ? CVAR_NEED_HESS : 0u);
-  double Ssum = 0.0, *K = as->K, *gl = as->K + nl * nl;
+  double Ssum = 0.0, bad = 0.0, *K = as->K, *gl = as->K + nl * nl;
   int *flp = as->fl;
   cv_status st;
   for (int e0 = 0, ne; e0 < d->E; e0 += ne) {
@@ -198,6 +225,19 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
     fill_points(as, Y, r, e0, ne);
     st = call_integrand(as, Fn, user, m, need);
     if (st) return st;
+    if (overwrite) {
+      /* Clear the columns of this batch's nodes not shared with the previous batch, just
+       * before they are summed into: in cache, instead of a pass over all of g and Ax. */
+      long J0 = (long)e0 * p + (e0 > 0), J1 = (long)(e0 + ne) * p;
+      int cA = cv_disc_node_first(d, J0);
+      int cB = J1 == d->nodes - 1 ? d->nu0 : cv_disc_node_first(d, J1 + 1);
+      if (g) memset(g + cA, 0, (size_t)(cB - cA) * sizeof *g);
+      if (Ax) memset(Ax + colptr[cA], 0, (size_t)(colptr[cB] - colptr[cA]) * sizeof *Ax);
+    }
+    if (n == 1) {
+      Ssum += batch_scalar_dispatch(d, r, e0, ne, &as->out, g, colptr, Ax, hscale, &bad);
+      continue; /* scattered by the kernel */
+    }
     double *F = as->out.F;
     const double *Fy = as->out.Fy, *Fp = as->out.Fp;
     const double *Fyy = as->out.Fyy, *Fyp = as->out.Fyp, *Fpp = as->out.Fpp;
@@ -213,13 +253,7 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
       } else {
         for (int a = 0; a < nl; a++) flp[a] = cv_disc_fidx(d, (long)e * p * n + a);
       }
-      if (n == 1) {
-        cv_partials o = {F, (double *)Fy, (double *)Fp, (double *)Fyy, (double *)Fyp,
-                         (double *)Fpp};
-        Ssum += element_scalar_dispatch(P1, r, q, el * q, J, rh, &o, flp, g, colptr, Ax,
-                                        hscale);
-        continue; /* scattered by the kernel */
-      } else {
+      {
       if (Ax) memset(K, 0, (size_t)nl * nl * sizeof *K);
       if (g) memset(gl, 0, (size_t)nl * sizeof *gl);
       for (int k = 0; k < q; k++) {
@@ -251,8 +285,10 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
       }
       }
       if (g)
-        for (int a = 0; a < nl; a++)
+        for (int a = 0; a < nl; a++) {
+          bad += 0.0 * gl[a];
           if (flp[a] >= 0) g[flp[a]] += gl[a];
+        }
       if (Ax) {
         /* Scatter the upper triangle; column c holds rows c+1-len(c) .. c (E-2). */
         for (int bcol = 0; bcol < nl; bcol++) {
@@ -261,18 +297,19 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
           long c0 = colptr[fb], rs = fb + 1 - (colptr[fb + 1] - c0);
           for (int arow = 0; arow <= bcol; arow++) {
             int fa = flp[arow];
+            bad += 0.0 * K[arow * nl + bcol];
             if (fa >= 0) Ax[c0 + fa - rs] += hscale * K[arow * nl + bcol];
           }
         }
       }
     }
   }
-  /* Every requested output enters S, g or H multiplied by a weight, and NaN or Inf
-   * survives that (0 * Inf is NaN), so checking the sums catches any non-finite output,
-   * including entries the callback forgot (pre-filled with NaN). */
+  /* Every requested output enters S or an element's gradient or matrix multiplied by
+   * weights and basis values, and NaN or Inf survives that (0 * Inf is NaN, Inf * 0 too),
+   * so the element checks catch any non-finite output, including entries the callback
+   * forgot (pre-filled with NaN). An entry that overflows only when elements are summed
+   * shows as a non-finite pivot (cv_ldlt_factor). */
   *S = Ssum;
-  if (!isfinite(Ssum)) return CVAR_ENONFINITE;
-  if (g && !all_finite(g, (size_t)d->nfree)) return CVAR_ENONFINITE;
-  if (Ax && !all_finite(Ax, (size_t)colptr[d->nfree])) return CVAR_ENONFINITE;
+  if (!isfinite(Ssum) || !(bad == 0.0)) return CVAR_ENONFINITE;
   return CVAR_OK;
 }

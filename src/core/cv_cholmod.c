@@ -94,10 +94,12 @@ cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char 
   const int *Lp = L->L->p, *Ap = L->A->p;
   const double *Lx = L->L->x, *Ax = L->A->x;
   int nneg = 0;
+  long bad = -1;
   double lo = INFINITY, hi = 0.0;
   for (long j = 0; j < L->n; j++) {
     double dj = Lx[Lp[j]], ajj = fabs(Ax[Ap[j + 1] - 1]);
     if (dj < 0) nneg++;
+    if (!isfinite(dj) || !isfinite(ajj)) bad = bad < 0 ? j : bad;
     double a = fabs(dj), rel = ajj > 0 ? a / ajj : (a > 0 ? 1.0 : 0.0);
     if (!(rel >= lo)) lo = rel; /* a NaN pivot makes lo NaN */
     if (a > hi) hi = a;
@@ -105,6 +107,13 @@ cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char 
   *neg = nneg;
   *dmin = L->n ? lo : 1.0;
   *dmax = hi;
+  /* The assembly checks each element's entries; only a sum of finite ones that overflows
+   * arrives here (cv_assemble). */
+  if (bad >= 0) {
+    cv_set_msg(msg, len, "the Hessian (or its factor) is not finite at unknown %ld: the "
+               "integrand's second derivatives overflow", bad);
+    return CVAR_ENONFINITE;
+  }
   /* CHOLMOD stops LDL^T at an exactly zero or NaN pivot and reports it as "not positive
    * definite" with L->minor < n; a TRUE return alone does not mean success (STYLE.md 4). */
   if (L->c.status == CHOLMOD_NOT_POSDEF || L->L->minor < (size_t)L->n) {

@@ -121,6 +121,11 @@ static inline int cv_disc_lidx(const cv_disc *d, long node, int k) {
   if (node == d->nodes - 1) return d->lamL < 0 ? -1 : d->lamL + k;
   return (int)(d->off0 + (node - 1) * d->stride + d->n + k);
 }
+/* first free index of node j's block (of the next block if node j has no free unknown); the
+ * blocks of nodes 0 .. nodes-1 fill 0 .. nu0-1 in order */
+static inline int cv_disc_node_first(const cv_disc *d, long j) {
+  return j == 0 ? 0 : (int)(d->off0 + (j - 1) * d->stride);
+}
 /* first unknown of element e (its first node's first unknown) */
 static inline int cv_disc_elem_first(const cv_disc *d, long e) {
   return e == 0 ? 0 : (int)(d->off0 + (e * d->p - 1) * d->stride);
@@ -178,10 +183,14 @@ cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc
 void cv_assembler_free(cv_assembler *as);
 /* Set *S to the discrete integral of Fn (theory A-1), add its gradient (A-2) to g (rows of the
  * y unknowns; may be NULL) and hscale times its Hessian (A-3) to Ax (may be NULL; column
- * layout colptr), at nodal values Y (length nodes*n). Nothing is zeroed here. Returns
- * CVAR_OK, CVAR_ENONFINITE (non-finite output or > 0 from the callback), CVAR_ECALLBACK. */
+ * layout colptr), at nodal values Y (length nodes*n). With overwrite 0 nothing is zeroed;
+ * with 1 the rows of g and columns of Ax of the mesh nodes (free indices 0 .. nu0-1) are
+ * cleared batch by batch before the sums, so they end up holding this assembly alone
+ * (integral-multiplier rows and columns are not touched). Returns CVAR_OK,
+ * CVAR_ENONFINITE (non-finite output or > 0 from the callback), CVAR_ECALLBACK. */
 cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y,
-                      double *S, double *g, const int *colptr, double *Ax, double hscale);
+                      double *S, double *g, const int *colptr, double *Ax, double hscale,
+                      int overwrite);
 
 /* ---- the Lagrangian system with constraints (cv_kkt.c) ---- */
 typedef struct {

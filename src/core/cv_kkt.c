@@ -99,10 +99,14 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
   const int *cp = k->colptr;
   int n = d->n, nc = d->nc, nf = d->nfree;
   cv_status st;
-  memset(G, 0, (size_t)nf * sizeof *G);
-  if (Ax) memset(Ax, 0, (size_t)cp[nf] * sizeof *Ax);
+  /* The assembly clears the node rows and columns as it goes; the integral multipliers'
+   * rows and columns (the last ni, dense, C-3) are cleared here. */
+  for (int c = d->nu0; c < nf; c++) {
+    G[c] = 0.0;
+    if (Ax) memset(Ax + cp[c], 0, (size_t)(cp[c + 1] - cp[c]) * sizeof *Ax);
+  }
   if (dreg) memset(dreg, 0, (size_t)nf * sizeof *dreg);
-  st = cv_assemble(&k->as, p->F, p->user, Y, S, G, cp, Ax, 1.0);
+  st = cv_assemble(&k->as, p->F, p->user, Y, S, G, cp, Ax, 1.0, 1);
   if (st) return st;
   double hmax = 0.0; /* largest diagonal entry of the action's Hessian, for delta */
   if (Ax && (nc > 0 || d->ni > 0))
@@ -115,7 +119,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
     double I, nu = M[(size_t)d->nodes * nc + r];
     int row = d->nu0 + r;
     memset(k->gK, 0, (size_t)nf * sizeof *k->gK);
-    st = cv_assemble(&k->as, ic->K, ic->user, Y, &I, k->gK, cp, Ax, nu);
+    st = cv_assemble(&k->as, ic->K, ic->user, Y, &I, k->gK, cp, Ax, nu, 0);
     if (st) return st;
     G[row] = I - ic->c;
     double gg = 0.0;
@@ -184,11 +188,11 @@ cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M) {
   int n = d->n, nc = d->nc, nf = d->nfree;
   double S, *g = cv_calloc((size_t)(nf ? nf : 1), sizeof *g);
   if (!g) return CVAR_ENOMEM;
-  cv_status st = cv_assemble(&k->as, p->F, p->user, Y, &S, g, k->colptr, NULL, 0.0);
+  cv_status st = cv_assemble(&k->as, p->F, p->user, Y, &S, g, k->colptr, NULL, 0.0, 0);
   for (int r = 0; r < d->ni && !st; r++) {
     double I, num = 0.0, den = 0.0;
     memset(k->gK, 0, (size_t)nf * sizeof *k->gK);
-    st = cv_assemble(&k->as, p->ic[r].K, p->ic[r].user, Y, &I, k->gK, k->colptr, NULL, 0.0);
+    st = cv_assemble(&k->as, p->ic[r].K, p->ic[r].user, Y, &I, k->gK, k->colptr, NULL, 0.0, 0);
     for (int f = 0; f < d->nu0 && !st; f++) {
       double w = 1.0 / (d->mass[f] * d->mass[f]);
       num += w * g[f] * k->gK[f];
@@ -242,7 +246,7 @@ cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, dou
     int row = d->nu0 + r;
     memset(k->gK, 0, (size_t)d->nfree * sizeof *k->gK);
     st = cv_assemble(&k->as, p->ic[r].K, p->ic[r].user, Y, &I, jac ? k->gK : NULL, k->colptr,
-                     NULL, 0.0);
+                     NULL, 0.0, 0);
     vals[row] = I - p->ic[r].c;
     if (jac && !st)
       for (int f = 0; f < d->nu0; f++)

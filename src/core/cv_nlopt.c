@@ -96,7 +96,7 @@ static double objective(unsigned n, const double *x, double *grad, void *data) {
   }
   memset(c->g, 0, (size_t)c->d->nfree * sizeof *c->g);
   cv_status st = cv_assemble(&c->kkt->as, c->kkt->prob->F, c->kkt->prob->user, c->Y, &S,
-                             grad ? c->g : NULL, c->kkt->colptr, NULL, 0.0);
+                             grad ? c->g : NULL, c->kkt->colptr, NULL, 0.0, 0);
   if (st == CVAR_ECALLBACK || st == CVAR_ENOMEM) {
     c->stop = st;
     nlopt_force_stop(c->opt);
@@ -170,7 +170,7 @@ static cv_status precondition(nl_ctx *c, const cv_disc *d, const int *colptr) {
   nn[0] = d->n;
   nn[1] = (int)fmin(2e9, fmax(1.0, L2 * 1e6));
   double *Ax = cv_ldlt_values(c->P);
-  cv_status st = cv_assemble(&c->kkt->as, model_F, nn, c->Y0, &S, NULL, colptr, Ax, 1.0);
+  cv_status st = cv_assemble(&c->kkt->as, model_F, nn, c->Y0, &S, NULL, colptr, Ax, 1.0, 0);
   if (st) return st;
   for (int f = 0; f < d->nfree; f++) c->dinv[f] = 1.0;
   for (int f = 0; f < d->nfree; f++)
