@@ -140,11 +140,13 @@ static void forward_L(const cv_ldlt *L, double *x) { /* x <- L^{-1} x, L unit lo
   }
 }
 
-static void backward_Lt(const cv_ldlt *L, double *x) { /* x <- L^{-T} x */
+/* x <- L^{-T} D^{-1} x (diag 1) or L^{-T} x (diag 0): one pass for both factors */
+static inline __attribute__((always_inline)) void backward_Lt(const cv_ldlt *L, int diag,
+                                                               double *x) {
   const int *Lp = L->L->p, *Li = L->L->i, *Lnz = L->L->nz;
   const double *Lx = L->L->x;
   for (long j = L->n - 1; j >= 0; j--) {
-    double xj = x[j];
+    double xj = diag ? x[j] / Lx[Lp[j]] : x[j];
     for (int k = Lp[j] + 1, ke = Lp[j] + Lnz[j]; k < ke; k++)
       xj -= Lx[k] * x[Li[k]];
     x[j] = xj;
@@ -152,16 +154,13 @@ static void backward_Lt(const cv_ldlt *L, double *x) { /* x <- L^{-T} x */
 }
 
 cv_status cv_ldlt_solve(cv_ldlt *L, double *x) {
-  const int *Lp = L->L->p;
-  const double *Lx = L->L->x;
   forward_L(L, x);
-  for (long j = 0; j < L->n; j++) x[j] /= Lx[Lp[j]];
-  backward_Lt(L, x);
+  backward_Lt(L, 1, x);
   return CVAR_OK;
 }
 
 cv_status cv_ldlt_solve_L(cv_ldlt *L, int transpose, double *x) {
-  if (transpose) backward_Lt(L, x);
+  if (transpose) backward_Lt(L, 0, x);
   else forward_L(L, x);
   return CVAR_OK;
 }

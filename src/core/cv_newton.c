@@ -227,13 +227,20 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
       goto cleanup;
     }
     s->iterations++;
-    /* Weighted RMS norm of the step in y, weights 1/(rtol |y| + atol) (N-4). */
+    /* Weighted RMS norm of the step in y, weights 1/(rtol |y| + atol) (N-4), in the same
+     * pass as the full-step trial point (apply_step with alpha = 1). */
     double wn = 0.0, slope = 0.0, ymax = 0.0;
     int ny = 0;
     for (int f = 0; f < nf; f++) {
-      slope += w.g[f] * w.delta[f];
-      if (w.gof[f] < 0) continue;
-      double ay = fabs(Yc[w.gof[f]]), v = w.delta[f] / (s->rtol * ay + atol);
+      int gi = w.gof[f];
+      double df = w.delta[f];
+      slope += w.g[f] * df;
+      if (gi < 0) {
+        w.Mt[-1 - gi] = Mc[-1 - gi] + df;
+        continue;
+      }
+      double yf = Yc[gi], ay = fabs(yf), v = df / (s->rtol * ay + atol);
+      w.Yt[gi] = yf + df;
       wn += v * v;
       ny++;
       if (!(ay <= ymax)) ymax = ay;
@@ -258,7 +265,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     double alpha = 1.0, St = 0.0, phit = 0.0, rnt = 0.0;
     int accepted = 0, use_S = neg == 0 && !constrained && slope < 0;
     for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
-      apply_step(&w, Yc, Mc, alpha);
+      if (ls > 0) apply_step(&w, Yc, Mc, alpha);
       ta = cv_now();
       /* A step within the tolerance is the last one (taken in full below): the Hessian
        * there would not be used, so only F and the gradient are evaluated. */

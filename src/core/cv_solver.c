@@ -156,8 +156,20 @@ cv_status cv_solver_set_start(cv_solver *s, int len, const double *y) {
   return CVAR_OK;
 }
 
-/* Initial nodal values: user start, guess callback, or the straight line between the end
- * values (a free end takes the other end's value; both free: 0). Fixed ends always win. */
+/* The default start at fraction t of the interval: the straight line between the end
+ * values (a free end takes the other end's value; both free: 0). */
+static void straight_line(const cv_problem *p, double t, double *y) {
+  for (int i = 0; i < p->n; i++) {
+    int fa = p->fixed[2 * i], fb = p->fixed[2 * i + 1];
+    double ya = p->endval[2 * i], yb = p->endval[2 * i + 1];
+    if (!fa) ya = fb ? yb : 0.0;
+    if (!fb) yb = ya;
+    y[i] = ya + (yb - ya) * t;
+  }
+}
+
+/* Initial nodal values: user start, guess callback, or the straight line. Fixed ends
+ * always win. */
 static cv_status initial_values(cv_solver *s, const cv_problem *p, const cv_disc *d,
                                 double *Y) {
   int n = p->n;
@@ -191,20 +203,21 @@ static cv_status initial_values(cv_solver *s, const cv_problem *p, const cv_disc
     }
     cv_free(yb);
   } else {
-    double *xn = cv_malloc((size_t)d->nodes * sizeof *xn);
-    if (!xn) return CVAR_ENOMEM;
-    cv_disc_fill_nodes(d, xn);
-    for (int i = 0; i < n; i++) {
-      int fa = p->fixed[2 * i], fb = p->fixed[2 * i + 1];
-      double ya = p->endval[2 * i], yb = p->endval[2 * i + 1];
-      if (!fa) ya = fb ? yb : 0.0;
-      if (!fb) yb = ya;
-      for (long j = 0; j < d->nodes; j++) {
-        double t = (xn[j] - d->a) / (d->b - d->a);
-        Y[j * n + i] = ya + (yb - ya) * t;
+    /* node by node, element by element: no array of abscissae (a large solve faults in
+     * every page it allocates, docs/performance.md) */
+    double rl = 1.0 / (d->b - d->a);
+    for (long e = 0; e < d->E; e++) {
+      double x0 = d->xe[e], h = d->xe[e + 1] - x0;
+      for (int l = 0; l < d->p; l++) {
+        double x = l ? x0 + 0.5 * (d->ref.xi[l] + 1.0) * h : x0;
+        straight_line(p, (x - d->a) * rl, Y + (e * d->p + l) * n);
       }
     }
-    cv_free(xn);
+    straight_line(p, 1.0, Y + (d->nodes - 1) * n);
+    for (int i = 0; i < n; i++) { /* exactly, so that no blend below is needed */
+      if (p->fixed[2 * i]) Y[i] = p->endval[2 * i];
+      if (p->fixed[2 * i + 1]) Y[(d->nodes - 1) * n + i] = p->endval[2 * i + 1];
+    }
   }
   /* A start or guess that misses the fixed end values is shifted onto them by a linear
    * blend, da (1 - t) + db t, rather than having its end nodes overwritten: a kink in the
@@ -332,14 +345,8 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
     goto done;
   }
   /* Newton from the start; if it fails to converge (not on bad input or a callback's
-   * abort), continuation from the same start before giving up (theory HC-2). */
-  double *Y0 = cv_malloc((size_t)s->disc.ndof * sizeof *Y0);
-  if (!Y0) {
-    st = CVAR_ENOMEM;
-    cv_set_msg(s->msg, sizeof s->msg, "out of memory");
-    goto done;
-  }
-  memcpy(Y0, s->y, (size_t)s->disc.ndof * sizeof *Y0);
+   * abort), continuation from the same start, computed again, before giving up (theory
+   * HC-2). */
   st = cv_newton_run(s, p, &s->disc, s->y, s->mult, NULL);
   /* Globalisation failures only: not a Hessian singular at the start itself (continuation
    * cannot cure an invariance; one met on the way is the wandering iterate's), not an
@@ -348,9 +355,15 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
   int lost = st == CVAR_ESTALL || st == CVAR_EDIVERGED ||
              ((st == CVAR_ENONFINITE || st == CVAR_ESINGULAR) && s->iterations > 0) ||
              (st == CVAR_EMAXITER && s->maxit >= 20);
-  if (lost && p->nc == 0 && p->ni == 0 && s->continuation)
-    st = cv_continuation_run(s, p, &s->disc, s->y, s->mult, Y0);
-  cv_free(Y0);
+  if (lost && p->nc == 0 && p->ni == 0 && s->continuation) {
+    double *Y0 = cv_malloc((size_t)s->disc.ndof * sizeof *Y0);
+    char keep[sizeof s->msg];
+    memcpy(keep, s->msg, sizeof keep);
+    cv_status st0 = Y0 ? initial_values(s, p, &s->disc, Y0) : CVAR_ENOMEM;
+    if (!st0) st = cv_continuation_run(s, p, &s->disc, s->y, s->mult, Y0);
+    else memcpy(s->msg, keep, sizeof keep); /* report Newton's failure */
+    cv_free(Y0);
+  }
 done:
   if (s->note[0]) {
     char m[sizeof s->msg];
