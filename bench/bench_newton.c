@@ -60,11 +60,12 @@ static double floor_ns(long E) {
 static int catenary(int m, const double *x, const double *y, const double *dy, unsigned need,
                     cv_partials *o, void *user) {
   (void)x; (void)need; (void)user;
+  /* one square root and one reciprocal per point, the arithmetic of the floor below */
   for (int k = 0; k < m; k++) {
-    double p = dy[k], s = sqrt(1 + p * p);
+    double p = dy[k], s = sqrt(1 + p * p), is = 1.0 / s;
     o->F[k] = y[k] * s;
-    if (o->Fy) { o->Fy[k] = s; o->Fp[k] = y[k] * p / s; }
-    if (o->Fyy) { o->Fyy[k] = 0; o->Fyp[k] = p / s; o->Fpp[k] = y[k] / (s * s * s); }
+    if (o->Fy) { o->Fy[k] = s; o->Fp[k] = y[k] * p * is; }
+    if (o->Fyy) { o->Fyy[k] = 0; o->Fyp[k] = p * is; o->Fpp[k] = y[k] * is * is * is; }
   }
   return 0;
 }
