@@ -91,6 +91,11 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
     for (int l = 0; l <= d->p; l++) {
       long node = (long)e * d->p + l;
       double m = 0.5 * h * d->ref.wl[l];
+      if (node > 0 && node < d->nodes - 1) { /* interior: the node's block, y then lambda */
+        double *blk = d->mass + cv_disc_node_first(d, node);
+        for (int t = 0; t < d->stride; t++) blk[t] += m;
+        continue;
+      }
       for (int i = 0; i < n; i++) {
         int fi = cv_disc_fidx(d, node * n + i);
         if (fi >= 0) d->mass[fi] += m;

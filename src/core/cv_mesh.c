@@ -72,10 +72,11 @@ cv_status cv_mesh_build(const cv_meshspec *m, double a, double b, int *Eout, dou
       st = CVAR_ENOMEM;
       goto cleanup;
     }
-    for (int i = 0; i <= E; i++) {
-      double t = m->kind == CV_MESH_USER ? m->t[i] : graded_t(m, i);
-      xe[i] = a + L * t;
-    }
+    if (m->kind == CV_MESH_UNIFORM) /* the common case, without a call per boundary */
+      for (int i = 0; i <= E; i++) xe[i] = a + L * ((double)i / E);
+    else
+      for (int i = 0; i <= E; i++)
+        xe[i] = a + L * (m->kind == CV_MESH_USER ? m->t[i] : graded_t(m, i));
     xe[0] = a;
     xe[E] = b;
     /* Insert each breakpoint that is not already a boundary (to 1e-13 relative). */
