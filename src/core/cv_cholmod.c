@@ -2,6 +2,7 @@
  * refactorisation per Newton step, inertia from the pivots. The only file with cholmod.h.
  * SPDX-License-Identifier: MIT */
 #include <limits.h>
+#include <pthread.h>
 #include <math.h>
 #include <string.h>
 
@@ -14,7 +15,28 @@ struct cv_ldlt {
   cholmod_sparse *A;
   cholmod_factor *L;
   long n;
+  pthread_t th;  /* the symbolic analysis, started by cv_ldlt_new on large systems */
+  int running;   /* th has to be joined */
+  int analysed;  /* cholmod_analyze has run (L->L set, or NULL on its failure) */
 };
+
+/* Below this many unknowns the analysis takes under ~3 ms and a thread is not worth it. */
+#define ASYNC_ANALYSIS_MIN 50000
+
+/* The analysis reads only the pattern of A (A->p, A->i), which is final once cv_ldlt_new
+ * returns; the caller meanwhile fills A->x, evaluates the integrand and so on, and the
+ * first cv_ldlt_factor joins. No user callback runs on this thread. */
+static void *analyze_main(void *arg) {
+  cv_ldlt *L = arg;
+  L->L = cholmod_analyze(L->A, &L->c);
+  L->analysed = 1;
+  return NULL;
+}
+
+static void join_analysis(cv_ldlt *L) {
+  if (L->running) pthread_join(L->th, NULL);
+  L->running = 0;
+}
 
 /* CHOLMOD's int interface: half the index memory of the long one, and every byte of a
  * large solve is a fresh page to fault in (docs/performance.md). 2^31 - 1 entries is far
@@ -57,12 +79,18 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
     for (int k = 0; k < len; k++) Ai[Ap[c] + k] = r0 + k;
   }
   memset(L->A->x, 0, nz * sizeof(double));
+  /* At 10^6 unknowns the analysis is about a tenth of a Newton solve, most of it faulting
+   * in CHOLMOD's workspace: on the second core it overlaps the first assembly
+   * (docs/performance.md). If no thread can be started it runs in cv_ldlt_factor. */
+  if (nfree >= ASYNC_ANALYSIS_MIN && pthread_create(&L->th, NULL, analyze_main, L) == 0)
+    L->running = 1;
   *out = L;
   return CVAR_OK;
 }
 
 void cv_ldlt_free(cv_ldlt *L) {
   if (!L) return;
+  join_analysis(L);
   cholmod_free_sparse(&L->A, &L->c);
   cholmod_free_factor(&L->L, &L->c);
   cholmod_finish(&L->c);
@@ -75,12 +103,14 @@ double *cv_ldlt_values(cv_ldlt *L) { return L->A->x; }
 
 cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg,
                          size_t len) {
-  if (!L->L) {
+  join_analysis(L);
+  if (!L->analysed) {
     L->L = cholmod_analyze(L->A, &L->c);
-    if (!L->L) {
-      cv_set_msg(msg, len, "CHOLMOD analysis failed (status %d)", L->c.status);
-      return L->c.status == CHOLMOD_OUT_OF_MEMORY ? CVAR_ENOMEM : CVAR_EDEPENDENCY;
-    }
+    L->analysed = 1;
+  }
+  if (!L->L) {
+    cv_set_msg(msg, len, "CHOLMOD analysis failed (status %d)", L->c.status);
+    return L->c.status == CHOLMOD_OUT_OF_MEMORY ? CVAR_ENOMEM : CVAR_EDEPENDENCY;
   }
   int ok = cholmod_factorize(L->A, L->L, &L->c);
   if (!ok || L->c.status < CHOLMOD_OK) {
