@@ -43,7 +43,12 @@ static void join_analysis(cv_ldlt *L) {
  * beyond what fits in memory next to them (24 GB of values and indices alone). */
 cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size_t len) {
   int nfree = d->nfree;
-  long nnz = cv_disc_pattern(d, NULL, NULL);
+  /* A column of a node holds at most the unknowns of p + 1 node blocks, an integral
+   * multiplier's column all before it (E-2, C-3). Allocated to that bound, the pattern is
+   * written in one pass; the pages past the true count are never touched, so they cost
+   * nothing. Only near the 32-bit limit is the exact count taken first. */
+  long nnz = (long)d->nu0 * (d->p + 1) * d->stride + (long)d->ni * d->nfree;
+  if (nnz > INT_MAX) nnz = cv_disc_pattern(d, NULL, NULL);
   *out = NULL;
   if (nnz > INT_MAX) {
     cv_set_msg(msg, len, "the Hessian would have %ld entries, more than the 2^31 - 1 of the "
@@ -73,12 +78,12 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
     return CVAR_ENOMEM;
   }
   int *Ap = L->A->p, *Ai = L->A->i;
-  cv_disc_pattern(d, Ap, gof);
+  nz = (size_t)cv_disc_pattern(d, Ap, gof);
   for (int c = 0; c < nfree; c++) {
     int len = Ap[c + 1] - Ap[c], r0 = c + 1 - len;
     for (int k = 0; k < len; k++) Ai[Ap[c] + k] = r0 + k;
   }
-  memset(L->A->x, 0, nz * sizeof(double));
+  memset(L->A->x, 0, (nz ? nz : 1) * sizeof(double));
   /* At 10^6 unknowns the analysis is about a tenth of a Newton solve, most of it faulting
    * in CHOLMOD's workspace: on the second core it overlaps the first assembly
    * (docs/performance.md). If no thread can be started it runs in cv_ldlt_factor. */
