@@ -18,19 +18,7 @@ struct cv_ldlt {
   pthread_t th;  /* the symbolic analysis, started by cv_ldlt_new on large systems */
   int running;   /* th has to be joined */
   int analysed;  /* cholmod_analyze has run (L->L set, or NULL on its failure) */
-  long sig[7];   /* the layout of the discretisation the pattern was made for */
 };
-
-static void signature(const cv_disc *d, long *sig) {
-  sig[0] = d->nfree, sig[1] = d->nodes, sig[2] = d->p, sig[3] = d->stride;
-  sig[4] = d->off0, sig[5] = d->nu0, sig[6] = d->ni;
-}
-
-int cv_ldlt_fits(const cv_ldlt *L, const cv_disc *d) {
-  long sig[7];
-  signature(d, sig);
-  return memcmp(sig, L->sig, sizeof sig) == 0;
-}
 
 /* Below this many unknowns the analysis takes under ~3 ms and a thread is not worth it. */
 #define ASYNC_ANALYSIS_MIN 50000
@@ -41,13 +29,6 @@ int cv_ldlt_fits(const cv_ldlt *L, const cv_disc *d) {
 static void *analyze_main(void *arg) {
   cv_ldlt *L = arg;
   L->L = cholmod_analyze(L->A, &L->c);
-  /* Also allocate the numeric factor here, as cholmod_factorize's simplicial path would
-   * on its first call (the same change_factor arguments as its rowfac): faulting in its
-   * pages is a third of the first factorisation. The first factorisation is then a
-   * refactorisation. On failure L->L stays symbolic and cholmod_factorize retries. */
-  if (L->L)
-    cholmod_change_factor(CHOLMOD_REAL, L->L->is_ll, 0 /* simplicial */, 0 /* unpacked */,
-                          1 /* monotonic */, L->L, &L->c);
   L->analysed = 1;
   return NULL;
 }
@@ -89,7 +70,6 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
   L->c.print = 0;
   L->c.error_handler = NULL;
   L->n = nfree;
-  signature(d, L->sig);
   size_t nz = (size_t)(nnz ? nnz : 1);
   L->A = cholmod_allocate_sparse((size_t)nfree, (size_t)nfree, nz, 1, 1, 1, CHOLMOD_REAL,
                                  &L->c);

@@ -35,8 +35,8 @@ double cv_disc_node_x(const cv_disc *d, long j) {
 
 /* Unknowns are node-major (theory E-2); fixed end values are removed, so free indices are
  * the global ones shifted by the fixed components of node 0, except at the two end nodes. */
-cv_status cv_disc_init_counts(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
-                              size_t len) {
+cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
+                       size_t len) {
   cv_status st;
   int n = p->n;
   memset(d, 0, sizeof *d);
@@ -79,11 +79,6 @@ cv_status cv_disc_init_counts(cv_disc *d, const cv_problem *p, const cv_solver *
   d->nu0 = f;
   f += d->ni;
   d->nfree = f;
-  return CVAR_OK;
-}
-
-cv_status cv_disc_init_weights(cv_disc *d) {
-  int f = d->nfree, n = d->n, nc = d->nc;
   d->mass = cv_calloc((size_t)(f ? f : 1), sizeof *d->mass);
   if (!d->mass) {
     cv_disc_free(d);
@@ -119,12 +114,6 @@ cv_status cv_disc_init_weights(cv_disc *d) {
   }
   for (int k = 0; k < f; k++) d->imass[k] = 1.0 / d->mass[k];
   return CVAR_OK;
-}
-
-cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
-                       size_t len) {
-  cv_status st = cv_disc_init_counts(d, p, s, msg, len);
-  return st ? st : cv_disc_init_weights(d);
 }
 
 cv_rule cv_disc_rule(const cv_disc *d, long e) {

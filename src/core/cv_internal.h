@@ -165,8 +165,6 @@ cv_status cv_ldlt_solve(cv_ldlt *L, double *x);
 cv_status cv_ldlt_solve_L(cv_ldlt *L, int transpose, double *x);
 /* The pivots D(j) of the last factorisation. */
 void cv_ldlt_diag(const cv_ldlt *L, double *D);
-/* Whether L was made for a discretisation with d's pattern (cv_ldlt_new). */
-int cv_ldlt_fits(const cv_ldlt *L, const cv_disc *d);
 
 /* ---- assembly (cv_assemble.c) ---- */
 typedef struct {
@@ -246,9 +244,6 @@ struct cv_solver {
   int adapt_max, rounds;
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[160];              /* what the solver decided on its own, prefixed to msg */
-  cv_ldlt *ldlt_next;          /* Newton's matrix for `disc`, made (and being analysed)
-                                  before the weights and start are computed; taken by the
-                                  next cv_newton_run if its pattern still fits */
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
@@ -269,11 +264,6 @@ cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, dou
 void cv_disc_free(cv_disc *d);
 cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
                        size_t len);
-/* cv_disc_init in two parts: the mesh and the unknowns' layout (enough for the matrix
- * pattern), then the lumped weights mass and imass. */
-cv_status cv_disc_init_counts(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
-                              size_t len);
-cv_status cv_disc_init_weights(cv_disc *d);
 void cv_set_msg(char *msg, size_t len, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 

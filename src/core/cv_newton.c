@@ -39,21 +39,14 @@ static void ws_free(newton_ws *w) {
 /* Every array here is a fresh page range of a large solve, and faulting it in is a large
  * part of the run time (docs/performance.md): the refinement arrays exist only with
  * multipliers. */
-static cv_status ws_init(newton_ws *w, const cv_disc *d, size_t nmult, cv_ldlt **pre,
-                         char *msg, size_t len) {
+static cv_status ws_init(newton_ws *w, const cv_disc *d, size_t nmult, char *msg, size_t len) {
   size_t nf = (size_t)d->nfree, one = nf ? nf : 1;
   memset(w, 0, sizeof *w);
   w->d = d;
   w->gof = cv_malloc(one * sizeof *w->gof);
   if (!w->gof) return CVAR_ENOMEM;
-  if (*pre && cv_ldlt_fits(*pre, d)) { /* made by the solver's setup (cv_solver.c) */
-    w->L = *pre;
-    *pre = NULL;
-    cv_disc_pattern(d, NULL, w->gof);
-  } else {
-    cv_status st = cv_ldlt_new(d, w->gof, &w->L, msg, len);
-    if (st) return st;
-  }
+  cv_status st = cv_ldlt_new(d, w->gof, &w->L, msg, len);
+  if (st) return st;
   w->colptr = cv_ldlt_colptr(w->L);
   w->g = cv_malloc(one * sizeof *w->g);
   w->gt = cv_malloc(one * sizeof *w->gt);
@@ -155,7 +148,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   s->gnorm = NAN;
   s->action = NAN;
   memset(&kkt, 0, sizeof kkt);
-  st = ws_init(&w, d, nmult, &s->ldlt_next, s->msg, sizeof s->msg);
+  st = ws_init(&w, d, nmult, s->msg, sizeof s->msg);
   if (!st) st = cv_kkt_init(&kkt, p, d, w.colptr);
   if (st) {
     if (st == CVAR_ENOMEM)

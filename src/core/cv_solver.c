@@ -35,7 +35,6 @@ void cv_solver_free(cv_solver *s) {
   cv_free(s->y);
   cv_free(s->mult);
   cv_disc_free(&s->disc);
-  cv_ldlt_free(s->ldlt_next);
   cv_free(s);
 }
 
@@ -282,18 +281,7 @@ static cv_status setup(cv_solver *s, const cv_problem *p) {
   s->y = s->mult = NULL;
   cv_disc_free(&s->disc);
   s->have = 0;
-  st = cv_disc_init_counts(&s->disc, p, s, s->msg, sizeof s->msg);
-  /* Newton's matrix as soon as its pattern is known: on a large system CHOLMOD analyses
-   * it on a second thread while the weights, the start and the first assembly are
-   * computed here (cv_cholmod.c). Kept if a second setup (graded mesh) has the same
-   * layout. */
-  if (!st && s->ldlt_next && !cv_ldlt_fits(s->ldlt_next, &s->disc)) {
-    cv_ldlt_free(s->ldlt_next);
-    s->ldlt_next = NULL;
-  }
-  if (!st && !s->ldlt_next && s->method == CVAR_METHOD_NEWTON)
-    st = cv_ldlt_new(&s->disc, NULL, &s->ldlt_next, s->msg, sizeof s->msg);
-  if (!st) st = cv_disc_init_weights(&s->disc);
+  st = cv_disc_init(&s->disc, p, s, s->msg, sizeof s->msg);
   if (st) {
     if (st == CVAR_ENOMEM) cv_set_msg(s->msg, sizeof s->msg, "out of memory building the mesh");
     return st;
@@ -377,8 +365,6 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
     cv_free(Y0);
   }
 done:
-  cv_ldlt_free(s->ldlt_next); /* not taken by a Newton run (an error came first) */
-  s->ldlt_next = NULL;
   if (s->note[0]) {
     char m[sizeof s->msg];
     size_t ln = strlen(s->note), lm = strlen(s->msg);
