@@ -138,6 +138,7 @@ const cli_gallery_scene cli_gallery_scenes[] = {
   {"brachistochrone",
    "# the cycloid to its lowest point; time pi sqrt 2. The integrand is infinite at the\n"
    "# start: calcvar grades the mesh towards it and integrates in sqrt(x) by itself.\n"
+   "# The guess starts like the cycloid, y ~ x^(2/3).\n"
    "[scene]\n"
    "title     = Brachistochrone (singular start)\n"
    "interval  = 0, pi\n"
@@ -146,7 +147,7 @@ const cli_gallery_scene cli_gallery_scenes[] = {
    "[boundary]\n"
    "y = 0, 2\n"
    "[guess]\n"
-   "y = 2*sqrt(x/pi)\n"
+   "y = 2*(x/pi)^(2/3)\n"
    "[exact]\n"
    "action = 4.442882938158366\n"
    "[mesh]\n"

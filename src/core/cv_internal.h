@@ -219,7 +219,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
 typedef struct {
   int iterations, morse, degenerate;
   double action, gnorm;
-  char msg[320];
+  char msg[640];
 } cv_newton_result;
 
 struct cv_solver {
@@ -232,7 +232,7 @@ struct cv_solver {
 
   /* results of the last solve */
   cv_status status;
-  char msg[320];
+  char msg[640];
   int n, have;
   cv_disc disc;
   double *y;   /* nodes*n */
@@ -243,7 +243,7 @@ struct cv_solver {
   double adapt_tol, err_est;   /* adaptive refinement (cv_adapt.c) */
   int adapt_max, rounds;
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
-  char note[160];              /* what the solver decided on its own, prefixed to msg */
+  char note[256];              /* what the solver decided on its own, prefixed to msg */
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);

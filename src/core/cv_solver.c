@@ -168,12 +168,12 @@ static void straight_line(const cv_problem *p, double t, double *y) {
   }
 }
 
-/* Initial nodal values: user start, guess callback, or the straight line. Fixed ends
- * always win. */
+/* Initial nodal values: user start, guess callback, or (always with line = 1) the
+ * straight line. Fixed ends always win. */
 static cv_status initial_values(cv_solver *s, const cv_problem *p, const cv_disc *d,
-                                double *Y) {
+                                double *Y, int line) {
   int n = p->n;
-  if (s->start) {
+  if (s->start && !line) {
     if (s->start_len != d->ndof) {
       cv_set_msg(s->msg, sizeof s->msg,
                  "start vector has %d values but the mesh has %d nodes x %d unknowns",
@@ -181,7 +181,7 @@ static cv_status initial_values(cv_solver *s, const cv_problem *p, const cv_disc
       return CVAR_EINVAL;
     }
     memcpy(Y, s->start, (size_t)d->ndof * sizeof *Y);
-  } else if (p->guess) {
+  } else if (p->guess && !line) {
     double xb[CV_BATCH], *yb = cv_malloc((size_t)n * CV_BATCH * sizeof *yb);
     if (!yb) return CVAR_ENOMEM;
     for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
@@ -292,7 +292,7 @@ static cv_status setup(cv_solver *s, const cv_problem *p) {
     cv_set_msg(s->msg, sizeof s->msg, "out of memory for %d nodal values", s->disc.ndof);
     return CVAR_ENOMEM;
   }
-  st = initial_values(s, p, &s->disc, s->y);
+  st = initial_values(s, p, &s->disc, s->y, 0);
   if (st) return st;
   s->have = 1;
   detect_singular_ends(p, &s->disc, s->y);
@@ -345,8 +345,8 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
     goto done;
   }
   /* Newton from the start; if it fails to converge (not on bad input or a callback's
-   * abort), continuation from the same start, computed again, before giving up (theory
-   * HC-2). */
+   * abort), Newton from the straight line when the start was given, then continuation
+   * from the start, computed again, before giving up (theory HC-2). */
   st = cv_newton_run(s, p, &s->disc, s->y, s->mult, NULL);
   /* Globalisation failures only: not a Hessian singular at the start itself (continuation
    * cannot cure an invariance; one met on the way is the wandering iterate's), not an
@@ -355,11 +355,41 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
   int lost = st == CVAR_ESTALL || st == CVAR_EDIVERGED ||
              ((st == CVAR_ENONFINITE || st == CVAR_ESINGULAR) && s->iterations > 0) ||
              (st == CVAR_EMAXITER && s->maxit >= 20);
+  /* A given start or guess that leads nowhere: once more from the straight line between
+   * the end values (a guess steeper than the solution at a singular end starts Newton
+   * where the Hessian is indefinite, docs/faq.md): one Newton run, cheaper than the
+   * continuation below. If it fails too, the first attempt is what continues. */
+  if (lost && (s->start || p->guess) && p->nc == 0 && p->ni == 0) {
+    double *Y1 = cv_malloc((size_t)s->disc.ndof * sizeof *Y1);
+    if (Y1 && !initial_values(s, p, &s->disc, Y1, 1)) {
+      char keep[sizeof s->msg];
+      int it = s->iterations, morse = s->morse, deg = s->degenerate;
+      double act = s->action, gn = s->gnorm, *Yfail = s->y;
+      memcpy(keep, s->msg, sizeof keep);
+      s->y = Y1;
+      if (cv_newton_run(s, p, &s->disc, s->y, s->mult, NULL) == CVAR_OK) {
+        cv_free(Yfail);
+        st = CVAR_OK;
+        lost = 0;
+        size_t ln = strlen(s->note);
+        cv_set_msg(s->note + ln, sizeof s->note - ln,
+                   "the given start led to no solution, the straight line did; ");
+      } else {
+        cv_free(s->y);
+        s->y = Yfail;
+        s->iterations = it, s->morse = morse, s->degenerate = deg;
+        s->action = act, s->gnorm = gn;
+        memcpy(s->msg, keep, sizeof keep);
+      }
+    } else {
+      cv_free(Y1);
+    }
+  }
   if (lost && p->nc == 0 && p->ni == 0 && s->continuation) {
     double *Y0 = cv_malloc((size_t)s->disc.ndof * sizeof *Y0);
     char keep[sizeof s->msg];
     memcpy(keep, s->msg, sizeof keep);
-    cv_status st0 = Y0 ? initial_values(s, p, &s->disc, Y0) : CVAR_ENOMEM;
+    cv_status st0 = Y0 ? initial_values(s, p, &s->disc, Y0, 0) : CVAR_ENOMEM;
     if (!st0) st = cv_continuation_run(s, p, &s->disc, s->y, s->mult, Y0);
     else memcpy(s->msg, keep, sizeof keep); /* report Newton's failure */
     cv_free(Y0);
