@@ -239,7 +239,7 @@ struct cv_solver {
   double *mult; /* nodes*nc multiplier field, then ni integral multipliers */
   double action, gnorm, time;
   int iterations, morse, degenerate;
-  double t_assemble, t_factor; /* seconds in assembly / LDL^T factor+solve (for bench/) */
+  double t_assemble, t_factor; /* seconds in assembly / LDL^T (bench/; from 512 unknowns) */
   double adapt_tol, err_est;   /* adaptive refinement (cv_adapt.c) */
   int adapt_max, rounds;
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */

@@ -177,9 +177,12 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   if (scale == 0.0) scale = 1.0;
   double atol = s->atol * scale, *Ax = cv_ldlt_values(w.L);
 
-  double ta = cv_now();
+  /* Phase timers for bench/ (t_assemble, t_factor): on a system of a few unknowns the
+   * clock reads were an eighth of the solve, so small systems are not split. */
+  int timed = nf >= 512;
+  double ta = timed ? cv_now() : 0.0;
   st = eval_system(&kkt, h, &w, Y, M, &S, w.g, Ax, w.dreg);
-  s->t_assemble += cv_now() - ta;
+  if (timed) s->t_assemble += cv_now() - ta;
   if (st) {
     s->action = NAN;
     cv_set_msg(s->msg, sizeof s->msg, "%s at the initial guess; give a [guess] inside the "
@@ -199,7 +202,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   for (;;) {
     int neg;
     double dmin, dmax;
-    double tf = cv_now();
+    double tf = timed ? cv_now() : 0.0;
     st = cv_ldlt_factor(w.L, &neg, &dmin, &dmax, detail, sizeof detail);
     if (st == CVAR_OK && !(dmin > DEGENERATE_PIVOT)) st = CVAR_ESINGULAR;
     if (st) {
@@ -225,7 +228,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     s->morse = neg - ncon;
     for (int f = 0; f < nf; f++) w.delta[f] = -w.g[f];
     st = solve_refined(&w, nf, constrained);
-    s->t_factor += cv_now() - tf;
+    if (timed) s->t_factor += cv_now() - tf;
     if (st) {
       cv_set_msg(s->msg, sizeof s->msg, "CHOLMOD solve failed");
       goto cleanup;
@@ -276,12 +279,12 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     int accepted = 0, use_S = neg == 0 && !constrained && slope < 0;
     for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
       if (ls > 0) apply_step(&w, Yc, Mc, alpha);
-      ta = cv_now();
+      ta = timed ? cv_now() : 0.0;
       /* A step within the tolerance is the last one (taken in full below): the Hessian
        * there would not be used, so only F and the gradient are evaluated. */
       double *Axt = wn <= 1.0 ? NULL : Ax;
       cv_status ast = eval_system(&kkt, h, &w, w.Yt, w.Mt, &St, w.gt, Axt, w.dreg);
-      s->t_assemble += cv_now() - ta;
+      if (timed) s->t_assemble += cv_now() - ta;
       if (ast == CVAR_ECALLBACK || ast == CVAR_ENOMEM) {
         st = ast;
         cv_set_msg(s->msg, sizeof s->msg, "%s",
