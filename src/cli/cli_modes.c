@@ -24,7 +24,8 @@ static void usage(FILE *f)
         "  finds an equilibrium dL/dy = 0 (y' = 0) from the guess at the start of the\n"
         "  interval, forms M = d2L/dy'dy' and K = -d2L/dydy there and prints each w^2 of\n"
         "  K v = w^2 M v: stable (period 2 pi/w), unstable (growth rate sqrt(-w^2)) or\n"
-        "  neutral (w^2 = 0: a free translation or rotation), with its mode shape\n"
+        "  neutral (w^2 = 0: a free translation or rotation), with its mode shape; with\n"
+        "  gyroscopic terms (L_y'y not symmetric) also the motions of M y'' + G y' + K y = 0\n"
         "  --json FILE   the same as JSON ('-' for stdout)\n", f);
 }
 
@@ -63,6 +64,31 @@ static int write_json(FILE *f, const scene *s, const sc_modes *md)
   }
   json_object_set_new(o, "equilibrium", eqm);
   json_object_set_new(o, "modes", modes);
+  /* Addition to the contract: with gyroscopic terms, the motions of M y'' + G y' + K y = 0
+   * (docs/mechanics.md); absent when G = 0. */
+  if (md->ngyro > 0) {
+    json_t *g = json_object(), *gm = json_array();
+    if (!g || !gm) {
+      json_decref(g);
+      json_decref(gm);
+      goto done;
+    }
+    json_object_set_new(g, "max_abs_G", json_real(md->gyroscopic));
+    for (int k = 0; k < md->ngyro; k++) {
+      json_t *m = json_object();
+      if (!m) {
+        json_decref(g);
+        json_decref(gm);
+        goto done;
+      }
+      json_object_set_new(m, "kind", json_string(kind_name(md->gyro_kind[k])));
+      json_object_set_new(m, "omega", json_real(md->gyro_omega[k]));
+      json_object_set_new(m, "growth", json_real(md->gyro_growth[k]));
+      json_array_append_new(gm, m);
+    }
+    json_object_set_new(g, "modes", gm);
+    json_object_set_new(o, "gyroscopic", g);
+  }
   rc = json_dumpf(o, f, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
   if (rc == 0 && fputc('\n', f) == EOF)
     rc = -1;
@@ -94,8 +120,9 @@ static void write_text(FILE *f, const scene *s, const sc_modes *md)
   print_matrix(f, "M = L_y'y'", n, md->mass);
   print_matrix(f, "K = -L_yy", n, md->stiffness);
   if (md->gyroscopic > 0)
-    fprintf(f, "  note         L has gyroscopic terms (L_y'y not symmetric, max |G| = %.3g); "
-            "these modes leave them out\n", md->gyroscopic);
+    fprintf(f, "  note         L has gyroscopic terms (L_y'y not symmetric, max |G| = %.3g): "
+            "the modes of K v = w^2 M v below leave them out; the motions with them follow\n",
+            md->gyroscopic);
   fprintf(f, "\n  %-4s %-22s %-9s %-32s %s\n", "mode", "omega^2", "kind", "frequency or growth",
           "shape (v'Mv = 1)");
   for (int k = 0; k < n; k++) {
@@ -111,6 +138,23 @@ static void write_text(FILE *f, const scene *s, const sc_modes *md)
     for (int i = 0; i < n; i++)
       fprintf(f, " %s %.6g", s->unknowns[i], md->shape[k * n + i]);
     fprintf(f, "\n");
+  }
+  if (md->ngyro == 0)
+    return;
+  fprintf(f, "\n  with the gyroscopic terms, M y'' + G y' + K y = 0 (G = L_y'y - L_y'y^T):\n");
+  fprintf(f, "  %-4s %-9s %s\n", "", "kind", "frequency or growth");
+  for (int k = 0; k < md->ngyro; k++) {
+    double w = md->gyro_omega[k], r = md->gyro_growth[k];
+    char what[96];
+    if (md->gyro_kind[k] == SC_MODE_STABLE)
+      snprintf(what, sizeof what, "omega %.6g, period %.6g", w, TWO_PI / w);
+    else if (md->gyro_kind[k] == SC_MODE_UNSTABLE && w > 0)
+      snprintf(what, sizeof what, "growth rate %.6g, oscillating with omega %.6g", r, w);
+    else if (md->gyro_kind[k] == SC_MODE_UNSTABLE)
+      snprintf(what, sizeof what, "growth rate %.6g", r);
+    else
+      snprintf(what, sizeof what, "free motion");
+    fprintf(f, "  %-4d %-9s %s\n", k + 1, kind_name(md->gyro_kind[k]), what);
   }
 }
 

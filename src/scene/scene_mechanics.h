@@ -76,6 +76,13 @@ typedef struct {
   double *stiffness;   /* [n*n] K = -d2L/dy dy, row-major (symmetric) */
   double gyroscopic;   /* max |G_ij| of G = C - C^T, C_ij = d2L/dy'_i dy_j; the modes of
                           K v = w2 M v ignore G (docs/theory.md (P-10)) */
+  /* With G != 0, the motions of M y'' + G y' + K y = 0 (P-12): one entry per frequency,
+   * ngyro <= n of them, stable (omega > 0, growth 0), unstable (growth > 0, omega >= 0)
+   * or neutral (both 0); increasing omega, then increasing growth. ngyro = 0 if G = 0. */
+  int ngyro;
+  double *gyro_omega;      /* [n] Im lambda >= 0 */
+  double *gyro_growth;     /* [n] Re lambda >= 0 */
+  sc_mode_kind *gyro_kind; /* [n] */
 } sc_modes;
 
 /** |omega2| <= SC_MODES_NEUTRAL_RTOL * max_k |omega2_k| counts as zero (neutral); when K

@@ -1,6 +1,7 @@
 /* src/scene/scene_modes.c — equilibrium of a Lagrangian L(y, y') and its small
- * oscillations: Newton on dL/dy = 0 at y' = 0, then K v = omega2 M v with LAPACK
- * (docs/theory.md (P-9), (P-10)). SPDX-License-Identifier: MIT */
+ * oscillations: Newton on dL/dy = 0 at y' = 0, then K v = omega2 M v with LAPACK, and with
+ * gyroscopic terms the motions of M y'' + G y' + K y = 0 (docs/theory.md (P-9), (P-10),
+ * (P-12)). SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,6 +16,10 @@ void dsygv_(const int *itype, const char *jobz, const char *uplo, const int *n, 
             const int *lwork, int *info);
 void dsyev_(const char *jobz, const char *uplo, const int *n, double *a, const int *lda,
             double *w, double *work, const int *lwork, int *info);
+void dggev_(const char *jobvl, const char *jobvr, const int *n, double *a, const int *lda,
+            double *b, const int *ldb, double *alphar, double *alphai, double *beta,
+            double *vl, const int *ldvl, double *vr, const int *ldvr, double *work,
+            const int *lwork, int *info);
 
 enum { MAX_NEWTON = 100 };
 
@@ -84,6 +89,89 @@ static int newton_step(int n, const double *J, const double *g, double *step, do
   return 0;
 }
 
+/* The gyroscopic problem (P-12): lambda^2 M v + lambda G v + K v = 0 as the pencil
+ * [[0, I], [-K, -G]] z = lambda [[I, 0], [0, M]] z of order 2n (LAPACK dggev, no inverse
+ * of M). Of each pair lambda, -conj(lambda) of a conservative system one is kept: the
+ * eigenvalues with Im > 0 and Re >= 0 (up to round-off), the real ones with Re > 0, and
+ * half of the zero ones. Returns 0, or -1 if LAPACK fails (or -2 out of memory). */
+static int gyro_modes(sc_modes *md, const double *C)
+{
+  int n = md->n, N = 2 * n, info = 0, lw = -1;
+  double q = 0;
+  double *A = calloc((size_t)N * N * 2 + 3 * (size_t)N, sizeof *A);
+  if (!A)
+    return -2;
+  double *B = A + (size_t)N * N, *ar = B + (size_t)N * N, *ai = ar + N, *be = ai + N;
+  for (int i = 0; i < n; i++) {
+    A[i + (size_t)(n + i) * N] = 1.0;
+    B[i + (size_t)i * N] = 1.0;
+    for (int j = 0; j < n; j++) {
+      A[(n + i) + (size_t)j * N] = -md->stiffness[i * n + j];
+      A[(n + i) + (size_t)(n + j) * N] = -(C[i * n + j] - C[j * n + i]);
+      B[(n + i) + (size_t)(n + j) * N] = md->mass[i * n + j];
+    }
+  }
+  dggev_("N", "N", &N, A, &N, B, &N, ar, ai, be, NULL, &N, NULL, &N, &q, &lw, &info);
+  lw = (int)fmax(q, 8.0 * N);
+  double *work = malloc((size_t)lw * sizeof *work);
+  if (!work) {
+    free(A);
+    return -2;
+  }
+  dggev_("N", "N", &N, A, &N, B, &N, ar, ai, be, NULL, &N, NULL, &N, work, &lw, &info);
+  free(work);
+  if (info != 0) {
+    free(A);
+    return -1;
+  }
+  double big = 0;
+  for (int k = 0; k < N; k++) { /* B is positive definite: beta > 0, no infinite lambda */
+    ar[k] /= be[k], ai[k] /= be[k];
+    big = fmax(big, hypot(ar[k], ai[k]));
+  }
+  /* A free direction is a double zero with a Jordan block, computed as two eigenvalues of
+   * size sqrt(eps) |lambda|: "zero" is 1e-6 of the largest. Re lambda of a stable pair is
+   * round-off of a non-normal eigenproblem: "zero" is 1e-7 of the largest. */
+  double tol0 = 1e-6 * big, tolre = 1e-7 * big;
+  int nzero = 0, m = 0;
+  for (int k = 0; k < N; k++) {
+    double re = ar[k], im = ai[k];
+    if (hypot(re, im) <= tol0) {
+      nzero++;
+      continue;
+    }
+    if (im < 0 || re < -tolre || (fabs(im) <= tolre && re <= tolre))
+      continue; /* the partner of a kept one */
+    md->gyro_kind[m] = re > tolre ? SC_MODE_UNSTABLE : SC_MODE_STABLE;
+    md->gyro_growth[m] = re > tolre ? re : 0.0;
+    md->gyro_omega[m] = im > tolre ? im : 0.0;
+    m++;
+  }
+  for (int k = 0; k < nzero / 2 && m < n; k++, m++) {
+    md->gyro_kind[m] = SC_MODE_NEUTRAL;
+    md->gyro_omega[m] = md->gyro_growth[m] = 0.0;
+  }
+  /* order: neutral and stable by omega, then unstable by growth (insertion sort, m <= n) */
+  for (int a = 1; a < m; a++)
+    for (int b = a; b > 0; b--) {
+      int ub = md->gyro_kind[b] == SC_MODE_UNSTABLE;
+      int ua = md->gyro_kind[b - 1] == SC_MODE_UNSTABLE;
+      double kb = ub ? md->gyro_growth[b] : md->gyro_omega[b];
+      double ka = ua ? md->gyro_growth[b - 1] : md->gyro_omega[b - 1];
+      if (ua < ub || (ua == ub && ka <= kb))
+        break;
+      double t = md->gyro_omega[b];
+      md->gyro_omega[b] = md->gyro_omega[b - 1], md->gyro_omega[b - 1] = t;
+      t = md->gyro_growth[b];
+      md->gyro_growth[b] = md->gyro_growth[b - 1], md->gyro_growth[b - 1] = t;
+      sc_mode_kind kk = md->gyro_kind[b];
+      md->gyro_kind[b] = md->gyro_kind[b - 1], md->gyro_kind[b - 1] = kk;
+    }
+  md->ngyro = m;
+  free(A);
+  return 0;
+}
+
 static int fail(const scene *s, char *err, size_t errlen, int code, const char *msg)
 {
   sc_err(err, errlen, s->file, 0, "%s", msg);
@@ -120,9 +208,13 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
   md->shape = malloc((size_t)nn * sizeof *md->shape);
   md->mass = malloc((size_t)nn * sizeof *md->mass);
   md->stiffness = malloc((size_t)nn * sizeof *md->stiffness);
+  md->gyro_omega = malloc((size_t)n * sizeof *md->gyro_omega);
+  md->gyro_growth = malloc((size_t)n * sizeof *md->gyro_growth);
+  md->gyro_kind = malloc((size_t)n * sizeof *md->gyro_kind);
   A = malloc((size_t)(2 * nn + 2 * n) * sizeof *A);
   if (!outs || !val || !md->equilibrium || !md->omega2 || !md->kind || !md->shape ||
-      !md->mass || !md->stiffness || !A)
+      !md->mass || !md->stiffness || !A || !md->gyro_omega || !md->gyro_growth ||
+      !md->gyro_kind)
     goto cleanup;
 
   /* The expressions: L_y, L_yy, L_y'y', L_y'y (P-9). */
@@ -196,12 +288,16 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
   /* M, K = -L_yy, gyroscopic part of C = L_y'y (P-10). */
   const double *Mv = val + n + nn, *C = val + n + 2 * nn;
   md->gyroscopic = 0;
+  double cmax = maxabs(nn, C);
   for (int i = 0; i < n; i++)
     for (int j = 0; j < n; j++) {
       md->mass[i * n + j] = Mv[i * n + j];
       md->stiffness[i * n + j] = 0.0 - J[i * n + j]; /* no -0 in the output */
       md->gyroscopic = fmax(md->gyroscopic, fabs(C[i * n + j] - C[j * n + i]));
     }
+  /* G below round-off of C itself (the two mixed partials differ in their last bits) */
+  if (md->gyroscopic <= 1e-13 * cmax)
+    md->gyroscopic = 0;
 
   /* K v = omega2 M v: dsygv, type 1, eigenvectors with V^T M V = I, omega2 increasing. */
   double *Ka = A, *Mb = A + nn;
@@ -237,6 +333,16 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
     for (int i = 0; i < n; i++)
       md->shape[k * n + i] = sg * v[i] + 0.0;
   }
+  if (md->gyroscopic > 0) {
+    int g = gyro_modes(md, C);
+    if (g == -2)
+      goto cleanup;
+    if (g < 0) {
+      rc = fail(s, err, errlen, SC_MODES_NO_EQUILIBRIUM,
+                "the gyroscopic eigenproblem did not converge (LAPACK dggev)");
+      goto cleanup;
+    }
+  }
   rc = SC_MODES_OK;
 cleanup:
   if (rc == SC_MODES_NOMEM)
@@ -260,5 +366,8 @@ void scene_modes_free(sc_modes *md)
   free(md->shape);
   free(md->mass);
   free(md->stiffness);
+  free(md->gyro_omega);
+  free(md->gyro_growth);
+  free(md->gyro_kind);
   memset(md, 0, sizeof *md);
 }

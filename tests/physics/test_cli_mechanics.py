@@ -186,6 +186,63 @@ check("free pair kinds", kinds == ["neutral", "stable"], json.dumps(o))
 if kinds == ["neutral", "stable"]:
     check("free pair omega2", abs(o["modes"][1]["omega2"] - 6) < 1e-12, json.dumps(o))
 
+# Gyroscopic terms (docs/theory.md (P-12)): the motions of M y'' + G y' + K y = 0, an
+# addition to the contract under the key "gyroscopic", absent when G = 0 (checked above).
+def gyro(path, *sets):
+    o = run_json("modes", path, *sets)
+    g = o.get("gyroscopic", {})
+    return o, g, [(m["kind"], m["omega"], m["growth"]) for m in g.get("modes", [])]
+
+
+trap = os.path.join(data, "magnetic_trap.scene")
+for k, B in ((3.0, 2.0), (-0.5, 2.0), (0.0, 1.0)):
+    o, g, ms = gyro(trap, "--set", "k=%r" % k, "--set", "B=%r" % B)
+    check("trap keys", set(o) == {"equilibrium", "modes", "gyroscopic"} and
+          set(g) == {"max_abs_G", "modes"}, json.dumps(o))
+    check("trap max |G| = B", abs(g.get("max_abs_G", 0) - B) < 1e-15, json.dumps(g))
+    r = math.sqrt(k + B * B / 4)
+    exact = sorted([abs(r - B / 2), r + B / 2])
+    if k == 0.0:  # r - B/2 = 0: a free drift (neutral) and the cyclotron motion
+        check("trap k=0 kinds", [m[0] for m in ms] == ["neutral", "stable"], json.dumps(g))
+        check("trap k=0 cyclotron omega", len(ms) == 2 and abs(ms[1][1] - B) < 1e-12 * B,
+              json.dumps(g))
+        continue
+    check("trap k=%g kinds" % k, [m[0] for m in ms] == ["stable", "stable"], json.dumps(g))
+    for (kind, w, gr), w_ex in zip(ms, exact):
+        check("trap k=%g B=%g omega %g" % (k, B, w_ex), abs(w - w_ex) < 1e-12 * (1 + w_ex) and
+              gr == 0, json.dumps(g))
+    if k < 0:  # K alone says unstable: the field is what confines
+        check("trap k<0: K-only modes unstable",
+              [m["kind"] for m in o["modes"]] == ["unstable", "unstable"], json.dumps(o))
+o, g, ms = gyro(trap, "--set", "k=-2", "--set", "B=2")  # k + B^2/4 = -1: growth 1, omega 1
+check("trap unstable: one growing oscillation", len(ms) == 1 and ms[0][0] == "unstable" and
+      abs(ms[0][1] - 1) < 1e-12 and abs(ms[0][2] - 1) < 1e-12, json.dumps(g))
+r = run("modes", trap)
+check("modes text: gyroscopic table", "with the gyroscopic terms" in r.stdout and
+      "omega 1, period 6.28319" in r.stdout and "omega 3, period 2.0944" in r.stdout, r.stdout)
+
+# Lagrange point L4: lambda^4 + lambda^2 + 27 mu (1 - mu) / 4 = 0; stable for mu < 0.0385.
+l4 = os.path.join(data, "lagrange_l4.scene")
+for mu in (0.01, 0.03, 0.05):
+    o, g, ms = gyro(l4, "--set", "mu=%r" % mu)
+    eq = o.get("equilibrium", {})
+    check("L4 equilibrium mu=%g" % mu, abs(eq.get("x", 0) - (0.5 - mu)) < 1e-12 and
+          abs(eq.get("y", 0) - math.sqrt(3) / 2) < 1e-12, json.dumps(eq))
+    check("L4 K-only modes unstable (a potential maximum)",
+          [m["kind"] for m in o.get("modes", [])] == ["unstable", "unstable"], json.dumps(o))
+    d = 1 - 27 * mu * (1 - mu)
+    if d > 0:
+        exact = sorted(math.sqrt((1 + s * math.sqrt(d)) / 2) for s in (-1, 1))
+        check("L4 mu=%g stable" % mu, [m[0] for m in ms] == ["stable", "stable"], json.dumps(g))
+        for (kind, w, gr), w_ex in zip(ms, exact):
+            check("L4 mu=%g omega %.6f" % (mu, w_ex), abs(w - w_ex) < 1e-10, json.dumps(g))
+    else:
+        lam = __import__("cmath").sqrt((-1 + __import__("cmath").sqrt(d)) / 2)
+        lam = complex(abs(lam.real), abs(lam.imag))
+        check("L4 mu=%g unstable" % mu, len(ms) == 1 and ms[0][0] == "unstable" and
+              abs(ms[0][1] - lam.imag) < 1e-10 and abs(ms[0][2] - lam.real) < 1e-10,
+              "%s vs %r" % (json.dumps(g), lam))
+
 # Bad inputs: clear messages.
 r = run("modes", os.path.join(problems, "graded_index_ray.scene"), expect_rc=2)
 check("modes explicit variable message", "graded_index_ray.scene:8: the integrand depends "
