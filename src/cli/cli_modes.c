@@ -4,8 +4,8 @@
  *
  * The numbers come from scene_modes_new (src/scene/scene_modes.c). Exit status: 0 modes
  * found; 1 no equilibrium from the guess, M not positive definite, or non-finite values
- * (nothing written); 2 bad input, including a scene whose integrand depends on the
- * variable or that has constraints (modes does not apply to it).
+ * (nothing written); 2 bad input, including a scene whose integrand or a constraint
+ * depends on the variable, or that has integral constraints (modes does not apply).
  */
 #include <jansson.h>
 #include <math.h>
@@ -25,7 +25,9 @@ static void usage(FILE *f)
         "  interval, forms M = d2L/dy'dy' and K = -d2L/dydy there and prints each w^2 of\n"
         "  K v = w^2 M v: stable (period 2 pi/w), unstable (growth rate sqrt(-w^2)) or\n"
         "  neutral (w^2 = 0: a free translation or rotation), with its mode shape; with\n"
-        "  gyroscopic terms (L_y'y not symmetric) also the motions of M y'' + G y' + K y = 0\n"
+        "  gyroscopic terms (L_y'y not symmetric) also the motions of M y'' + G y' + K y = 0;\n"
+        "  with [constraints] G(y) = 0 the equilibrium on them, the multipliers, and the\n"
+        "  modes along them\n"
         "  --json FILE   the same as JSON ('-' for stdout)\n", f);
 }
 
@@ -46,7 +48,7 @@ static int write_json(FILE *f, const scene *s, const sc_modes *md)
   }
   for (int i = 0; i < n; i++)
     json_object_set_new(eqm, s->unknowns[i], json_real(md->equilibrium[i]));
-  for (int k = 0; k < n; k++) {
+  for (int k = 0; k < md->nmodes; k++) {
     json_t *m = json_object(), *sh = json_object();
     if (!m || !sh) {
       json_decref(m);
@@ -64,6 +66,15 @@ static int write_json(FILE *f, const scene *s, const sc_modes *md)
   }
   json_object_set_new(o, "equilibrium", eqm);
   json_object_set_new(o, "modes", modes);
+  /* Addition to the contract: the multipliers of [constraints] at the equilibrium. */
+  if (md->nc > 0) {
+    json_t *mu = json_object();
+    if (!mu)
+      goto done;
+    for (int c = 0; c < md->nc; c++)
+      json_object_set_new(mu, s->cons[c].name, json_real(md->multipliers[c]));
+    json_object_set_new(o, "multipliers", mu);
+  }
   /* Addition to the contract: with gyroscopic terms, the motions of M y'' + G y' + K y = 0
    * (docs/mechanics.md); absent when G = 0. */
   if (md->ngyro > 0) {
@@ -115,17 +126,24 @@ static void write_text(FILE *f, const scene *s, const sc_modes *md)
   for (int i = 0; i < n; i++)
     fprintf(f, " %s = %.15g%s", s->unknowns[i], md->equilibrium[i], i + 1 < n ? "," : "");
   fprintf(f, "\n               (Newton from the guess at %s = %.15g: %d iteration%s, "
-          "max |dL/dy| = %.2g)\n", s->variable, s->a, md->iterations,
-          md->iterations == 1 ? "" : "s", md->residual);
+          "max |dL/dy%s| = %.2g)\n", s->variable, s->a, md->iterations,
+          md->iterations == 1 ? "" : "s", md->nc ? " + lambda.dG/dy|, |G" : "", md->residual);
+  for (int c = 0; c < md->nc; c++)
+    fprintf(f, "  %-12s lambda_%s = %.15g (multiplier of the constraint %s = 0)\n",
+            c ? "" : "multipliers", s->cons[c].name, md->multipliers[c], s->cons[c].name);
+  if (md->nc > 0)
+    fprintf(f, "  %-12s %d mode%s on the constraints' tangent space (%d unknowns - %d "
+            "constraint%s)\n", "constrained", md->nmodes, md->nmodes == 1 ? "" : "s", n,
+            md->nc, md->nc == 1 ? "" : "s");
   print_matrix(f, "M = L_y'y'", n, md->mass);
-  print_matrix(f, "K = -L_yy", n, md->stiffness);
+  print_matrix(f, md->nc ? "K = -(L+l.G)_yy" : "K = -L_yy", n, md->stiffness);
   if (md->gyroscopic > 0)
     fprintf(f, "  note         L has gyroscopic terms (L_y'y not symmetric, max |G| = %.3g): "
             "the modes of K v = w^2 M v below leave them out; the motions with them follow\n",
             md->gyroscopic);
   fprintf(f, "\n  %-4s %-22s %-9s %-32s %s\n", "mode", "omega^2", "kind", "frequency or growth",
           "shape (v'Mv = 1)");
-  for (int k = 0; k < n; k++) {
+  for (int k = 0; k < md->nmodes; k++) {
     double w2 = md->omega2[k];
     char what[64];
     if (md->kind[k] == SC_MODE_STABLE)

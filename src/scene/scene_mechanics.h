@@ -66,14 +66,17 @@ enum {
 /** Equilibrium and normal modes. Arrays are owned (scene_modes_free). */
 typedef struct {
   int n;
+  int nc;              /* pointwise constraints G_c(y) = 0 (P-13) */
+  int nmodes;          /* n - nc: modes on the constraints' tangent space */
   double *equilibrium; /* [n] */
+  double *multipliers; /* [nc]: lambda_c of L + lambda.G at the equilibrium */
   double residual;     /* max |dL/dy_i| at the equilibrium */
   int iterations;      /* Newton iterations for the equilibrium */
-  double *omega2;      /* [n], increasing */
-  sc_mode_kind *kind;  /* [n] */
-  double *shape;       /* [n*n]: mode k is shape[k*n .. k*n + n-1], v^T M v = 1 */
+  double *omega2;      /* [nmodes], increasing */
+  sc_mode_kind *kind;  /* [nmodes] */
+  double *shape;       /* [nmodes*n]: mode k is shape[k*n .. k*n + n-1], v^T M v = 1 */
   double *mass;        /* [n*n] M, row-major (symmetric) */
-  double *stiffness;   /* [n*n] K = -d2L/dy dy, row-major (symmetric) */
+  double *stiffness;   /* [n*n] K = -d2(L + lambda.G)/dy dy, row-major (symmetric) */
   double gyroscopic;   /* max |G_ij| of G = C - C^T, C_ij = d2L/dy'_i dy_j; the modes of
                           K v = w2 M v ignore G (docs/theory.md (P-10)) */
   /* With G != 0, the motions of M y'' + G y' + K y = 0 (P-12): one entry per frequency,

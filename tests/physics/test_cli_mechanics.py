@@ -243,6 +243,41 @@ for mu in (0.01, 0.03, 0.05):
               abs(ms[0][1] - lam.imag) < 1e-10 and abs(ms[0][2] - lam.real) < 1e-10,
               "%s vs %r" % (json.dumps(g), lam))
 
+# Pointwise constraints (docs/theory.md (P-13)): modes on the constraints' tangent space, the
+# multipliers as an addition to the contract. The Cartesian pendulum hangs at (0, -l) with
+# lambda = -g/(2l) (tension -2 l lambda = m g) and omega^2 = g/l; the Cartesian double
+# pendulum has the angle form's omega^2 = (g/l)(2 -+ sqrt 2) and tensions 2mg and mg.
+o = run_json("modes", os.path.join(problems, "pendulum_cartesian.scene"))
+check("Cartesian pendulum keys", set(o) == {"equilibrium", "modes", "multipliers"}, sorted(o))
+ms = o.get("modes", [])
+check("Cartesian pendulum: one mode, omega2 = g/l", len(ms) == 1 and
+      abs(ms[0]["omega2"] - 9.81) < 1e-12 * 9.81 and ms[0]["kind"] == "stable", json.dumps(o))
+check("Cartesian pendulum: tension m g", abs(-2 * o.get("multipliers", {}).get("rod", 0) - 9.81)
+      < 1e-12 * 9.81, json.dumps(o))
+dpc = os.path.join(data, "double_pendulum_cartesian.scene")
+for sets, l, g in (((), 1.0, 9.81), (("--set", "l=0.7", "--set", "g=3.25"), 0.7, 3.25)):
+    o = run_json("modes", dpc, *sets)
+    ms = o.get("modes", [])
+    check("Cartesian double pendulum: 2 modes", len(ms) == 2, json.dumps(o))
+    for k, md in enumerate(ms[:2]):
+        w2 = g / l * (2 - math.sqrt(2) if k == 0 else 2 + math.sqrt(2))
+        check("Cartesian double pendulum omega2[%d] l=%g" % (k, l),
+              abs(md["omega2"] - w2) <= 1e-12 * w2, "%r vs %r" % (md["omega2"], w2))
+        v = md["shape"]
+        vmv = sum(v[c] ** 2 for c in ("x1", "y1", "x2", "y2"))  # M = I
+        check("Cartesian double pendulum unit M-norm", abs(vmv - 1) < 1e-13, repr(vmv))
+        # the angle form's shape (a, b) = (x1 / l, (x2 - x1) / l) up to scale: b/a = +-sqrt 2
+        a, b = v["x1"] / l, (v["x2"] - v["x1"]) / l
+        check("Cartesian double pendulum shape ratio", abs(b / a - (math.sqrt(2) if k == 0
+              else -math.sqrt(2))) < 1e-10, json.dumps(v))
+    mu = o.get("multipliers", {})
+    check("Cartesian double pendulum tensions 2mg, mg",
+          abs(-2 * l * mu.get("rod1", 0) - 2 * g) < 1e-12 * g and
+          abs(-2 * l * mu.get("rod2", 0) - g) < 1e-12 * g, json.dumps(mu))
+r = run("modes", dpc)
+check("modes text: constrained", "2 modes on the constraints' tangent space" in r.stdout and
+      "lambda_rod1 = -9.81" in r.stdout, r.stdout)
+
 # Bad inputs: clear messages.
 r = run("modes", os.path.join(problems, "graded_index_ray.scene"), expect_rc=2)
 check("modes explicit variable message", "graded_index_ray.scene:8: the integrand depends "
@@ -251,8 +286,9 @@ r = run("modes", os.path.join(data, "no_kinetic.scene"), expect_rc=1)
 check("modes M singular message", "not positive definite" in r.stderr, r.stderr)
 r = run("modes", os.path.join(problems, "catenary.scene"), expect_rc=1)
 check("modes no equilibrium message", "no equilibrium" in r.stderr, r.stderr)
-r = run("modes", os.path.join(problems, "pendulum_cartesian.scene"), expect_rc=2)
-check("modes constraints message", "does not handle constraints" in r.stderr, r.stderr)
+r = run("modes", os.path.join(problems, "hanging_chain.scene"), expect_rc=2)
+check("modes integral constraints message", "does not handle integral constraints" in r.stderr,
+      r.stderr)
 run("modes", os.path.join(problems, "double_pendulum.scene"), "--elements", "3", expect_rc=2)
 run("equations", os.path.join(problems, "double_pendulum.scene"), "--csv", "-", expect_rc=2)
 run("equations", os.path.join(data, "missing.scene"), expect_rc=2)

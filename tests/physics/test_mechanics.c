@@ -311,10 +311,18 @@ static void special_cases(void)
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=y\nintegrand=y'^2/2 - x*y^2\n"
        "[boundary]\ny=0,0\n",
        SC_MODES_EXPLICIT, "t.scene:5: the integrand depends explicitly on x"},
-      {"constraint",
+      {"constraint (Cartesian pendulum, g = l = 1)",
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=x1,y1\nintegrand=(x1'^2+y1'^2)/2 - y1\n"
        "[boundary]\nx1=0,0\ny1=-1,-1\n[constraints]\nrod = x1^2 + y1^2 - 1\n",
-       SC_MODES_CONSTRAINED, "t.scene:10: modes does not handle constraints"},
+       SC_MODES_OK, NULL},
+      {"integral constraint",
+       "[scene]\ntitle=t\ninterval=0,1\nunknowns=y\nintegrand=y'^2/2 - y^2/2\n"
+       "[boundary]\ny=0,0\n[integrals]\narea = y, 1\n",
+       SC_MODES_CONSTRAINED, "t.scene:9: modes does not handle integral constraints"},
+      {"moving constraint",
+       "[scene]\ntitle=t\ninterval=0,1\nunknowns=a,b\nintegrand=(a'^2+b'^2)/2\n"
+       "[boundary]\na=0,free\nb=0,free\n[constraints]\nslide = a - x*b\n",
+       SC_MODES_EXPLICIT, "t.scene:10: the constraint 'slide' depends on x"},
       {"not finite at the guess",
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=y\nintegrand=y'^2/2 + log(y)\n"
        "[boundary]\ny=0,1\n",
@@ -330,6 +338,17 @@ static void special_cases(void)
     truth(cases[c].what, rc == cases[c].rc, err[0] ? err : "(no message)");
     if (cases[c].msg)
       truth(cases[c].what, strstr(err, cases[c].msg) != NULL, err);
+    if (rc == SC_MODES_OK && strstr(cases[c].what, "Cartesian pendulum")) {
+      /* hanging at (0, -1): lambda = -g/(2l) = -1/2, one mode on the circle, omega2 = g/l,
+       * shape along x with unit mass norm */
+      truth("pendulum: one constrained mode", md.nmodes == 1 && md.nc == 1, "nmodes");
+      near("pendulum: x", md.equilibrium[0], 0, 1e-14);
+      near("pendulum: y", md.equilibrium[1], -1, 1e-14);
+      near("pendulum: lambda", md.multipliers[0], -0.5, 1e-14);
+      near("pendulum: omega2", md.omega2[0], 1, 1e-13);
+      near("pendulum: shape x", md.shape[0], 1, 1e-13);
+      near("pendulum: shape y", md.shape[1], 0, 1e-13);
+    }
     if (rc == SC_MODES_OK && c == 0) {
       truth("spring: lower mode neutral", md.kind[0] == SC_MODE_NEUTRAL, "neutral");
       near("spring: lower omega2", md.omega2[0], 0, 1e-12);
