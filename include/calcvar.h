@@ -13,7 +13,10 @@
  * go to caller-owned buffers whose lengths are documented per function.
  *
  * Thread safety: distinct handles may be used from distinct threads; one handle must not be
- * used concurrently. Callbacks are never re-entered on the same handle.
+ * used concurrently. Callbacks are never re-entered on the same handle, and every callback
+ * runs on the thread that called cv_solve. On large systems (50 000 unknowns and more) a
+ * solve runs CHOLMOD's symbolic analysis of the sparse pattern on one extra thread of its
+ * own, which it joins before it returns; no user code runs there.
  *
  * Minimal use (the catenary, see examples/catenary.c):
  * \code
