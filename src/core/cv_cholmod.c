@@ -23,9 +23,10 @@ struct cv_ldlt {
 /* Below this many unknowns the analysis takes under ~3 ms and a thread is not worth it. */
 #define ASYNC_ANALYSIS_MIN 50000
 
-/* The analysis reads only the pattern of A (A->p, A->i), which is final once cv_ldlt_new
- * returns; the caller meanwhile fills A->x, evaluates the integrand and so on, and the
- * first cv_ldlt_factor joins. No user callback runs on this thread. */
+/* The analysis reads only the pattern of A (A->p, A->i; its transposes are made without
+ * values), which is final once cv_ldlt_new returns; the caller meanwhile fills A->x,
+ * evaluates the integrand and so on, and the first cv_ldlt_factor joins. No user callback
+ * runs on this thread. */
 static void *analyze_main(void *arg) {
   cv_ldlt *L = arg;
   L->L = cholmod_analyze(L->A, &L->c);
@@ -79,9 +80,9 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
   }
   int *Ap = L->A->p, *Ai = L->A->i;
   nz = (size_t)cv_disc_pattern(d, Ap, gof);
-  for (int c = 0; c < nfree; c++) {
-    int len = Ap[c + 1] - Ap[c], r0 = c + 1 - len;
-    for (int k = 0; k < len; k++) Ai[Ap[c] + k] = r0 + k;
+  for (int c = 0; c < nfree; c++) { /* column c: rows c + 1 - length .. c */
+    int cl = Ap[c + 1] - Ap[c], r0 = c + 1 - cl;
+    for (int k = 0; k < cl; k++) Ai[Ap[c] + k] = r0 + k;
   }
   memset(L->A->x, 0, (nz ? nz : 1) * sizeof(double));
   /* At 10^6 unknowns the analysis is about a tenth of a Newton solve, most of it faulting
