@@ -3,11 +3,14 @@
  * floor of DESIGN.md measured in the same run: a hand-written Newton for the same
  * discretisation (2-point Gauss, analytic tridiagonal Hessian, Thomas algorithm).
  * Usage: bench_newton [max_exponent (default 7)] [degree (default 1)] [min_exponent (3)]
- * Peak memory: run one size under /usr/bin/time -v (docs/robustness.md has the figures).
+ * peak_B_el: the process's peak resident memory so far (getrusage) per element; sizes grow
+ * down the table, so from 10^5 on it is that size's peak (below, the process's own few
+ * MB dominate). Constant down the table = memory linear in N.
  * SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/resource.h>
 
 #include "core/cv_internal.h"
 
@@ -75,8 +78,9 @@ int main(int argc, char **argv) {
   int minexp = argc > 3 ? atoi(argv[3]) : 3;
   double c = 2 * cosh(0.5);
   printf("catenary, degree %d: per element per Newton iteration\n", deg);
-  printf("%10s %6s %12s %12s %12s %10s %12s %10s %7s\n", "elements", "iters", "assemble_ns",
-         "ldlt_ns", "total_ns", "total_s", "max_err", "floor_ns", "ratio");
+  printf("%10s %6s %12s %12s %12s %10s %12s %10s %7s %10s\n", "elements", "iters",
+         "assemble_ns", "ldlt_ns", "total_ns", "total_s", "max_err", "floor_ns", "ratio",
+         "peak_B_el");
   /* One throwaway solve first: the first in a process also pays for resolving CHOLMOD's
    * symbols and growing the heap, which is not a cost per element. */
   {
@@ -106,10 +110,12 @@ int main(int argc, char **argv) {
       double x = cv_disc_node_x(&s->disc, j);
       err = fmax(err, fabs(s->y[j] - 2 * cosh(x / 2)));
     }
+    struct rusage ru;
+    double peak = getrusage(RUSAGE_SELF, &ru) == 0 ? 1024.0 * ru.ru_maxrss / E : NAN;
     double fl = deg == 1 ? floor_ns(E) : NAN;
-    printf("%10d %6d %12.1f %12.1f %12.1f %10.4f %12.3e %10.1f %7.2f %s\n", E, it,
+    printf("%10d %6d %12.1f %12.1f %12.1f %10.4f %12.3e %10.1f %7.2f %10.0f %s\n", E, it,
            s->t_assemble * per, s->t_factor * per, cv_solver_get_time(s) * per,
-           cv_solver_get_time(s), err, fl, cv_solver_get_time(s) * per / fl,
+           cv_solver_get_time(s), err, fl, cv_solver_get_time(s) * per / fl, peak,
            st ? cv_status_name(st) : "");
     cv_solver_free(s);
     cv_problem_free(p);
