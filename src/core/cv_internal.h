@@ -243,7 +243,7 @@ struct cv_solver {
   double adapt_tol, err_est;   /* adaptive refinement (cv_adapt.c) */
   int adapt_max, rounds;
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
-  char note[256];              /* what the solver decided on its own, prefixed to msg */
+  char note[320];              /* what the solver decided on its own, prefixed to msg */
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);

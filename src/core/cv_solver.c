@@ -368,12 +368,13 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
       memcpy(keep, s->msg, sizeof keep);
       s->y = Y1;
       if (cv_newton_run(s, p, &s->disc, s->y, s->mult, NULL) == CVAR_OK) {
+        size_t ln = strlen(s->note);
+        cv_set_msg(s->note + ln, sizeof s->note - ln,
+                   "from the given start Newton failed after %d iterations (%s), from the "
+                   "straight line it converged; ", it, cv_strerror(st));
         cv_free(Yfail);
         st = CVAR_OK;
         lost = 0;
-        size_t ln = strlen(s->note);
-        cv_set_msg(s->note + ln, sizeof s->note - ln,
-                   "the given start led to no solution, the straight line did; ");
       } else {
         cv_free(s->y);
         s->y = Yfail;
