@@ -112,7 +112,7 @@ static cv_status call_integrand(cv_assembler *as, cv_integrand_fn Fn, void *user
   as->cb_status = rc;
   if (rc < 0) return CVAR_ECALLBACK;
   if (rc > 0) return CVAR_ENONFINITE;
-  return CVAR_OK; /* finiteness is checked on the sums, see cv_assemble */
+  return CVAR_OK; /* finiteness is checked per element, see cv_assemble */
 }
 
 /* Kernel for one unknown (n = 1) over the elements e0 .. e0+ne-1 of a batch, inlined with
@@ -264,7 +264,6 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
       } else {
         for (int a = 0; a < nl; a++) flp[a] = cv_disc_fidx(d, (long)e * p * n + a);
       }
-      {
       if (Ax) memset(K, 0, (size_t)nl * nl * sizeof *K);
       if (g) memset(gl, 0, (size_t)nl * sizeof *gl);
       for (int k = 0; k < q; k++) {
@@ -293,7 +292,6 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
               }
             }
         }
-      }
       }
       if (g)
         for (int a = 0; a < nl; a++) {

@@ -254,7 +254,7 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
   int n = s->n, nn = n * n, nc = s->ncons, N = n + nc, rc = SC_MODES_NOMEM, info = 0;
   ex_dag *d = s->dag;
   ex_id *outs = NULL;
-  double *val = NULL, *work = NULL, *A = NULL, *Jk = NULL, *T = NULL, *Ktot = NULL;
+  double *val = NULL, *work = NULL, *A = NULL, *Jk = NULL, *T = NULL, *Ag = NULL;
   memset(md, 0, sizeof *md);
   md->n = n;
   if (err && errlen)
@@ -300,10 +300,10 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
   A = malloc((size_t)(2 * N * N + 2 * N) * sizeof *A);
   Jk = malloc((size_t)(N * N + N) * sizeof *Jk);
   T = malloc((size_t)(nn + 3 * nn) * sizeof *T);
-  Ktot = malloc((size_t)nn * sizeof *Ktot);
+  Ag = malloc((size_t)nn * sizeof *Ag); /* constraint gradients, n x nc column-major */
   if (!outs || !val || !md->equilibrium || !md->multipliers || !md->omega2 || !md->kind ||
       !md->shape || !md->mass || !md->stiffness || !A || !md->gyro_omega ||
-      !md->gyro_growth || !md->gyro_kind || !Jk || !T || !Ktot)
+      !md->gyro_growth || !md->gyro_kind || !Jk || !T || !Ag)
     goto cleanup;
   md->nc = nc;
 
@@ -422,7 +422,6 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
    * C_r = T'CT; without constraints T = I and these are M, K, C. */
   double *Mr = T + nn, *Kr = Mr + nn, *Cr = Kr + nn;
   if (nc > 0) {
-    double *Ag = Ktot; /* the constraint gradients as columns, n x nc column-major */
     for (int c = 0; c < nc; c++)
       for (int i = 0; i < n; i++)
         Ag[i + (size_t)c * n] = val[n + 3 * nn + c * per + 1 + i];
@@ -517,7 +516,7 @@ cleanup:
   free(A);
   free(Jk);
   free(T);
-  free(Ktot);
+  free(Ag);
   if (rc != SC_MODES_OK)
     scene_modes_free(md);
   return rc;
