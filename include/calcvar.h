@@ -153,6 +153,13 @@ cv_problem *cv_problem_new(int n, double a, double b, cv_status *why);
 void cv_problem_free(cv_problem *p);
 /** The integrand (required before solving). `user` is passed through untouched. */
 cv_status cv_problem_set_integrand(cv_problem *p, cv_integrand_fn F, void *user);
+/** Releases user data handed to the problem (see the `_owned` setters). */
+typedef void (*cv_release_fn)(void *user);
+/** Like cv_problem_set_integrand, but the problem owns `user`: cv_problem_free (or the next
+ * integrand set) calls release(user) when release is not NULL. On failure release(user) is
+ * called before returning, so the caller never has to. */
+cv_status cv_problem_set_integrand_owned(cv_problem *p, cv_integrand_fn F, void *user,
+                                         cv_release_fn release);
 /** Fix unknown k (0 <= k < n) to ya at a and yb at b. Values must be finite. */
 cv_status cv_problem_set_dirichlet(cv_problem *p, int k, double ya, double yb);
 /** Fix unknown k at one end: end 0 is a, end 1 is b. */
@@ -196,6 +203,13 @@ cv_status cv_problem_add_constraint(cv_problem *p, cv_constraint_fn G, void *use
  * the partials asked for. *index (may be NULL) receives its number, 0, 1, ... */
 cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, void *user, double c,
                                   int *index);
+/** cv_problem_add_constraint whose `user` the problem owns and
+ * releases as in cv_problem_set_integrand_owned (also on failure). */
+cv_status cv_problem_add_constraint_owned(cv_problem *p, cv_constraint_fn G, void *user,
+                                          cv_release_fn release, int *index);
+/** cv_problem_add_integral whose `user` the problem owns (see above). */
+cv_status cv_problem_add_integral_owned(cv_problem *p, cv_integrand_fn K, void *user,
+                                        cv_release_fn release, double c, int *index);
 /** The number of pointwise constraints added so far. */
 int cv_problem_get_num_constraints(const cv_problem *p);
 /** The number of integral constraints added so far. */

@@ -8,7 +8,6 @@
 #include <string.h>
 
 #include "calcvar.h"
-#include "core/cv_internal_owned.h"
 #include "expr/ex_integrand.h"
 
 /* Names known while parsing: the variable (slot 0), the unknowns (slots 1..n, primed
