@@ -243,6 +243,7 @@ struct cv_solver {
   int adapt_max, rounds;
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
+  int near_sing[2];            /* ends found nearly singular after a solve */
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
 /* The start of a solve (cv_start.c): cv_start_setup discretises the current mesh spec,
@@ -251,6 +252,11 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
 cv_status cv_start_setup(cv_solver *s, const cv_problem *p);
 cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y,
                           int line);
+/* After a solve: is the integrand at end `end` (0 = a, 1 = b) nearly singular, so that
+ * the end element's rule under-integrates it (theory Q-3)? *rel: the relative change of
+ * the action under the singular-end rule there. */
+int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
+                            double action, double *rel);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
 double cv_now(void);
 
