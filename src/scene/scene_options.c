@@ -61,7 +61,7 @@ static int load_breakpoints(sc_loader *L, const sc_entry *e)
   scene *s = L->s;
   sc_list list;
   if (sc_list_split(e->value, &list) < 0 ||
-      !(s->breakpoints = malloc((size_t)list.n * sizeof *s->breakpoints))) {
+      !(s->breakpoints = cv_malloc((size_t)list.n * sizeof *s->breakpoints))) {
     sc_list_free(&list);
     sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
     return -1;
