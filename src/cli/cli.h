@@ -15,7 +15,7 @@ enum { EXIT_SOLVED = 0, EXIT_UNSOLVED = 1, EXIT_BADINPUT = 2 };
 typedef struct {
   const char *scene_path;
   int elements, degree, max_iterations;
-  int method; /* sc_method or -1 */
+  int method; /* cv_method or -1 */
   double tolerance;
   double adapt;
   const char *cont; /* --continue name=from:to */
@@ -41,7 +41,7 @@ int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver
  * apply are left out). report.c fills it from a solver and its scene. */
 typedef struct {
   const scene *sc;
-  sc_method method;
+  cv_method method;
   cv_status st;
   const char *status;
   char message[640];
@@ -67,7 +67,7 @@ typedef struct {
 } cli_report;
 
 const char *cli_status_string(cv_status st);
-int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_status st);
+int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, cv_method m, cv_status st);
 /* estimate.c: the max nodal error of a solve without [exact], from a reference solve on
  * a mesh whose element boundaries include every node (docs/cli.md). cli_estimate_error
  * gives the max over all nodes and over the element boundaries (NaN when the reference

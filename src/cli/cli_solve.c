@@ -40,14 +40,14 @@ static int unsupported(const cli_opts *o, const scene *s)
             "(continuation keeps one mesh)\n");
     return EXIT_BADINPUT;
   }
-  if ((s->method == SC_LBFGS || s->method == SC_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
+  if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
     /* an unconstrained minimiser cannot impose [constraints] or [integrals] */
     if (o->method >= 0)
       fprintf(stderr, "calcvar solve: --method %s cannot impose constraints; use mma, ccsaq, "
-              "slsqp, auglag or newton\n", scene_method_name(s->method));
+              "slsqp, auglag or newton\n", cv_method_name(s->method));
     else
       fprintf(stderr, "%s:%d: method %s cannot impose constraints; use mma, ccsaq, slsqp, "
-              "auglag or newton\n", s->file, s->method_line, scene_method_name(s->method));
+              "auglag or newton\n", s->file, s->method_line, cv_method_name(s->method));
     return EXIT_BADINPUT;
   }
   return 0;
@@ -80,7 +80,7 @@ int cli_solve(int argc, char **argv)
   if (o.degree)
     s->degree = o.degree;
   if (o.method >= 0)
-    s->method = (sc_method)o.method;
+    s->method = (cv_method)o.method;
   if (o.tolerance > 0)
     s->tolerance = o.tolerance;
   if (o.max_iterations)

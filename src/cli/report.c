@@ -212,7 +212,7 @@ static void compose_message(cli_report *r, cv_solver *sv)
 }
 
 /* Fill r after cv_solve returned st. Returns 0, or -1 on allocation failure. */
-int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_status st)
+int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, cv_method m, cv_status st)
 {
   int n = s->n;
   memset(r, 0, sizeof *r);
@@ -248,7 +248,7 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
 
   /* The Morse index describes a stationary point: reported only when Newton converged to
    * one (an unconverged iterate's inertia says nothing about the answer). */
-  if (m == SC_NEWTON && st == CVAR_OK) {
+  if (m == CVAR_METHOD_NEWTON && st == CVAR_OK) {
     int morse = cv_solver_get_morse_index(sv), nfree = cv_solver_get_num_free(sv);
     if (morse >= 0) {
       r->has_morse = 1;

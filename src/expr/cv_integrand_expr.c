@@ -75,7 +75,7 @@ static char **split(const char *s, int *count) {
     else if (s[i] == ')') depth--;
     else if (s[i] == ',' && depth == 0) parts++;
   }
-  char **list = calloc((size_t)parts + 1, sizeof *list);
+  char **list = cv_calloc((size_t)parts + 1, sizeof *list);
   if (!list) return NULL;
   size_t start = 0;
   int k = 0;
@@ -87,10 +87,10 @@ static char **split(const char *s, int *count) {
       size_t a = start, b = i;
       while (a < b && isspace((unsigned char)s[a])) a++;
       while (b > a && isspace((unsigned char)s[b - 1])) b--;
-      list[k] = malloc(b - a + 1);
+      list[k] = cv_malloc(b - a + 1);
       if (!list[k]) {
-        for (int j = 0; j < k; j++) free(list[j]);
-        free(list);
+        for (int j = 0; j < k; j++) cv_free(list[j]);
+        cv_free(list);
         return NULL;
       }
       memcpy(list[k], s + a, b - a);
@@ -105,8 +105,8 @@ static char **split(const char *s, int *count) {
 
 static void free_list(char **list) {
   if (!list) return;
-  for (int i = 0; list[i]; i++) free(list[i]);
-  free(list);
+  for (int i = 0; list[i]; i++) cv_free(list[i]);
+  cv_free(list);
 }
 
 static const char *const reserved[] = {"pi", "sin", "cos", "tan", "asin", "acos", "atan",
@@ -174,8 +174,8 @@ cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
   if (parameters && parameters[0]) {
     plist = split(parameters, &np);
     if (!plist) goto nomem;
-    c.pname = calloc((size_t)np, sizeof *c.pname);
-    c.pval = calloc((size_t)np, sizeof *c.pval);
+    c.pname = cv_calloc((size_t)np, sizeof *c.pname);
+    c.pval = cv_calloc((size_t)np, sizeof *c.pval);
     if (!c.pname || !c.pval) goto nomem;
     for (int i = 0; i < np; i++) {
       char *eq = strchr(plist[i], '=');
@@ -240,7 +240,7 @@ cleanup:
   ex_dag_free(d);
   free_list(c.unk);
   free_list(plist);
-  free(c.pname);
-  free(c.pval);
+  cv_free(c.pname);
+  cv_free(c.pval);
   return st;
 }
