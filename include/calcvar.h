@@ -205,6 +205,18 @@ CVAR_API cv_status cv_problem_add_constraint(cv_problem *p, cv_constraint_fn G, 
  * the partials asked for. *index (may be NULL) receives its number, 0, 1, ... */
 CVAR_API cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, void *user, double c,
                                   int *index);
+/** The pointwise constraint G(x, y) = 0 as a formula (no callback, exact partials): the
+ * arguments as cv_problem_set_integrand_expr's; G may not involve the derivatives y'.
+ * On failure CVAR_EINVAL with a sentence in err. *index as cv_problem_add_constraint. */
+CVAR_API cv_status cv_problem_add_constraint_expr(cv_problem *p, const char *variable,
+                                                  const char *unknowns, const char *G,
+                                                  const char *parameters, int *index,
+                                                  char *err, size_t errlen);
+/** The integral constraint int_a^b K(x, y, y') dx = c as a formula, as above. */
+CVAR_API cv_status cv_problem_add_integral_expr(cv_problem *p, const char *variable,
+                                                const char *unknowns, const char *K,
+                                                double c, const char *parameters, int *index,
+                                                char *err, size_t errlen);
 /** The number of pointwise constraints added so far. */
 CVAR_API int cv_problem_get_num_constraints(const cv_problem *p);
 /** The number of integral constraints added so far. */
@@ -363,6 +375,61 @@ CVAR_API cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *
 /** Evaluate the last solution (degree-p interpolant) at m abscissae in [a, b]:
  * y[i*m + k] and, if dy != NULL, y'[i*m + k]. */
 CVAR_API cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y, double *dy);
+/**@}*/
+
+/** \name Scene files: a problem and its options from the scene format (docs/scenes.md)
+ * The loader the calcvar command uses. A scene is loaded from a file or from text, with
+ * optional `name=value` overrides of its [parameters]; every failure is one sentence
+ * "FILE:LINE: what is wrong" in the caller's err buffer (errlen bytes; 1024 is ample).
+ * A problem made from a scene refers to it: free the problem before the scene. */
+/**@{*/
+/** A loaded scene. Opaque; made by cv_scene_load_file or cv_scene_load_text, released by
+ * cv_scene_free. */
+typedef struct cv_scene cv_scene;
+/** Load the scene file at path. set: nset strings "name=value" (value a constant
+ * expression) overriding [parameters]; NULL when nset is 0. NULL on failure, with the
+ * sentence in err. */
+CVAR_API cv_scene *cv_scene_load_file(const char *path, int nset, const char *const *set,
+                                      char *err, size_t errlen);
+/** Load a scene from NUL-terminated text; name (NULL: "<text>") stands for the file in
+ * messages. Otherwise as cv_scene_load_file. */
+CVAR_API cv_scene *cv_scene_load_text(const char *text, const char *name, int nset,
+                                      const char *const *set, char *err, size_t errlen);
+/** Release a scene; NULL is a no-op. */
+CVAR_API void cv_scene_free(cv_scene *sc);
+/** The number of unknowns. */
+CVAR_API int cv_scene_get_num_unknowns(const cv_scene *sc);
+/** The name of unknown i (NULL when out of range); owned by the scene. */
+CVAR_API const char *cv_scene_get_unknown(const cv_scene *sc, int i);
+/** The scene's title and its variable's name; owned by the scene, never NULL. */
+CVAR_API const char *cv_scene_get_title(const cv_scene *sc);
+/** The name of the independent variable ("x" unless the scene says otherwise). */
+CVAR_API const char *cv_scene_get_variable(const cv_scene *sc);
+/** Override a [mesh] or [solver] setting before cv_scene_problem_new and
+ * cv_scene_configure_solver, as the command's options do: "elements", "degree",
+ * "tolerance", "max_iterations", "adapt" (a number), "method" (a cv_method value).
+ * CVAR_EINVAL for an unknown name or a value out of range, with a sentence in err. */
+CVAR_API cv_status cv_scene_set_option(cv_scene *sc, const char *name, double value,
+                                       char *err, size_t errlen);
+/** A problem for the scene: integrand, ends, guess, [constraints], [integrals]. NULL on
+ * failure (sentence in err). Free it (cv_problem_free) before the scene. */
+CVAR_API cv_problem *cv_scene_problem_new(const cv_scene *sc, char *err, size_t errlen);
+/** Apply the scene's [mesh] and [solver] (and cv_scene_set_option overrides) to a solver. */
+CVAR_API cv_status cv_scene_configure_solver(const cv_scene *sc, cv_solver *s, char *err,
+                                             size_t errlen);
+
+/** The report of a solve, as `calcvar solve --json` writes it (docs/cli.md): the same keys,
+ * built by the same code. Opaque; released by cv_report_free. */
+typedef struct cv_report cv_report;
+/** The report of the last cv_solve of s on p, a problem of sc (s is not modified). Without
+ * [exact] it estimates the nodal error by a reference solve (docs/cli.md), as the command
+ * does. NULL on failure (*why, may be NULL: CVAR_ESTATE before a solve, CVAR_ENOMEM). */
+CVAR_API cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *s,
+                                  cv_status *why);
+/** The report as JSON text (UTF-8, NUL-terminated), owned by the report. */
+CVAR_API const char *cv_report_json(const cv_report *r);
+/** Release a report; NULL is a no-op. */
+CVAR_API void cv_report_free(cv_report *r);
 /**@}*/
 
 #ifdef __cplusplus
