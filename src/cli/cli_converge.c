@@ -283,7 +283,7 @@ int cli_converge(int argc, char **argv)
   if (c.ndeg == 0)
     c.deg[c.ndeg++] = s->degree;
   if (o.method >= 0)
-    s->method = (sc_method)o.method;
+    s->method = (cv_method)o.method;
   if (o.tolerance > 0)
     s->tolerance = o.tolerance;
   if (o.max_iterations)

@@ -5,6 +5,7 @@
 
 #include <stddef.h>
 #include "calcvar.h"
+#include "cv_memory.h" /* the one allocator (tests may inject failures) */
 
 /* Largest batch handed to an integrand callback (documented in calcvar.h). */
 #define CV_BATCH 256
@@ -12,12 +13,6 @@
 #define CV_MAX_QUAD 32
 #define CV_PI 3.14159265358979323846
 
-/* ---- memory: the one allocator (tests may inject failures) ---- */
-void *cv_malloc(size_t n);
-void *cv_calloc(size_t count, size_t size);
-void cv_free(void *ptr);
-/* Fail the k-th allocation from now on (k >= 0); -1 disables. For tests only. */
-void cv_debug_fail_alloc_after(long k);
 
 typedef struct {
   cv_constraint_fn G;

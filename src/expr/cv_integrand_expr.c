@@ -1,5 +1,6 @@
-/* src/expr/cv_integrand_expr.c — cv_problem_set_integrand_expr: an integrand given as a
- * formula string, compiled with exact symbolic partials. SPDX-License-Identifier: MIT */
+/* src/expr/cv_integrand_expr.c — cv_problem_set_integrand_expr and the formula constraints
+ * (cv_problem_add_constraint_expr, cv_problem_add_integral_expr): formula strings compiled
+ * with exact symbolic partials. SPDX-License-Identifier: MIT */
 #include <ctype.h>
 #include <math.h>
 #include <stdarg.h>
@@ -75,7 +76,7 @@ static char **split(const char *s, int *count) {
     else if (s[i] == ')') depth--;
     else if (s[i] == ',' && depth == 0) parts++;
   }
-  char **list = calloc((size_t)parts + 1, sizeof *list);
+  char **list = cv_calloc((size_t)parts + 1, sizeof *list);
   if (!list) return NULL;
   size_t start = 0;
   int k = 0;
@@ -87,10 +88,10 @@ static char **split(const char *s, int *count) {
       size_t a = start, b = i;
       while (a < b && isspace((unsigned char)s[a])) a++;
       while (b > a && isspace((unsigned char)s[b - 1])) b--;
-      list[k] = malloc(b - a + 1);
+      list[k] = cv_malloc(b - a + 1);
       if (!list[k]) {
-        for (int j = 0; j < k; j++) free(list[j]);
-        free(list);
+        for (int j = 0; j < k; j++) cv_free(list[j]);
+        cv_free(list);
         return NULL;
       }
       memcpy(list[k], s + a, b - a);
@@ -105,8 +106,8 @@ static char **split(const char *s, int *count) {
 
 static void free_list(char **list) {
   if (!list) return;
-  for (int i = 0; list[i]; i++) free(list[i]);
-  free(list);
+  for (int i = 0; list[i]; i++) cv_free(list[i]);
+  cv_free(list);
 }
 
 static const char *const reserved[] = {"pi", "sin", "cos", "tan", "asin", "acos", "atan",
@@ -126,12 +127,20 @@ static const char *bad_name(const char *s) {
   return NULL;
 }
 
-cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
-                                        const char *unknowns, const char *F,
-                                        const char *parameters, char *err, size_t errlen) {
+/* The kinds of formula a problem takes: what the formula is called in messages. */
+typedef enum { FORMULA_INTEGRAND, FORMULA_CONSTRAINT, FORMULA_INTEGRAL } formula_kind;
+static const char *const formula_what[] = {"integrand", "constraint", "integral"};
+
+/* Parse F (with its variable, unknowns and parameters) and hand the compiled formula to
+ * the problem as the integrand, a pointwise constraint (no y' allowed) or an integral
+ * constraint int K = c. */
+static cv_status compile(cv_problem *p, const char *variable, const char *unknowns,
+                         const char *F, const char *parameters, formula_kind kind, double c_rhs,
+                         int *index, char *err, size_t errlen) {
+  const char *what = formula_what[kind];
   if (err && errlen) err[0] = 0;
   if (!p || !unknowns || !F) {
-    msg(err, errlen, "problem, unknowns and integrand must not be NULL");
+    msg(err, errlen, "problem, unknowns and %s must not be NULL", what);
     return CVAR_EINVAL;
   }
   cv_status st = CVAR_EINVAL;
@@ -174,8 +183,8 @@ cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
   if (parameters && parameters[0]) {
     plist = split(parameters, &np);
     if (!plist) goto nomem;
-    c.pname = calloc((size_t)np, sizeof *c.pname);
-    c.pval = calloc((size_t)np, sizeof *c.pval);
+    c.pname = cv_calloc((size_t)np, sizeof *c.pname);
+    c.pval = cv_calloc((size_t)np, sizeof *c.pval);
     if (!c.pname || !c.pval) goto nomem;
     for (int i = 0; i < np; i++) {
       char *eq = strchr(plist[i], '=');
@@ -219,18 +228,36 @@ cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
   c.np = np;
   ex_id f = ex_parse(d, F, resolve, &c, 0, perr, sizeof perr);
   if (f < 0) {
-    msg(err, errlen, "integrand: %s", perr);
+    msg(err, errlen, "%s: %s", what, perr);
+    goto cleanup;
+  }
+  if (kind == FORMULA_CONSTRAINT)
+    for (int i = 0; i < c.n; i++)
+      if (ex_depends_on(d, f, 1 + c.n + i)) {
+        msg(err, errlen, "constraint: a pointwise constraint G(%s, y) may not involve %s'",
+            c.var, c.unk[i]);
+        goto cleanup;
+      }
+  if (kind == FORMULA_INTEGRAL && !isfinite(c_rhs)) {
+    msg(err, errlen, "integral: the constant is not a finite number");
     goto cleanup;
   }
   ex_integrand *g = ex_integrand_new(d, c.n, f, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS,
                                      perr, sizeof perr);
   if (!g) {
-    msg(err, errlen, "integrand: %s", perr);
+    msg(err, errlen, "%s: %s", what, perr);
     st = CVAR_ENOMEM;
     goto cleanup;
   }
   /* The problem owns g from here on, also when the call fails (it releases it). */
-  st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
+  if (kind == FORMULA_INTEGRAND)
+    st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
+  else if (kind == FORMULA_CONSTRAINT)
+    st = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g,
+                                         ex_integrand_release, index);
+  else
+    st = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release, c_rhs,
+                                       index);
   if (st != CVAR_OK) msg(err, errlen, "%s", cv_strerror(st));
   goto cleanup;
 nomem:
@@ -240,7 +267,30 @@ cleanup:
   ex_dag_free(d);
   free_list(c.unk);
   free_list(plist);
-  free(c.pname);
-  free(c.pval);
+  cv_free(c.pname);
+  cv_free(c.pval);
   return st;
+}
+
+cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
+                                        const char *unknowns, const char *F,
+                                        const char *parameters, char *err, size_t errlen) {
+  return compile(p, variable, unknowns, F, parameters, FORMULA_INTEGRAND, 0.0, NULL, err,
+                 errlen);
+}
+
+cv_status cv_problem_add_constraint_expr(cv_problem *p, const char *variable,
+                                         const char *unknowns, const char *G,
+                                         const char *parameters, int *index, char *err,
+                                         size_t errlen) {
+  return compile(p, variable, unknowns, G, parameters, FORMULA_CONSTRAINT, 0.0, index, err,
+                 errlen);
+}
+
+cv_status cv_problem_add_integral_expr(cv_problem *p, const char *variable,
+                                       const char *unknowns, const char *K, double c,
+                                       const char *parameters, int *index, char *err,
+                                       size_t errlen) {
+  return compile(p, variable, unknowns, K, parameters, FORMULA_INTEGRAL, c, index, err,
+                 errlen);
 }

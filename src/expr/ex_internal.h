@@ -5,6 +5,7 @@
 
 #include <stdint.h>
 
+#include "core/cv_memory.h"
 #include "expr/expr.h"
 
 /* pi to more digits than a double holds (M_PI is not ISO C). */

@@ -19,9 +19,9 @@ int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const doub
   if (nout == 0 || m == 0)
     return 0;
   ex_tape *t = ex_tape_new(s->dag, ns, nout, outs);
-  const double **in = malloc((size_t)ns * sizeof *in);
-  double **o = malloc((size_t)nout * sizeof *o);
-  double *work = t ? malloc((ex_tape_work_size(t, BATCH) + 1) * sizeof *work) : NULL;
+  const double **in = cv_malloc((size_t)ns * sizeof *in);
+  double **o = cv_malloc((size_t)nout * sizeof *o);
+  double *work = t ? cv_malloc((ex_tape_work_size(t, BATCH) + 1) * sizeof *work) : NULL;
   if (!t || !in || !o || !work)
     goto done;
   for (int k0 = 0; k0 < m; k0 += BATCH) {
@@ -37,9 +37,9 @@ int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const doub
   }
   rc = 0;
 done:
-  free(work);
-  free(o);
-  free(in);
+  cv_free(work);
+  cv_free(o);
+  cv_free(in);
   ex_tape_free(t);
   return rc;
 }
@@ -112,7 +112,7 @@ int scene_eval_momenta(scene *s, int m, const double *x, const double *y, const 
                        double *p)
 {
   int n = s->n, rc = -1;
-  ex_id *outs = malloc((size_t)n * sizeof *outs);
+  ex_id *outs = cv_malloc((size_t)n * sizeof *outs);
   if (!outs)
     return -1;
   for (int i = 0; i < n; i++)
@@ -120,7 +120,7 @@ int scene_eval_momenta(scene *s, int m, const double *x, const double *y, const 
       goto done;
   rc = sc_eval_exprs(s, n, outs, m, x, y, dy, p);
 done:
-  free(outs);
+  cv_free(outs);
   return rc;
 }
 
@@ -128,12 +128,12 @@ int scene_eval_reports(scene *s, int m, const double *x, const double *y, const 
                        double *out)
 {
   int nr = s->nreports, rc;
-  ex_id *outs = malloc((size_t)(nr + 1) * sizeof *outs);
+  ex_id *outs = cv_malloc((size_t)(nr + 1) * sizeof *outs);
   if (!outs)
     return -1;
   for (int r = 0; r < nr; r++)
     outs[r] = s->reports[r].expr;
   rc = sc_eval_exprs(s, nr, outs, m, x, y, dy, out);
-  free(outs);
+  cv_free(outs);
   return rc;
 }

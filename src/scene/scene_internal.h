@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 
+#include "core/cv_memory.h"
 #include "scene/scene.h"
 
 /* Where a piece of a (possibly continued) value came from: the value's characters from

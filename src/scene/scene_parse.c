@@ -14,9 +14,9 @@
 void sc_list_free(sc_list *list)
 {
   for (int i = 0; i < list->n; i++)
-    free(list->item[i]);
-  free(list->item);
-  free(list->off);
+    cv_free(list->item[i]);
+  cv_free(list->item);
+  cv_free(list->off);
   memset(list, 0, sizeof *list);
 }
 
@@ -40,10 +40,10 @@ int sc_list_split(const char *value, sc_list *list)
         b--;
       if (list->n == cap) {
         cap = cap ? 2 * cap : 4;
-        char **it = realloc(list->item, (size_t)cap * sizeof *it);
+        char **it = cv_realloc(list->item, (size_t)cap * sizeof *it);
         if (it)
           list->item = it;
-        int *off = realloc(list->off, (size_t)cap * sizeof *off);
+        int *off = cv_realloc(list->off, (size_t)cap * sizeof *off);
         if (off)
           list->off = off;
         if (!it || !off)

@@ -68,7 +68,7 @@ static int looks_like_free(const scene *s, const char *t)
 int sc_load_boundary(sc_loader *L)
 {
   scene *s = L->s;
-  s->bc = calloc((size_t)s->n, sizeof *s->bc);
+  s->bc = cv_calloc((size_t)s->n, sizeof *s->bc);
   if (!s->bc)
     return nomem(L, 0);
   for (int i = 0; i < L->raw.ne[SEC_BOUNDARY]; i++) {
@@ -147,8 +147,8 @@ static ex_id parse_of_variable(sc_loader *L, const sc_entry *e, const char *what
 int sc_load_guess_exact(sc_loader *L)
 {
   scene *s = L->s;
-  s->guess = malloc((size_t)s->n * sizeof *s->guess);
-  s->exact = malloc((size_t)s->n * sizeof *s->exact);
+  s->guess = cv_malloc((size_t)s->n * sizeof *s->guess);
+  s->exact = cv_malloc((size_t)s->n * sizeof *s->exact);
   if (!s->guess || !s->exact)
     return nomem(L, 0);
   for (int i = 0; i < s->n; i++)
@@ -243,12 +243,12 @@ static int check_constraint_ends(sc_loader *L, const sc_item *c)
     if (!fixed)
       continue;
     int ns = 1 + 2 * n;
-    ex_id *outs = malloc((size_t)(n + 1) * sizeof *outs);
-    double x = end ? s->b : s->a, *y = calloc((size_t)(ns + n + 1), sizeof *y);
+    ex_id *outs = cv_malloc((size_t)(n + 1) * sizeof *outs);
+    double x = end ? s->b : s->a, *y = cv_calloc((size_t)(ns + n + 1), sizeof *y);
     double *v = y ? y + ns : NULL;
     if (!outs || !y) {
-      free(outs);
-      free(y);
+      cv_free(outs);
+      cv_free(y);
       return nomem(L, c->line);
     }
     outs[0] = c->expr;
@@ -263,8 +263,8 @@ static int check_constraint_ends(sc_loader *L, const sc_item *c)
     double scale = 1.0, g = v[0];
     for (int i = 0; i < n; i++)
       scale += fabs(y[i] * v[1 + i]);
-    free(outs);
-    free(y);
+    cv_free(outs);
+    cv_free(y);
     if (rc < 0)
       return nomem(L, c->line);
     if (!(fabs(g) <= 1e-8 * scale)) {

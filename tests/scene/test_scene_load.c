@@ -106,7 +106,7 @@ static void test_catenary(void)
   near("exact action", s->exact_action, 4.350402387287603, 0);
   near("default elements", s->elements, 100, 0);
   near("default degree", s->degree, 1, 0);
-  near("default method newton", s->method, SC_NEWTON, 0);
+  near("default method newton", s->method, CVAR_METHOD_NEWTON, 0);
   near("default tolerance", s->tolerance, 1e-10, 0);
   near("default max_iterations", s->max_iterations, 50, 0);
   truth("F has no explicit x", !scene_F_depends_on_variable(s), "0", "1");
@@ -280,7 +280,7 @@ static void test_good_extras(void)
   near("breakpoints sorted", s->nbreak == 2 ? s->breakpoints[0] : -1, 1, 0);
   near("grading", s->grading, 2, 0);
   near("grading_at both", s->graded_end, CVAR_GRADE_BOTH, 0);
-  near("method lbfgs", s->method, SC_LBFGS, 0);
+  near("method lbfgs", s->method, CVAR_METHOD_LBFGS, 0);
   near("lbfgs needs F and the gradient", scene_method_need(s->method),
        CVAR_NEED_F | CVAR_NEED_GRAD, 0);
   near("tolerance", s->tolerance, 1e-8, 0);

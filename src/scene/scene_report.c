@@ -1,4 +1,4 @@
-/* src/cli/report.c — gather what `solve` reports from a solver and its scene.
+/* src/scene/scene_report.c — gather what `solve` reports from a solver and its scene.
  * SPDX-License-Identifier: MIT
  *
  * Energy, momenta and [report] integrals are evaluated at the solver's quadrature points
@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cli/cli.h"
+#include "scene/scene_report.h"
 
 const char *cli_status_string(cv_status st)
 {
@@ -212,7 +212,7 @@ static void compose_message(cli_report *r, cv_solver *sv)
 }
 
 /* Fill r after cv_solve returned st. Returns 0, or -1 on allocation failure. */
-int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_status st)
+int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, cv_method m, cv_status st)
 {
   int n = s->n;
   memset(r, 0, sizeof *r);
@@ -248,7 +248,7 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
 
   /* The Morse index describes a stationary point: reported only when Newton converged to
    * one (an unconverged iterate's inertia says nothing about the answer). */
-  if (m == SC_NEWTON && st == CVAR_OK) {
+  if (m == CVAR_METHOD_NEWTON && st == CVAR_OK) {
     int morse = cv_solver_get_morse_index(sv), nfree = cv_solver_get_num_free(sv);
     if (morse >= 0) {
       r->has_morse = 1;
@@ -289,4 +289,22 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
     return -1;
   compose_message(r, sv);
   return 0;
+}
+
+int cli_report_build(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv, cv_status st,
+                     int adaptive)
+{
+  if (cli_report_collect(r, s, sv, cv_solver_get_method(sv), st) < 0)
+    return -1;
+  int any_exact = 0;
+  for (int i = 0; i < s->n; i++)
+    any_exact |= s->exact[i] >= 0;
+  if (adaptive) {
+    /* the adaptive solve's own two-mesh estimate (theory AD-1) */
+    double est = cv_solver_get_error_estimate(sv);
+    r->has_err_est = !any_exact && isfinite(est);
+    r->err_est = est;
+    return 0;
+  }
+  return any_exact ? 0 : cli_report_estimate(r, s, p);
 }
