@@ -65,6 +65,9 @@ void cv_gauss_lobatto(int p, double *xi, double *w);
 /* Lagrange basis on nodes xi[0..p] at s: phi[l] and (if dphi) phi_l'(s). */
 void cv_lagrange(int p, const double *xi, double s, double *phi, double *dphi);
 void cv_refelem_init(cv_refelem *r, int p, int q);
+/* The singular-end rule (Q-2) on the element touching end 0 (a) or 1 (b), qs points, for
+ * degree p (1 <= p <= CV_MAX_DEGREE, 1 <= qs <= CV_MAX_QUAD); cached for the process. */
+cv_rule cv_end_rule(int p, int qs, int end);
 
 /* ---- mesh (cv_mesh.c) ---- */
 enum { CV_MESH_UNIFORM, CV_MESH_GRADED, CV_MESH_USER };
