@@ -242,8 +242,15 @@ struct cv_solver {
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
   int near_sing[2];            /* ends found nearly singular after a solve */
+  /* The sparse LDL^T of the Hessian pattern of `disc` (CHOLMOD common, pattern, symbolic
+   * analysis) and the y dof of each unknown: made by the first Newton run on the mesh and
+   * reused by the next ones on it (retries, continuation steps); dropped with the mesh. */
+  struct cv_ldlt *ldlt;
+  int *gof;
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
+/* Release the solver's factor of its mesh (before the mesh changes). */
+void cv_solver_drop_factor(cv_solver *s);
 /* The start of a solve (cv_start.c): cv_start_setup discretises the current mesh spec,
  * allocates the results and fills s->y with the starting values and flags singular ends;
  * cv_start_values fills Y with the given start / guess, or (line = 1) the straight line. */
