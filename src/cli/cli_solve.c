@@ -28,7 +28,7 @@ static void usage(FILE *f)
         "  --csv FILE           nodal table ('-' for stdout)\n"
         "  --plot FILE          picture of the solution (.png or .svg)\n"
         "  --quiet              no summary on stdout\n"
-        "exit status: 0 converged, 1 not solved, 2 bad input\n", f);
+        "exit status: 0 converged, 1 not solved, 2 bad input, 3 write error\n", f);
 }
 
 /* Combinations that cannot be honoured: refuse (exit 2, nothing written) rather than
@@ -94,9 +94,9 @@ int cli_solve(int argc, char **argv)
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if ((o.json && cli_outfile_open(&jf, o.json) < 0) ||
-      (o.csv && cli_outfile_open(&cf, o.csv) < 0) ||
-      (o.plot && cli_outfile_open(&pf, o.plot) < 0)) {
+  if ((o.json && cli_outfile_open(&jf, o.json, o.scene_path) < 0) ||
+      (o.csv && cli_outfile_open(&cf, o.csv, o.scene_path) < 0) ||
+      (o.plot && cli_outfile_open(&pf, o.plot, o.scene_path) < 0)) {
     rc = EXIT_BADINPUT;
     goto done;
   }
@@ -157,17 +157,17 @@ int cli_solve(int argc, char **argv)
     goto done;
   }
   rc = st == CVAR_OK ? EXIT_SOLVED : EXIT_UNSOLVED;
-  if (jf.f && (cli_report_json(jf.f, &r) < 0 || cli_outfile_commit(&jf) < 0)) {
+  if (jf.f && cli_outfile_finish(&jf, cli_report_json(jf.f, &r)) < 0) {
     fprintf(stderr, "calcvar solve: the JSON report could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   if (pf.f && cli_plot_solution(&pf, &r, sv) < 0) {
     fprintf(stderr, "calcvar solve: the plot could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
-  if (cf.f && (cli_report_csv(cf.f, &r) < 0 || cli_outfile_commit(&cf) < 0)) {
+  if (cf.f && cli_outfile_finish(&cf, cli_report_csv(cf.f, &r)) < 0) {
     fprintf(stderr, "calcvar solve: the CSV table could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   /* stdout carries the data when a report goes there; the summary would corrupt it. */
   int stdout_taken = (o.json && strcmp(o.json, "-") == 0) || (o.csv && strcmp(o.csv, "-") == 0);
