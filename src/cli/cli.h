@@ -19,6 +19,7 @@ typedef struct {
   int method; /* sc_method or -1 */
   double tolerance;
   double adapt;
+  int max_elements; /* --max-elements: the adaptive cap (0: 2e6) */
   const char *cont; /* --continue name=from:to */
   int nset;
   sc_set *set;

@@ -88,7 +88,7 @@ static int split_args(int argc, char **argv, conv_opts *c, char **rest, int *nre
 {
   static const char *const valued[] = {"--elements", "--method", "--tolerance",
                                        "--max-iterations", "--set", "--adapt", "--continue",
-                                       "--json", "--csv", "--plot", NULL};
+                                       "--json", "--csv", "--plot", "--max-elements", NULL};
   static const char *const mine[] = {"--levels", "--degree", "--svg"};
   c->levels = 6;
   *nrest = 0;
@@ -264,7 +264,7 @@ int cli_converge(int argc, char **argv)
     goto done;
   }
   const char *notmine = o.csv ? "--csv" : o.plot ? "--plot" : o.adapt > 0 ? "--adapt"
-                        : o.cont ? "--continue" : NULL;
+                        : o.cont ? "--continue" : o.max_elements ? "--max-elements" : NULL;
   if (notmine) {
     rc = bad("%s is an option of solve, not of converge", notmine);
     goto done;

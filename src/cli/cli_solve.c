@@ -23,6 +23,7 @@ static void usage(FILE *f)
         "  --max-iterations K   iteration limit (default 50)\n"
         "  --set name=value     override a parameter (repeatable)\n"
         "  --adapt TOL          refine until the estimated max nodal error < TOL\n"
+        "  --max-elements N     cap of adaptive refinement (default 2000000)\n"
         "  --continue name=from:to   continuation in a parameter\n"
         "  --json FILE          JSON report ('-' for stdout)\n"
         "  --csv FILE           nodal table ('-' for stdout)\n"
@@ -38,6 +39,11 @@ static int unsupported(const cli_opts *o, const scene *s)
   if (o->cont && (o->adapt > 0 || s->adapt > 0)) {
     fprintf(stderr, "calcvar solve: --continue and adaptive refinement cannot be combined "
             "(continuation keeps one mesh)\n");
+    return EXIT_BADINPUT;
+  }
+  if (o->max_elements > 0 && !(o->adapt > 0 || s->adapt > 0)) {
+    fprintf(stderr, "calcvar solve: --max-elements applies to adaptive refinement only "
+            "(--adapt TOL or [mesh] adapt)\n");
     return EXIT_BADINPUT;
   }
   if ((s->method == SC_LBFGS || s->method == SC_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
@@ -101,9 +107,11 @@ int cli_solve(int argc, char **argv)
     goto done;
   }
 
-  /* Adaptive refinement: [mesh] adapt or --adapt, capped at 2e6 elements (theory AD-1). */
+  /* Adaptive refinement: [mesh] adapt or --adapt, capped at --max-elements, default 2e6
+   * elements (theory AD-1). */
   double adapt = o.adapt > 0 ? o.adapt : s->adapt;
-  if (adapt > 0 && cv_solver_set_adapt(sv, adapt, 2000000) != CVAR_OK) {
+  int cap = o.max_elements > 0 ? o.max_elements : 2000000;
+  if (adapt > 0 && cv_solver_set_adapt(sv, adapt, cap) != CVAR_OK) {
     fprintf(stderr, "calcvar solve: invalid adaptive tolerance %g\n", adapt);
     rc = EXIT_BADINPUT;
     goto done;
