@@ -46,6 +46,10 @@ struct cv_problem {
   double *endval;  /* endval[2*k + end] */
   cv_guess_fn guess;
   void *guess_user;
+  cv_note_fn note;   /* the integrand's failure note (cv_internal_owned.h), or NULL */
+  int ntables;       /* tables added by cv_problem_add_table, each with a reference */
+  char **table_name;
+  cv_table **table;
 };
 
 /* ---- reference element: GLL nodes, Gauss-Legendre rule, basis tables (cv_quadrature.c) */

@@ -414,8 +414,17 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   double t0 = cv_now();
   s->err_est = NAN;
   s->rounds = 0;
+  if (p && p->note) p->note(p->user, 1);
   cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
   s->status = st;
+  /* A failure the integrand can explain (a table's grid left): say which, after the
+   * engine's sentence. */
+  const char *note = st != CVAR_OK && p && p->note ? p->note(p->user, 0) : NULL;
+  if (note && note[0]) {
+    size_t len = strlen(s->msg);
+    if (len + 3 < sizeof s->msg)
+      snprintf(s->msg + len, sizeof s->msg - len, "%s%s", len ? "; " : "", note);
+  }
   s->time = cv_now() - t0;
   return st;
 }

@@ -172,6 +172,16 @@ cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
   }
   d = ex_dag_new();
   if (!d) goto nomem;
+  for (int i = 0; i < cv_problem_num_tables(p); i++) {
+    const char *tn = cv_problem_table_name(p, i);
+    int clash = strcmp(tn, c.var) == 0;
+    for (int j = 0; j < c.n; j++) clash |= strcmp(tn, c.unk[j]) == 0;
+    if (clash || (why = bad_name(tn))) {
+      msg(err, errlen, "table '%s': %s", tn, clash ? "the name is already used" : why);
+      goto cleanup;
+    }
+    if (ex_dag_add_table(d, tn, (cv_table *)cv_problem_table(p, i)) < 0) goto nomem;
+  }
   if (parameters && parameters[0]) {
     plist = split(parameters, &np);
     if (!plist) goto nomem;
@@ -191,7 +201,7 @@ cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
         msg(err, errlen, "parameters: '%s' %s", name, why);
         goto cleanup;
       }
-      int clash = strcmp(name, c.var) == 0;
+      int clash = strcmp(name, c.var) == 0 || ex_dag_find_table(d, name) >= 0;
       for (int j = 0; j < c.n; j++) clash |= strcmp(name, c.unk[j]) == 0;
       for (int j = 0; j < i; j++) clash |= strcmp(name, c.pname[j]) == 0;
       if (clash) {
@@ -232,6 +242,7 @@ cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
   }
   /* The problem owns g from here on, also when the call fails (it releases it). */
   st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
+  if (st == CVAR_OK) st = cv_problem_set_integrand_note(p, ex_integrand_note);
   if (st != CVAR_OK) msg(err, errlen, "%s", cv_strerror(st));
   goto cleanup;
 nomem:
