@@ -420,10 +420,10 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   /* A failure the integrand can explain (a table's grid left): say which, after the
    * engine's sentence. */
   const char *note = st != CVAR_OK && p && p->note ? p->note(p->user, 0) : NULL;
-  if (note && note[0]) {
-    size_t len = strlen(s->msg);
-    if (len + 3 < sizeof s->msg)
-      snprintf(s->msg + len, sizeof s->msg - len, "%s%s", len ? "; " : "", note);
+  if (note && note[0]) { /* the cause first, then what the engine saw */
+    char m[sizeof s->msg];
+    snprintf(m, sizeof m, "%s%s%s", note, s->msg[0] ? "; " : "", s->msg);
+    memcpy(s->msg, m, sizeof m);
   }
   s->time = cv_now() - t0;
   return st;
