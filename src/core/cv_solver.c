@@ -421,9 +421,10 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
    * engine's sentence. */
   const char *note = st != CVAR_OK && p && p->note ? p->note(p->user, 0) : NULL;
   if (note && note[0]) { /* the cause first, then what the engine saw */
-    char m[sizeof s->msg];
+    char m[2 * sizeof s->msg];
     snprintf(m, sizeof m, "%s%s%s", note, s->msg[0] ? "; " : "", s->msg);
-    memcpy(s->msg, m, sizeof m);
+    memcpy(s->msg, m, sizeof s->msg - 1); /* truncated to the message buffer */
+    s->msg[sizeof s->msg - 1] = '\0';
   }
   s->time = cv_now() - t0;
   return st;
