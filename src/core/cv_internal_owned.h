@@ -18,6 +18,10 @@ cv_status cv_problem_add_integral_owned(cv_problem *p, cv_integrand_fn K, void *
 cv_table *cv_table_ref(cv_table *t);
 cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords,
                            const double *values, cv_status *why, char *msg, size_t len);
+/* Several partials of t at the point u at once (one cell search): out[j] has the orders
+ * ord[j][0..dim-1]. Returns 0, or k + 1 when u is outside the grid along axis k (all NaN). */
+int cv_table_eval_multi(const cv_table *t, const double *u, int nord, const int (*ord)[3],
+                        double *out);
 /* Tables added to a problem (cv_problem_add_table), for the formula compiler: count and
  * the i-th name and table (borrowed). */
 int cv_problem_num_tables(const cv_problem *p);

@@ -278,38 +278,76 @@ static void weights(int o, double t, double h, double w[4]) {
   }
 }
 
-int cv_table_eval(const cv_table *t, const double *u, const int *order, double *value) {
-  if (!t || !u || !value) return -1;
-  double w[3][4];
-  size_t base = 0;
+/* TB-2 for several derivative orders at one point: the cell is found and the 4^d
+ * coefficients (values and second-derivative arrays at the cell's corners) gathered once;
+ * each order is then a contraction with per-axis weights, one axis at a time. */
+int cv_table_eval_multi(const cv_table *t, const double *u, int nord, const int (*ord)[3],
+                        double *out) {
   int dim = t->dim;
+  size_t base = 0;
+  double tt[3] = {0, 0, 0}, hh[3] = {1, 1, 1};
   for (int k = 0; k < dim; k++) {
     const tb_axis *a = &t->ax[k];
     int i = find_cell(a, u[k]);
     if (i < 0) {
-      *value = NAN;
+      for (int j = 0; j < nord; j++) out[j] = NAN;
       return k + 1;
     }
-    double h = a->h[i];
-    weights(order ? order[k] : 0, (u[k] - a->x[i]) / h, h, w[k]);
+    hh[k] = a->h[i];
+    tt[k] = (u[k] - a->x[i]) / hh[k];
     base += (size_t)i * t->stride[k];
   }
-  /* TB-2: sum over the 2^d cell corners c and the 2^d arrays G[mask] of the product of the
-   * per-axis weights (w[k][c_k] for values, w[k][2 + c_k] for second derivatives). */
-  double sum = 0.0;
-  for (int mask = 0; mask < (1 << dim); mask++) {
-    const double *G = t->G[mask];
-    for (int c = 0; c < (1 << dim); c++) {
-      double p = 1.0;
-      size_t idx = base;
-      for (int k = 0; k < dim; k++) {
-        int ck = (c >> k) & 1;
-        p *= w[k][((mask >> k) & 1) * 2 + ck];
-        idx += (size_t)ck * t->stride[k];
+  /* c[a_0 .. a_d-1], a_k = 2 * (second derivative along k) + (corner along k), the last
+   * axis fastest: the order of the weights of TB-1 */
+  double c[64];
+  const size_t *st = t->stride;
+  if (dim == 1) {
+    c[0] = t->G[0][base], c[1] = t->G[0][base + 1];
+    c[2] = t->G[1][base], c[3] = t->G[1][base + 1];
+  } else {
+    for (int mask = 0; mask < (1 << dim); mask++) {
+      const double *G = t->G[mask];
+      for (int cr = 0; cr < (1 << dim); cr++) {
+        size_t idx = base;
+        int lin = 0;
+        for (int k = 0; k < dim; k++) {
+          int ck = (cr >> k) & 1, mk = (mask >> k) & 1;
+          idx += (size_t)ck * st[k];
+          lin = lin * 4 + 2 * mk + ck;
+        }
+        c[lin] = G[idx];
       }
-      sum += p * G[idx];
     }
   }
-  *value = sum;
+  for (int j = 0; j < nord; j++) {
+    double w[3][4];
+    for (int k = 0; k < dim; k++) weights(ord ? ord[j][k] : 0, tt[k], hh[k], w[k]);
+    double sum = 0.0;
+    if (dim == 1) {
+      sum = w[0][0] * c[0] + w[0][1] * c[1] + w[0][2] * c[2] + w[0][3] * c[3];
+    } else if (dim == 2) {
+      for (int a = 0; a < 4; a++) {
+        const double *r = c + 4 * a;
+        sum += w[0][a] * (w[1][0] * r[0] + w[1][1] * r[1] + w[1][2] * r[2] + w[1][3] * r[3]);
+      }
+    } else {
+      for (int a = 0; a < 4; a++) {
+        double s1 = 0.0;
+        for (int b = 0; b < 4; b++) {
+          const double *r = c + 16 * a + 4 * b;
+          s1 += w[1][b] * (w[2][0] * r[0] + w[2][1] * r[1] + w[2][2] * r[2] + w[2][3] * r[3]);
+        }
+        sum += w[0][a] * s1;
+      }
+    }
+    out[j] = sum;
+  }
   return 0;
+}
+
+int cv_table_eval(const cv_table *t, const double *u, const int *order, double *value) {
+  if (!t || !u || !value) return -1;
+  int o[1][3] = {{0, 0, 0}};
+  for (int k = 0; k < t->dim && order; k++) o[0][k] = order[k];
+  return cv_table_eval_multi(t, u, 1, (const int(*)[3])o, value);
 }

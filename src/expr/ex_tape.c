@@ -39,8 +39,18 @@ typedef struct {
   double (*fn)(double); /* T_FN1: the libm function */
   double k;             /* scalar operand (K variants, T_FILL) */
   loc dst, a, b, c;
-  int tab, ord[3];      /* T_TABLE: index in the tape's tables, derivative orders */
+  int tab, multi;       /* T_TABLE: index in the tape's tables and in its call groups */
 } instr;
+
+/* One T_TABLE instruction computes every partial the tape needs of one table at the same
+ * arguments (value, gradient, Hessian entries): one cell search and one gather per point
+ * for all of them (cv_table_eval_multi). */
+enum { EX_TABLE_FUSE = 10 };
+typedef struct {
+  int n;
+  loc dst[EX_TABLE_FUSE];
+  int ord[EX_TABLE_FUSE][3];
+} table_group;
 
 struct ex_tape {
   int nslots, nout, nins, nregs;
@@ -48,6 +58,8 @@ struct ex_tape {
   int ntab;             /* tables the tape calls, each with a reference, and their names */
   cv_table **tab;
   char **tabname;
+  int ngroup;
+  table_group *group;
 };
 
 /* T_TABLE records the first point outside a table's grid in the EX_TAPE_FAULT doubles
@@ -80,6 +92,7 @@ typedef struct {
   unsigned char live;   /* reachable from an output through non-constant nodes */
   unsigned char konst;  /* constant: its value is cval */
   unsigned char needv;  /* needs a vector location (computed or filled) */
+  unsigned char fused;  /* a table call computed by an earlier call's instruction */
   double cval;
   int last;             /* id of the last node reading it as a vector operand */
   loc home;
@@ -159,6 +172,7 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
       continue;
     }
     if (c->konst && !c->needv) continue; /* used only as a scalar (or output: filled later) */
+    if (c->fused) goto free_operands;
     instr in;
     memset(&in, 0, sizeof in);
     if (c->konst) {
@@ -217,8 +231,8 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
       case EX_GE: in.op = T_GE; break;
       case EX_IF: in.op = T_IF; break;
       case EX_TABLE: {
-        int index;
-        ex_table_decode(nd->v, &index, in.ord);
+        int index, ord[3];
+        ex_table_decode(nd->v, &index, ord);
         if (index < 0 || index >= d->ntables) goto fail;
         in.op = T_TABLE;
         in.tab = -1;
@@ -238,6 +252,41 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
           t->tab[t->ntab] = cv_table_ref(d->tabs[index]);
           t->tabname[t->ntab] = copy;
           in.tab = t->ntab++;
+        }
+        table_group *gr = realloc(t->group, ((size_t)t->ngroup + 1) * sizeof *gr);
+        if (!gr) goto fail;
+        t->group = gr;
+        gr = &t->group[t->ngroup];
+        in.multi = t->ngroup++;
+        gr->n = 1;
+        memcpy(gr->ord[0], ord, sizeof ord);
+        /* the later calls of this table at the same arguments join the instruction; their
+         * destinations are allocated now (after the operands', so never aliasing them) */
+        for (int j = id + 1; j < nn && gr->n < EX_TABLE_FUSE; j++) {
+          const ex_node *nj = &d->nodes[j];
+          if (!cn[j].live || cn[j].konst || nj->op != EX_TABLE || nj->a != nd->a ||
+              nj->b != nd->b || nj->c != nd->c)
+            continue;
+          int jindex, jord[3];
+          ex_table_decode(nj->v, &jindex, jord);
+          if (jindex != index) continue;
+          if (cn[j].home.space < 0) {
+            int r;
+            if (nfree > 0) {
+              int best = 0;
+              for (int i = 1; i < nfree; i++)
+                if (freeregs[i] < freeregs[best]) best = i;
+              r = freeregs[best];
+              freeregs[best] = freeregs[--nfree];
+            } else {
+              r = t->nregs++;
+            }
+            cn[j].home = (loc){L_REG, r};
+          }
+          cn[j].fused = 1;
+          gr->dst[gr->n] = cn[j].home;
+          memcpy(gr->ord[gr->n], jord, sizeof jord);
+          gr->n++;
         }
         break;
       }
@@ -263,7 +312,9 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
       c->home = (loc){L_REG, r};
     }
     in.dst = c->home;
+    if (in.op == T_TABLE) t->group[in.multi].dst[0] = c->home;
     ins[n++] = in;
+  free_operands:
     if (!c->konst) {
       ex_id ops[3] = {nd->a, nd->b, nd->c};
       for (int i = 0; i < 3; i++) {
@@ -312,6 +363,7 @@ void ex_tape_free(ex_tape *t) {
   }
   free(t->tab);
   free(t->tabname);
+  free(t->group);
   free(t->ins);
   free(t);
 }
@@ -369,14 +421,22 @@ static void run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
   }
 }
 
-/* T_TABLE over the m points; a point outside the grid gives NaN and, the first time in
- * this evaluation, a fault record (EX_TAPE_FAULT). */
-static void run_table(const ex_tape *t, const instr *in, int m, double *D, const double *A,
-                      const double *B, const double *C, double *fault) {
+static double *where(loc l, int m, const double *const *in, double *const *out,
+                     double *work);
+
+/* T_TABLE over the m points: every partial of its group at once; a point outside the grid
+ * gives NaN and, the first time in this evaluation, a fault record (EX_TAPE_FAULT). */
+static void run_table(const ex_tape *t, const instr *in, int m, const double *const *inp,
+                      double *const *out, double *work, const double *A, const double *B,
+                      const double *C, double *fault) {
   const cv_table *tab = t->tab[in->tab];
+  const table_group *g = &t->group[in->multi];
+  double *D[EX_TABLE_FUSE], v[EX_TABLE_FUSE];
+  for (int j = 0; j < g->n; j++) D[j] = where(g->dst[j], m, inp, out, work);
   for (int k = 0; k < m; k++) {
     double u[3] = {A[k], B ? B[k] : 0.0, C ? C[k] : 0.0};
-    int rc = cv_table_eval(tab, u, in->ord, &D[k]);
+    int rc = cv_table_eval_multi(tab, u, g->n, (const int(*)[3])g->ord, v);
+    for (int j = 0; j < g->n; j++) D[j][k] = v[j];
     if (rc != 0 && fault[0] == 0) {
       fault[0] = in->tab + 1;
       fault[1] = rc;
@@ -406,7 +466,7 @@ void ex_tape_eval(const ex_tape *t, int m, const double *const *in, double *cons
     const double *A = where(p->a, m, in, out, work);
     const double *B = where(p->b, m, in, out, work);
     const double *C = where(p->c, m, in, out, work);
-    if (p->op == T_TABLE) run_table(t, p, m, D, A, B, C, fault);
+    if (p->op == T_TABLE) run_table(t, p, m, in, out, work, A, B, C, fault);
     else run(p, m, D, A, B, C);
   }
 }
@@ -420,8 +480,8 @@ int ex_tape_fault(const ex_tape *t, int m, const double *work, char *msg, size_t
   double lo = 0, hi = 0;
   cv_table_get_range(t->tab[j], k, &lo, &hi);
   if (msg && len)
-    snprintf(msg, len, "the path left the grid of table '%s': its %s argument was %.6g, "
-             "outside [%.6g, %.6g] (tables are not extrapolated)", t->tabname[j],
+    snprintf(msg, len, "the path left the grid of table '%s': its %s argument was %.15g, "
+             "outside [%.10g, %.10g] (tables are not extrapolated)", t->tabname[j],
              axis[k < 0 ? 0 : k > 2 ? 2 : k], fault[2 + (k < 0 ? 0 : k > 2 ? 2 : k)], lo, hi);
   return 1;
 }
