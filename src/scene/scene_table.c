@@ -8,6 +8,7 @@
  * ten up to 22; both exact doubles, so one rounding) with strtod for everything else, so a
  * 200^3 grid reads in well under a second (bench/bench_table). */
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -79,6 +80,30 @@ static int parse_num(const char *s, size_t len, double *out)
       return 0;
     }
   }
+#if LDBL_MANT_DIG == 64
+  /* Up to 19 digits (17-digit output of %.17g included): m and 10^|ex| (|ex| <= 27) are
+   * exact in the 64-bit significand of long double, so m * 10^ex is rounded once there;
+   * rounding that to double is then correct unless the long double lies on or next to a
+   * midpoint between two doubles (low 11 bits 0x3ff..0x401), which goes to strtod. */
+  if (fast && i == len && m != 0) {
+    int ex = e - frac;
+    if (ex >= -27 && ex <= 27) {
+      long double p = 1.0L;
+      for (int j = 0; j < (ex < 0 ? -ex : ex); j++)
+        p *= 10.0L;
+      long double L = ex < 0 ? (long double)m / p : (long double)m * p;
+      int be;
+      long double fr = frexpl(L, &be);
+      uint64_t bits = (uint64_t)ldexpl(fr, 64);
+      unsigned low = (unsigned)(bits & 0x7ff);
+      if (low < 0x3ff || low > 0x401) {
+        double v = (double)L;
+        *out = neg ? -v : v;
+        return 0;
+      }
+    }
+  }
+#endif
   /* everything else (and every malformed field) through strtod on a copy */
   char buf[128];
   if (len == 0 || len >= sizeof buf)
