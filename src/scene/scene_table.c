@@ -80,7 +80,7 @@ static int parse_num(const char *s, size_t len, double *out)
       return 0;
     }
   }
-#if LDBL_MANT_DIG == 64
+#if LDBL_MANT_DIG == 64 && defined(__x86_64__)
   /* Up to 19 digits (17-digit output of %.17g included): m and 10^|ex| (|ex| <= 27) are
    * exact in the 64-bit significand of long double, so m * 10^ex is rounded once there;
    * rounding that to double is then correct unless the long double lies on or next to a
@@ -88,13 +88,13 @@ static int parse_num(const char *s, size_t len, double *out)
   if (fast && i == len && m != 0) {
     int ex = e - frac;
     if (ex >= -27 && ex <= 27) {
-      long double p = 1.0L;
-      for (int j = 0; j < (ex < 0 ? -ex : ex); j++)
-        p *= 10.0L;
-      long double L = ex < 0 ? (long double)m / p : (long double)m * p;
-      int be;
-      long double fr = frexpl(L, &be);
-      uint64_t bits = (uint64_t)ldexpl(fr, 64);
+      static const long double p10l[28] = {
+          1e0L,  1e1L,  1e2L,  1e3L,  1e4L,  1e5L,  1e6L,  1e7L,  1e8L,  1e9L,
+          1e10L, 1e11L, 1e12L, 1e13L, 1e14L, 1e15L, 1e16L, 1e17L, 1e18L, 1e19L,
+          1e20L, 1e21L, 1e22L, 1e23L, 1e24L, 1e25L, 1e26L, 1e27L}; /* exact: 5^27 < 2^64 */
+      long double L = ex < 0 ? (long double)m / p10l[-ex] : (long double)m * p10l[ex];
+      uint64_t bits; /* x87 extended: the explicit 64-bit significand comes first */
+      memcpy(&bits, &L, sizeof bits);
       unsigned low = (unsigned)(bits & 0x7ff);
       if (low < 0x3ff || low > 0x401) {
         double v = (double)L;
