@@ -24,7 +24,7 @@ static int run_one(const cli_gallery_scene *g)
   }
   cv_status st = cv_solve(sv, p);
   cli_report r;
-  if (cli_report_collect(&r, s, sv, s->method, st) < 0) {
+  if (cli_report_collect(&r, s, p, sv, s->method, st) < 0) {
     printf("%-40s  out of memory\n", s->title);
     cli_report_free(&r);
     goto done;

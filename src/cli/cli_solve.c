@@ -131,7 +131,7 @@ int cli_solve(int argc, char **argv)
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if (cli_report_collect(&r, s, sv, s->method, st) < 0) {
+  if (cli_report_collect(&r, s, p, sv, s->method, st) < 0) {
     fprintf(stderr, "calcvar solve: out of memory while reporting\n");
     rc = EXIT_UNSOLVED;
     goto done;
