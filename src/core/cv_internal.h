@@ -5,7 +5,6 @@
 
 #include <stddef.h>
 #include "calcvar.h"
-#include "cv_internal_owned.h"
 #include "cv_memory.h" /* the one allocator (tests may inject failures) */
 
 /* Largest batch handed to an integrand callback (documented in calcvar.h). */
@@ -18,13 +17,13 @@
 typedef struct {
   cv_constraint_fn G;
   void *user;
-  void (*release)(void *);
+  cv_release_fn release;
 } cv_pconstraint;
 
 typedef struct {
   cv_integrand_fn K;
   void *user;
-  void (*release)(void *);
+  cv_release_fn release;
   double c;
 } cv_iconstraint;
 
@@ -36,7 +35,7 @@ struct cv_problem {
   double a, b;
   cv_integrand_fn F;
   void *user;
-  void (*release)(void *);
+  cv_release_fn release;
   int *fixed;      /* fixed[2*k + end]: 1 fixed, 0 free (natural condition) */
   double *endval;  /* endval[2*k + end] */
   cv_guess_fn guess;
@@ -241,6 +240,12 @@ struct cv_solver {
   char note[320];              /* what the solver decided on its own, prefixed to msg */
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
+/* The start of a solve (cv_start.c): cv_start_setup discretises the current mesh spec,
+ * allocates the results and fills s->y with the starting values and flags singular ends;
+ * cv_start_values fills Y with the given start / guess, or (line = 1) the straight line. */
+cv_status cv_start_setup(cv_solver *s, const cv_problem *p);
+cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y,
+                          int line);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
 double cv_now(void);
 

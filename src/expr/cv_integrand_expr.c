@@ -1,5 +1,6 @@
-/* src/expr/cv_integrand_expr.c — cv_problem_set_integrand_expr: an integrand given as a
- * formula string, compiled with exact symbolic partials. SPDX-License-Identifier: MIT */
+/* src/expr/cv_integrand_expr.c — cv_problem_set_integrand_expr and the formula constraints
+ * (cv_problem_add_constraint_expr, cv_problem_add_integral_expr): formula strings compiled
+ * with exact symbolic partials. SPDX-License-Identifier: MIT */
 #include <ctype.h>
 #include <math.h>
 #include <stdarg.h>
@@ -8,7 +9,6 @@
 #include <string.h>
 
 #include "calcvar.h"
-#include "core/cv_internal_owned.h"
 #include "expr/ex_integrand.h"
 
 /* Names known while parsing: the variable (slot 0), the unknowns (slots 1..n, primed
@@ -76,12 +76,20 @@ static const char *bad_name(const char *s) {
   return NULL;
 }
 
-cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
-                                        const char *unknowns, const char *F,
-                                        const char *parameters, char *err, size_t errlen) {
+/* The kinds of formula a problem takes: what the formula is called in messages. */
+typedef enum { FORMULA_INTEGRAND, FORMULA_CONSTRAINT, FORMULA_INTEGRAL } formula_kind;
+static const char *const formula_what[] = {"integrand", "constraint", "integral"};
+
+/* Parse F (with its variable, unknowns and parameters) and hand the compiled formula to
+ * the problem as the integrand, a pointwise constraint (no y' allowed) or an integral
+ * constraint int K = c. */
+static cv_status compile(cv_problem *p, const char *variable, const char *unknowns,
+                         const char *F, const char *parameters, formula_kind kind, double c_rhs,
+                         int *index, char *err, size_t errlen) {
+  const char *what = formula_what[kind];
   if (err && errlen) err[0] = 0;
   if (!p || !unknowns || !F) {
-    msg(err, errlen, "problem, unknowns and integrand must not be NULL");
+    msg(err, errlen, "problem, unknowns and %s must not be NULL", what);
     return CVAR_EINVAL;
   }
   cv_status st = CVAR_EINVAL;
@@ -168,18 +176,36 @@ cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
   c.np = np;
   ex_id f = ex_parse(d, F, resolve, &c, 0, perr, sizeof perr);
   if (f < 0) {
-    msg(err, errlen, "integrand: %s", perr);
+    msg(err, errlen, "%s: %s", what, perr);
+    goto cleanup;
+  }
+  if (kind == FORMULA_CONSTRAINT)
+    for (int i = 0; i < c.n; i++)
+      if (ex_depends_on(d, f, 1 + c.n + i)) {
+        msg(err, errlen, "constraint: a pointwise constraint G(%s, y) may not involve %s'",
+            c.var, c.unk[i]);
+        goto cleanup;
+      }
+  if (kind == FORMULA_INTEGRAL && !isfinite(c_rhs)) {
+    msg(err, errlen, "integral: the constant is not a finite number");
     goto cleanup;
   }
   ex_integrand *g = ex_integrand_new(d, c.n, f, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS,
                                      perr, sizeof perr);
   if (!g) {
-    msg(err, errlen, "integrand: %s", perr);
+    msg(err, errlen, "%s: %s", what, perr);
     st = CVAR_ENOMEM;
     goto cleanup;
   }
   /* The problem owns g from here on, also when the call fails (it releases it). */
-  st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
+  if (kind == FORMULA_INTEGRAND)
+    st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
+  else if (kind == FORMULA_CONSTRAINT)
+    st = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g,
+                                         ex_integrand_release, index);
+  else
+    st = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release, c_rhs,
+                                       index);
   if (st != CVAR_OK) msg(err, errlen, "%s", cv_strerror(st));
   goto cleanup;
 nomem:
@@ -192,4 +218,27 @@ cleanup:
   cv_free(c.pname);
   cv_free(c.pval);
   return st;
+}
+
+cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
+                                        const char *unknowns, const char *F,
+                                        const char *parameters, char *err, size_t errlen) {
+  return compile(p, variable, unknowns, F, parameters, FORMULA_INTEGRAND, 0.0, NULL, err,
+                 errlen);
+}
+
+cv_status cv_problem_add_constraint_expr(cv_problem *p, const char *variable,
+                                         const char *unknowns, const char *G,
+                                         const char *parameters, int *index, char *err,
+                                         size_t errlen) {
+  return compile(p, variable, unknowns, G, parameters, FORMULA_CONSTRAINT, 0.0, index, err,
+                 errlen);
+}
+
+cv_status cv_problem_add_integral_expr(cv_problem *p, const char *variable,
+                                       const char *unknowns, const char *K, double c,
+                                       const char *parameters, int *index, char *err,
+                                       size_t errlen) {
+  return compile(p, variable, unknowns, K, parameters, FORMULA_INTEGRAL, c, index, err,
+                 errlen);
 }

@@ -3,7 +3,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "core/cv_internal_owned.h"
 #include "expr/ex_integrand.h"
 #include "scene/scene_internal.h"
 

@@ -1,4 +1,4 @@
-/* src/cli/report.c — gather what `solve` reports from a solver and its scene.
+/* src/scene/scene_report.c — gather what `solve` reports from a solver and its scene.
  * SPDX-License-Identifier: MIT
  *
  * Energy, momenta and [report] integrals are evaluated at the solver's quadrature points
@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cli/cli.h"
+#include "scene/scene_report.h"
 
 const char *cli_status_string(cv_status st)
 {
@@ -295,4 +295,22 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
     return -1;
   compose_message(r, sv);
   return 0;
+}
+
+int cli_report_build(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv, cv_status st,
+                     int adaptive)
+{
+  if (cli_report_collect(r, s, p, sv, cv_solver_get_method(sv), st) < 0)
+    return -1;
+  int any_exact = 0;
+  for (int i = 0; i < s->n; i++)
+    any_exact |= s->exact[i] >= 0;
+  if (adaptive) {
+    /* the adaptive solve's own two-mesh estimate (theory AD-1) */
+    double est = cv_solver_get_error_estimate(sv);
+    r->has_err_est = !any_exact && isfinite(est);
+    r->err_est = est;
+    return 0;
+  }
+  return any_exact ? 0 : cli_report_estimate(r, s, p);
 }
