@@ -235,6 +235,15 @@ CVAR_API cv_status cv_problem_add_integral_expr(cv_problem *p, const char *varia
 CVAR_API int cv_problem_get_num_constraints(const cv_problem *p);
 /** The number of integral constraints added so far. */
 CVAR_API int cv_problem_get_num_integrals(const cv_problem *p);
+/** Energy H = sum_i y'_i dF/dy'_i - F and momenta P_i = dF/dy'_i at m >= 0 points, from
+ * the integrand's own partials (any m: the callback is called in batches), e.g. at the
+ * quadrature points of a solution (cv_solver_get_qpoints): x[k], y[i*m + k], dy[i*m + k]
+ * in; H[k] and P[i*m + k] out, either may be NULL. Returns CVAR_ECALLBACK or
+ * CVAR_ENONFINITE when the callback returns < 0 or > 0 at some point, CVAR_ENOMEM or
+ * CVAR_EINVAL; values are written as they come (the caller checks finiteness). */
+CVAR_API cv_status cv_problem_eval_energy(const cv_problem *p, int m, const double *x,
+                                          const double *y, const double *dy, double *H,
+                                          double *P);
 
 /** Outcome of cv_problem_check_derivatives. */
 typedef struct {

@@ -94,7 +94,7 @@ int cli_equations(int argc, char **argv); /* cli_equations.c */
 int cli_modes(int argc, char **argv);     /* cli_modes.c */
 int cli_unsupported(const char *cmd);
 
-/* gallery_scenes.c */
+/* gallery_scenes.c, generated from examples/scenes by src/cli/embed_scenes.py */
 typedef struct {
   const char *name;
   const char *text;

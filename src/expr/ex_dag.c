@@ -158,17 +158,6 @@ int ex_op_arity(ex_op op) {
   }
 }
 
-const char *ex_op_name(ex_op op) {
-  static const char *const names[EX_NUM_OPS] = {
-      [EX_SIN] = "sin",     [EX_COS] = "cos",     [EX_TAN] = "tan",     [EX_ASIN] = "asin",
-      [EX_ACOS] = "acos",   [EX_ATAN] = "atan",   [EX_SINH] = "sinh",   [EX_COSH] = "cosh",
-      [EX_TANH] = "tanh",   [EX_ASINH] = "asinh", [EX_ACOSH] = "acosh", [EX_ATANH] = "atanh",
-      [EX_EXP] = "exp",     [EX_LOG] = "log",     [EX_SQRT] = "sqrt",   [EX_ABS] = "abs",
-      [EX_ATAN2] = "atan2", [EX_MIN] = "min",     [EX_MAX] = "max",     [EX_IF] = "if",
-      [EX_POW] = "pow"};
-  return (unsigned)op < EX_NUM_OPS ? names[op] : NULL;
-}
-
 /* min/max pick the first operand on ties (the branch whose derivative ex_diff uses) and
  * propagate NaN from either operand instead of hiding it as fmin/fmax would. */
 double ex_apply(ex_op op, double a, double b, double c) {

@@ -116,12 +116,6 @@ int scene_F_depends_on_unknown(const scene *s, int i);
 int scene_eval_exact(const scene *s, int m, const double *x, double *exact);
 /** The guess (the [guess] expression or the default) at m abscissae: y[i*m + k]. */
 int scene_eval_guess(const scene *s, int m, const double *x, double *y);
-/** H = sum_i y'_i dF/dy'_i - F at m points. */
-int scene_eval_energy(scene *s, int m, const double *x, const double *y, const double *dy,
-                      double *H);
-/** p[i*m + k] = dF/dy'_i at m points, every unknown. */
-int scene_eval_momenta(scene *s, int m, const double *x, const double *y, const double *dy,
-                       double *p);
 /** K_r at m points: out[r*m + k] for each [report] entry r. */
 int scene_eval_reports(scene *s, int m, const double *x, const double *y, const double *dy,
                        double *out);

@@ -93,7 +93,7 @@ static const char *taken(const scene *s, const char *name)
 static int check_new_name(sc_loader *L, int line, const char *name, const char *role)
 {
   const char *t;
-  if (!sc_is_identifier(name)) {
+  if (!ex_is_identifier(name)) {
     sc_err(L->err, L->errlen, L->file, line,
            "'%s' is not a valid %s name (letters, digits and '_', starting with a letter)",
            name, role);
@@ -137,25 +137,25 @@ static int load_scene_section(sc_loader *L)
     sc_err(L->err, L->errlen, L->file, hl, "[scene] needs 'unknowns = name, ...'");
     return -1;
   }
-  sc_list list;
-  if (sc_list_split(e->value, &list) < 0)
+  ex_list list;
+  if (ex_list_split(e->value, &list) < 0)
     goto nomem;
   s->unknowns = cv_calloc((size_t)list.n, sizeof *s->unknowns);
   if (!s->unknowns) {
-    sc_list_free(&list);
+    ex_list_free(&list);
     goto nomem;
   }
   for (int i = 0; i < list.n; i++) {
     int line, col;
     sc_entry_locate(e, list.off[i], &line, &col);
     if (check_new_name(L, line, list.item[i], "unknown") < 0) {
-      sc_list_free(&list);
+      ex_list_free(&list);
       return -1;
     }
     s->unknowns[s->n++] = list.item[i];
     list.item[i] = NULL;
   }
-  sc_list_free(&list);
+  ex_list_free(&list);
   if (!find_entry(L, SEC_SCENE, "interval")) {
     sc_err(L->err, L->errlen, L->file, hl, "[scene] needs 'interval = a, b'");
     return -1;
@@ -271,8 +271,8 @@ static int load_interval_integrand(sc_loader *L)
 {
   scene *s = L->s;
   const sc_entry *e = find_entry(L, SEC_SCENE, "interval");
-  sc_list list;
-  if (sc_list_split(e->value, &list) < 0) {
+  ex_list list;
+  if (ex_list_split(e->value, &list) < 0) {
     sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
     return -1;
   }
@@ -296,7 +296,7 @@ static int load_interval_integrand(sc_loader *L)
     goto done;
   rc = 0;
 done:
-  sc_list_free(&list);
+  ex_list_free(&list);
   return rc;
 }
 
