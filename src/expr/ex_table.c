@@ -5,7 +5,8 @@
 #include <string.h>
 
 #include "calcvar.h"
-#include "core/cv_internal_owned.h"
+#include "core/cv_memory.h"
+#include "core/cv_table_internal.h"
 #include "expr/ex_internal.h"
 
 int ex_dag_add_table(ex_dag *d, const char *name, struct cv_table *t) {
@@ -18,13 +19,13 @@ int ex_dag_add_table(ex_dag *d, const char *name, struct cv_table *t) {
     if (fn && strcmp(fn, name) == 0) return -1;
   }
   size_t len = strlen(name);
-  char *copy = malloc(len + 1);
-  char **names = realloc(d->tab_name, ((size_t)d->ntables + 1) * sizeof *names);
+  char *copy = cv_malloc(len + 1);
+  char **names = cv_realloc(d->tab_name, ((size_t)d->ntables + 1) * sizeof *names);
   if (names) d->tab_name = names;
-  struct cv_table **tabs = realloc(d->tabs, ((size_t)d->ntables + 1) * sizeof *tabs);
+  struct cv_table **tabs = cv_realloc(d->tabs, ((size_t)d->ntables + 1) * sizeof *tabs);
   if (tabs) d->tabs = tabs;
   if (!copy || !names || !tabs) {
-    free(copy);
+    cv_free(copy);
     return -1;
   }
   memcpy(copy, name, len + 1);
@@ -35,11 +36,11 @@ int ex_dag_add_table(ex_dag *d, const char *name, struct cv_table *t) {
 
 void ex_dag_free_tables(ex_dag *d) {
   for (int i = 0; i < d->ntables; i++) {
-    free(d->tab_name[i]);
+    cv_free(d->tab_name[i]);
     cv_table_free(d->tabs[i]);
   }
-  free(d->tab_name);
-  free(d->tabs);
+  cv_free(d->tab_name);
+  cv_free(d->tabs);
   d->tab_name = NULL;
   d->tabs = NULL;
   d->ntables = 0;

@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "calcvar.h"
-#include "core/cv_internal_owned.h"
+#include "core/cv_table_internal.h"
 #include "expr/ex_internal.h"
 
 /* Tape operations. Suffix V = vector operand, K = the instruction's scalar constant. */
@@ -111,11 +111,11 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
     if (outs[o] > top) top = outs[o];
   }
   int nn = top + 1;
-  ex_tape *t = calloc(1, sizeof *t);
-  cnode *cn = calloc((size_t)(nn > 0 ? nn : 1), sizeof *cn);
+  ex_tape *t = cv_calloc(1, sizeof *t);
+  cnode *cn = cv_calloc((size_t)(nn > 0 ? nn : 1), sizeof *cn);
   int *freeregs = NULL, nfree = 0;
   /* At most one instruction per node plus one per output (copies and fills). */
-  instr *ins = malloc(((size_t)nn + (size_t)nout + 1) * sizeof *ins);
+  instr *ins = cv_malloc(((size_t)nn + (size_t)nout + 1) * sizeof *ins);
   if (!t || !cn || !ins) goto fail;
   t->nslots = nslots;
   t->nout = nout;
@@ -159,7 +159,7 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
     if (c->home.space < 0 && !c->konst && d->nodes[outs[o]].op != EX_SLOT)
       c->home = (loc){L_OUT, o};
   }
-  freeregs = malloc(((size_t)nn + 1) * sizeof *freeregs);
+  freeregs = cv_malloc(((size_t)nn + 1) * sizeof *freeregs);
   if (!freeregs) goto fail;
 
   int n = 0;
@@ -239,13 +239,13 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
         for (int j = 0; j < t->ntab; j++)
           if (t->tab[j] == d->tabs[index]) in.tab = j;
         if (in.tab < 0) {
-          cv_table **tabs = realloc(t->tab, ((size_t)t->ntab + 1) * sizeof *tabs);
+          cv_table **tabs = cv_realloc(t->tab, ((size_t)t->ntab + 1) * sizeof *tabs);
           if (tabs) t->tab = tabs;
-          char **names = realloc(t->tabname, ((size_t)t->ntab + 1) * sizeof *names);
+          char **names = cv_realloc(t->tabname, ((size_t)t->ntab + 1) * sizeof *names);
           if (names) t->tabname = names;
-          char *copy = malloc(strlen(d->tab_name[index]) + 1);
+          char *copy = cv_malloc(strlen(d->tab_name[index]) + 1);
           if (!tabs || !names || !copy) {
-            free(copy);
+            cv_free(copy);
             goto fail;
           }
           strcpy(copy, d->tab_name[index]);
@@ -253,7 +253,7 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
           t->tabname[t->ntab] = copy;
           in.tab = t->ntab++;
         }
-        table_group *gr = realloc(t->group, ((size_t)t->ngroup + 1) * sizeof *gr);
+        table_group *gr = cv_realloc(t->group, ((size_t)t->ngroup + 1) * sizeof *gr);
         if (!gr) goto fail;
         t->group = gr;
         gr = &t->group[t->ngroup];
@@ -343,13 +343,13 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
   }
   t->ins = ins;
   t->nins = n;
-  free(cn);
-  free(freeregs);
+  cv_free(cn);
+  cv_free(freeregs);
   return t;
 fail:
-  free(cn);
-  free(freeregs);
-  free(ins);
+  cv_free(cn);
+  cv_free(freeregs);
+  cv_free(ins);
   if (t) t->ins = NULL;
   ex_tape_free(t);
   return NULL;
@@ -359,13 +359,13 @@ void ex_tape_free(ex_tape *t) {
   if (!t) return;
   for (int j = 0; j < t->ntab; j++) {
     cv_table_free(t->tab[j]);
-    free(t->tabname[j]);
+    cv_free(t->tabname[j]);
   }
-  free(t->tab);
-  free(t->tabname);
-  free(t->group);
-  free(t->ins);
-  free(t);
+  cv_free(t->tab);
+  cv_free(t->tabname);
+  cv_free(t->group);
+  cv_free(t->ins);
+  cv_free(t);
 }
 
 size_t ex_tape_work_size(const ex_tape *t, int m) {

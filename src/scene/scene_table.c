@@ -15,7 +15,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/cv_internal_owned.h"
+#include "core/cv_memory.h"
+#include "core/cv_table_internal.h"
 #include "scene/scene_internal.h"
 
 enum { TB_MAXCOL = 4 };
@@ -162,11 +163,11 @@ static int dset_add(dset *s, double x)
     x = 0.0; /* -0 and 0 are one coordinate */
   if ((s->n + 1) * 2 > s->cap) {
     size_t ncap = s->cap ? s->cap * 2 : 64;
-    double *nv = malloc(ncap * sizeof *nv);
-    unsigned char *nu = calloc(ncap, 1);
+    double *nv = cv_malloc(ncap * sizeof *nv);
+    unsigned char *nu = cv_calloc(ncap, 1);
     if (!nv || !nu) {
-      free(nv);
-      free(nu);
+      cv_free(nv);
+      cv_free(nu);
       return -1;
     }
     for (size_t i = 0; i < s->cap; i++)
@@ -179,8 +180,8 @@ static int dset_add(dset *s, double x)
         nu[h] = 1;
         nv[h] = s->v[i];
       }
-    free(s->v);
-    free(s->used);
+    cv_free(s->v);
+    cv_free(s->used);
     s->v = nv;
     s->used = nu;
     s->cap = ncap;
@@ -229,14 +230,14 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
     return NULL;
   }
   size_t len = 0, cap = 1 << 16;
-  text = malloc(cap + 1);
+  text = cv_malloc(cap + 1);
   while (text) {
     len += fread(text + len, 1, cap - len, f);
     if (len < cap)
       break;
-    char *nt = realloc(text, (cap *= 2) + 1);
+    char *nt = cv_realloc(text, (cap *= 2) + 1);
     if (!nt) {
-      free(text);
+      cv_free(text);
       text = NULL;
     } else
       text = nt;
@@ -307,8 +308,8 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
     }
     if (nrows == caprows) {
       caprows = caprows ? caprows * 2 : 1024;
-      double *nr = realloc(rows, caprows * (size_t)ncol * sizeof *nr);
-      int *nlines = realloc(rowline, caprows * sizeof *nlines);
+      double *nr = cv_realloc(rows, caprows * (size_t)ncol * sizeof *nr);
+      int *nlines = cv_realloc(rowline, caprows * sizeof *nlines);
       if (nr)
         rows = nr;
       if (nlines)
@@ -353,7 +354,7 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
              names[k], ds[k].n, ds[k].n == 1 ? "" : "s");
       goto done;
     }
-    coords[k] = malloc(ds[k].n * sizeof *coords[k]);
+    coords[k] = cv_malloc(ds[k].n * sizeof *coords[k]);
     if (!coords[k]) {
       sc_err(err, errlen, shown, 0, "out of memory");
       goto done;
@@ -366,8 +367,8 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
     n[k] = (int)m;
     size *= m;
   }
-  vals = malloc(size * sizeof *vals);
-  where = calloc(size, sizeof *where); /* line of the row holding each point, 0 = none */
+  vals = cv_malloc(size * sizeof *vals);
+  where = cv_calloc(size, sizeof *where); /* line of the row holding each point, 0 = none */
   if (!vals || !where) {
     sc_err(err, errlen, shown, 0, "out of memory");
     goto done;
@@ -411,15 +412,15 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
   if (!t)
     sc_err(err, errlen, shown, 0, "%s", msg);
 done:
-  free(text);
-  free(rows);
-  free(rowline);
-  free(vals);
-  free(where);
+  cv_free(text);
+  cv_free(rows);
+  cv_free(rowline);
+  cv_free(vals);
+  cv_free(where);
   for (int k = 0; k < 3; k++) {
-    free(coords[k]);
-    free(ds[k].v);
-    free(ds[k].used);
+    cv_free(coords[k]);
+    cv_free(ds[k].v);
+    cv_free(ds[k].used);
   }
   return t;
 }
@@ -444,7 +445,7 @@ int sc_load_tables(sc_loader *L)
       return -1;
     }
     size_t vl = strlen(e->value);
-    char *path = malloc(dirlen + vl + 1);
+    char *path = cv_malloc(dirlen + vl + 1);
     if (!path) {
       sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
       return -1;
@@ -462,10 +463,10 @@ int sc_load_tables(sc_loader *L)
         sc_err(L->err, L->errlen, L->file, e->line, "table '%s': %s", e->key, msg);
       else
         snprintf(L->err, L->errlen, "%s", msg); /* the CSV's own FILE:LINE */
-      free(path);
+      cv_free(path);
       return -1;
     }
-    free(path);
+    cv_free(path);
     int idx = ex_dag_add_table(s->dag, e->key, t);
     cv_table_free(t); /* the DAG holds its own reference */
     if (idx < 0) {
