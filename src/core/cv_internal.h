@@ -244,8 +244,15 @@ struct cv_solver {
   int adapt_max, rounds;
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
+  double search_work;          /* cv_solve_all's work limit (cv_deflation.c) */
+  struct cv_pathset *paths;    /* the paths of the last cv_solve_all (cv_deflation.c) */
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
+/* Starting values on d: the start or guess (line = 0) or the straight line (line = 1). */
+cv_status cv_solver_initial_values(cv_solver *s, const cv_problem *p, const cv_disc *d,
+                                   double *Y, int line);
+/* The paths found by cv_solve_all (cv_deflation.c); NULL is a no-op. */
+void cv_pathset_free(struct cv_pathset *ps);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
 double cv_now(void);
 

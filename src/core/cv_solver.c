@@ -19,6 +19,7 @@ cv_solver *cv_solver_new(cv_status *why) {
   s->rtol = s->atol = 1e-10;
   s->maxit = 50;
   s->continuation = 1;
+  s->search_work = 8.0;
   s->adapt_max = 1000000;
   s->err_est = NAN;
   s->status = CVAR_ESTATE;
@@ -35,6 +36,7 @@ void cv_solver_free(cv_solver *s) {
   cv_free(s->y);
   cv_free(s->mult);
   cv_disc_free(&s->disc);
+  cv_pathset_free(s->paths);
   cv_free(s);
 }
 
@@ -412,6 +414,8 @@ done:
 cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   if (!s) return CVAR_EINVAL;
   double t0 = cv_now();
+  cv_pathset_free(s->paths); /* a plain solve forgets the paths of cv_solve_all */
+  s->paths = NULL;
   s->err_est = NAN;
   s->rounds = 0;
   cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
@@ -596,3 +600,8 @@ cv_status cv_solver_set_continuation(cv_solver *s, int on) {
 }
 
 int cv_solver_get_continuation_steps(const cv_solver *s) { return s ? s->csteps : 0; }
+
+cv_status cv_solver_initial_values(cv_solver *s, const cv_problem *p, const cv_disc *d,
+                                   double *Y, int line) {
+  return initial_values(s, p, d, Y, line);
+}
