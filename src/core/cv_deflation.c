@@ -18,7 +18,8 @@
 
 #define DEFL_P 2.0      /* power of the distance (DF-1) */
 #define DEFL_SIGMA 1.0  /* shift: M -> 1 far from every known path (DF-1) */
-#define DEFL_MAXIT 60   /* deflated Newton iterations per start */
+#define DEFL_MAXIT 25   /* deflated Newton iterations per start */
+#define WORK_FLOOR 64   /* the work limit is at least this many iterations */
 #define EIG_DIRS 3      /* lowest Hessian eigen-directions per path (DF-4) */
 #define EIG_STEPS 6     /* block inverse-iteration steps */
 #define MAX_BACKTRACK 30
@@ -431,8 +432,8 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
   first = st = cv_solve(s, p);
   info->starts = 1;
   /* Bounded work (DF-4): Newton iterations of the search, deflated and polishing, at most
-   * search_work times those of the first solve (at least 1). */
-  int work = 0, budget = (int)fmin(1e9, s->search_work * (s->iterations > 1 ? s->iterations : 1));
+   * search_work times those of the first solve, and at least WORK_FLOOR. */
+  int work = 0, budget = (int)fmin(1e9, fmax(WORK_FLOOR, s->search_work * s->iterations));
   memcpy(msg0, s->msg, sizeof msg0);
   if (!s->have) goto finish; /* bad input: nothing to search around */
   /* 2. The search mesh: the mesh of that solve, frozen (DF-5); adaptation only polishes. */
@@ -477,7 +478,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
 
   /* 3. Starts (DF-4): the guess and the straight line, deflated; then around every path
    * found, in order, perturbations along its EIG_DIRS softest Hessian directions. */
-  static const double amp[] = {1.0, -1.0, 2.5, -2.5};
+  static const double amp[] = {0.5, -0.5, 1.5, -1.5};
   int namp = (int)(sizeof amp / sizeof amp[0]);
   int around = 0; /* the path whose perturbations are being tried */
   int nmodes = -1, mode = 0, ai = 0, phase = 0;
@@ -489,8 +490,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
     }
     if (work >= budget) {
       cv_set_msg(info->stop, sizeof info->stop,
-                 "the work limit was reached (%d Newton iterations, %g times the first "
-                 "solve's)", work, s->search_work);
+                 "the work limit was reached (%d Newton iterations)", work);
       break;
     }
     /* the next start into Y */
