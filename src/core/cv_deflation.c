@@ -506,6 +506,12 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
       s->start_len = 0;
       if (st) continue;
     } else {
+      if (w.nknown == 0) {
+        cv_set_msg(info->stop, sizeof info->stop,
+                   "no path converged from the guess, so there was none to deflate or to "
+                   "perturb");
+        break;
+      }
       if (around >= w.nknown) {
         cv_set_msg(info->stop, sizeof info->stop,
                    "every start was tried (the guess, the straight line and %d perturbations "

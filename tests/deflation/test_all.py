@@ -134,7 +134,7 @@ if out:
 # ---- pendulum th'' = -sin th from 0 to 0.5 in time 10: shooting with RK4 on the
 # equation and its Jacobi equation h'' = -cos(th) h, h(0) = 0, h'(0) = 1; the number of
 # zeros of h in (0, 10) is the number of conjugate points = the Morse index.
-def shoot(v, T=10.0, N=4000):
+def shoot(v, T=10.0, N=2000):
     h = T / N
 
     def f(s):
@@ -158,8 +158,8 @@ def shoot(v, T=10.0, N=4000):
 
 # every root of th(10; v) = 0.5 with |v| < 2 (beyond, the pendulum goes over the top and
 # never comes back to 0.5): a grid, finer towards the separatrix v = +-2
-vs = sorted(set([-1.9999 + 3.9998 * i / 600 for i in range(601)] +
-                [sg * 2 * (1 - 10 ** (-e / 10)) for sg in (1, -1) for e in range(30, 130)]))
+vs = sorted(set([-1.9999 + 3.9998 * i / 200 for i in range(201)] +
+                [sg * 2 * (1 - 10 ** (-e / 10)) for sg in (1, -1) for e in range(30, 130, 2)]))
 fs = [shoot(v)[0] for v in vs]
 roots = []
 for i in range(len(vs) - 1):
