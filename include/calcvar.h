@@ -380,8 +380,8 @@ typedef struct {
  * forgets the paths. */
 cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max);
 /** Work limit of cv_solve_all: its Newton iterations after the first solve (deflated and
- * polishing) stop at factor (>= 1, default 8) times the iterations of that first solve, or
- * at 64 when that is more. */
+ * polishing) stop at factor (>= 1, default 8) times the iterations of that first solve
+ * (counted as at least 8). */
 cv_status cv_solver_set_search_work(cv_solver *s, double factor);
 /** Number of distinct converged paths of the last cv_solve_all (0 otherwise). */
 int cv_solver_get_num_solutions(const cv_solver *s);

@@ -82,7 +82,7 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
                strcmp(name, "-h") == 0 || strcmp(name, "--all") == 0;
     static const char *const valued[] = {
       "--elements", "--degree", "--method", "--tolerance", "--max-iterations", "--set",
-      "--adapt", "--continue", "--json", "--csv", "--plot", "--max", NULL};
+      "--adapt", "--continue", "--json", "--csv", "--plot", "--max", "--work", NULL};
     int known = flag;
     for (int k = 0; valued[k]; k++)
       known |= strcmp(name, valued[k]) == 0;
@@ -116,6 +116,9 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     } else if (strcmp(name, "--max") == 0) {
       if (parse_int(v, 1, 1000, &o->max_paths) < 0)
         return bad(cmd, "--max needs a whole number of paths from 1 to 1000, got '%s'", v);
+    } else if (strcmp(name, "--work") == 0) {
+      if (parse_pos_double(v, &o->work) < 0 || o->work < 1 || o->work > 1e6)
+        return bad(cmd, "--work needs a factor from 1 to 1e6, got '%s'", v);
     } else if (strcmp(name, "--max-iterations") == 0) {
       if (parse_int(v, 1, INT_MAX, &o->max_iterations) < 0)
         return bad(cmd, "--max-iterations needs a whole number >= 1, got '%s'", v);
@@ -173,8 +176,8 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     return 0;
   if (!o->scene_path)
     return bad(cmd, "a scene file is missing: calcvar %s SCENE [options]", cmd);
-  if (o->max_paths && !o->all)
-    return bad(cmd, "--max K counts the paths of --all; give --all too");
+  if ((o->max_paths || o->work > 0) && !o->all)
+    return bad(cmd, "--max and --work belong to --all; give --all too");
   if (o->json && o->csv && strcmp(o->json, "-") == 0 && strcmp(o->csv, "-") == 0)
     return bad(cmd, "--json - and --csv - cannot both write to stdout");
   if (o->json && o->csv && strcmp(o->json, o->csv) == 0 && strcmp(o->json, "-") != 0)

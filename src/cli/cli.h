@@ -24,6 +24,7 @@ typedef struct {
   const char *json, *csv, *plot;
   int quiet, help;
   int all, max_paths; /* --all, --max K (0: default 8) */
+  double work;        /* --work F: the search's work limit (0: default 8) */
 } cli_opts;
 
 /* args.c: parse argv (after the command word). Returns 0, or EXIT_BADINPUT after printing

@@ -163,11 +163,11 @@ static int write_plot(cli_outfile *o, cli_report *r, const int *keep, int np, cv
       ln->colour = num - 1;
       ln->style = n > 1 ? i % 8 : 0;
       if (n > 1)
-        snprintf(labels[nl], sizeof labels[nl], "%d: %s, %s (Morse %d), action %.6g", num,
-                 s->unknowns[i], r[k].kind ? r[k].kind : "?", r[k].morse, r[k].action);
+        snprintf(labels[nl], sizeof labels[nl], "%d %s: %s", num, s->unknowns[i],
+                 r[k].kind ? r[k].kind : "?");
       else
-        snprintf(labels[nl], sizeof labels[nl], "%d: %s (Morse %d), action %.6g", num,
-                 r[k].kind ? r[k].kind : "?", r[k].morse, r[k].action);
+        snprintf(labels[nl], sizeof labels[nl], "%d: %s (Morse %d)", num,
+                 r[k].kind ? r[k].kind : "?", r[k].morse);
       ln->label = labels[nl++];
     }
   }
@@ -193,6 +193,10 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, doubl
                 cli_outfile *jf, cli_outfile *cf, cli_outfile *pf)
 {
   int max = o->max_paths > 0 ? o->max_paths : 8, rc = EXIT_UNSOLVED;
+  if (o->work > 0 && cv_solver_set_search_work(sv, o->work) != CVAR_OK) {
+    fprintf(stderr, "calcvar solve: invalid --work %g\n", o->work);
+    return EXIT_BADINPUT;
+  }
   cv_status st = cv_solve_all(sv, p, max);
   if (st == CVAR_EINVAL) {
     fprintf(stderr, "%s: %s\n", s->file, cv_solver_last_error(sv));

@@ -26,6 +26,7 @@ static void usage(FILE *f)
         "  --continue name=from:to   continuation in a parameter\n"
         "  --all                every stationary path that can be found (deflation)\n"
         "  --max K              at most K paths with --all (default 8)\n"
+        "  --work F             --all's work limit: F times the first solve's (default 8)\n"
         "  --json FILE          JSON report ('-' for stdout)\n"
         "  --csv FILE           nodal table ('-' for stdout)\n"
         "  --plot FILE          picture of the solution (.png or .svg)\n"

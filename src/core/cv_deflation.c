@@ -19,7 +19,7 @@
 #define DEFL_P 2.0      /* power of the distance (DF-1) */
 #define DEFL_SIGMA 1.0  /* shift: M -> 1 far from every known path (DF-1) */
 #define DEFL_MAXIT 25   /* deflated Newton iterations per start */
-#define WORK_FLOOR 64   /* the work limit is at least this many iterations */
+#define WORK_FLOOR 8    /* the first solve counts as at least this many iterations */
 #define EIG_DIRS 3      /* lowest Hessian eigen-directions per path (DF-4) */
 #define EIG_STEPS 6     /* block inverse-iteration steps */
 #define MAX_BACKTRACK 30
@@ -432,8 +432,8 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
   first = st = cv_solve(s, p);
   info->starts = 1;
   /* Bounded work (DF-4): Newton iterations of the search, deflated and polishing, at most
-   * search_work times those of the first solve, and at least WORK_FLOOR. */
-  int work = 0, budget = (int)fmin(1e9, fmax(WORK_FLOOR, s->search_work * s->iterations));
+   * search_work times those of the first solve (counted as at least WORK_FLOOR). */
+  int work = 0, budget = (int)fmin(1e9, s->search_work * fmax(WORK_FLOOR, s->iterations));
   memcpy(msg0, s->msg, sizeof msg0);
   if (!s->have) goto finish; /* bad input: nothing to search around */
   /* 2. The search mesh: the mesh of that solve, frozen (DF-5); adaptation only polishes. */
