@@ -166,8 +166,7 @@ static int write_plot(cli_outfile *o, cli_report *r, const int *keep, int np, cv
         snprintf(labels[nl], sizeof labels[nl], "%d %s: %s", num, s->unknowns[i],
                  r[k].kind ? r[k].kind : "?");
       else
-        snprintf(labels[nl], sizeof labels[nl], "%d: %s (Morse %d)", num,
-                 r[k].kind ? r[k].kind : "?", r[k].morse);
+        snprintf(labels[nl], sizeof labels[nl], "%d: %s", num, r[k].kind ? r[k].kind : "?");
       ln->label = labels[nl++];
     }
   }
