@@ -3,7 +3,7 @@
  * SPDX-License-Identifier: MIT
  *
  * Each path gets the report a plain solve writes (cli_report_collect), with its own error
- * estimate: the reference solve of estimate.c starts from that path (the problem's guess
+ * estimate: the reference solve of scene_estimate.c starts from that path (the problem's guess
  * is pointed at the selected path), so it polishes the same path on the finer mesh rather
  * than whichever path the scene's guess leads to. Two paths whose nodal values differ by
  * at most the larger of their error estimates are one path (SCENES.md): the one of higher
@@ -204,28 +204,19 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, doubl
   cv_search_info in;
   memset(&in, 0, sizeof in);
   cv_solver_get_search(sv, &in);
-  int np = cv_solver_get_num_solutions(sv), listed = 0, any_exact = 0;
+  int np = cv_solver_get_num_solutions(sv), listed = 0;
   cli_report *r = calloc((size_t)(np ? np : 1), sizeof *r);
   int *keep = calloc((size_t)(np ? np : 1), sizeof *keep);
   path_guess pg = {sv, s->a, s->b};
   if (!r || !keep)
     goto oom;
-  for (int i = 0; i < s->n; i++)
-    any_exact |= s->exact[i] >= 0;
   /* every later solve on p (the estimates' reference solves) starts from the selected path */
   if (np > 0 && cv_problem_set_guess(p, guess_from_path, &pg) != CVAR_OK)
     goto oom;
   for (int k = 0; k < np; k++) {
     if (cv_solver_select_solution(sv, k) != CVAR_OK ||
-        cli_report_collect(&r[k], s, sv, s->method, CVAR_OK) < 0)
+        cli_report_build(&r[k], s, p, sv, CVAR_OK, adapt > 0) < 0)
       goto oom;
-    if (adapt > 0) {
-      double est = cv_solver_get_error_estimate(sv);
-      r[k].has_err_est = !any_exact && isfinite(est);
-      r[k].err_est = est;
-    } else if (!any_exact && cli_report_estimate(&r[k], s, p) < 0) {
-      goto oom;
-    }
     keep[k] = 1;
   }
   /* distinct only beyond the error estimate of either (paths are in increasing action) */

@@ -501,7 +501,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
       if (w.nknown == 0 || (line && !p->guess && !start0)) continue;
       s->start = line ? NULL : start0;
       s->start_len = line ? 0 : start_len0;
-      st = cv_solver_initial_values(s, p, &ds, Y, line);
+      st = cv_start_values(s, p, &ds, Y, line);
       s->start = NULL;
       s->start_len = 0;
       if (st) continue;
