@@ -187,6 +187,48 @@ if out:
             check("pendulum path v0 = %.6f: Morse index %d = conjugate points" % (v, z),
                   best[1]["morse_index"] == z, (best[1]["morse_index"], z))
 
+
+# ---- the mirage, n(y) = 1 + a tanh(y/b), ends at height h, L apart: a ray turning at
+# height t keeps Snell's invariant n / sqrt(1 + y'^2) = n(t), so it covers the horizontal
+# distance D(t) = 2 int_t^h n(t) / sqrt(n(y)^2 - n(t)^2) dy (y = t + s^2 removes the
+# inverse square root). The rays are the roots of D(t) = L, found here by bisection.
+A, B, H, L = 0.01, 0.2, 1.0, 20.0
+nidx = lambda y: 1 + A * math.tanh(y / B)
+
+
+def reach(t, m=400):
+    C, S = nidx(t), math.sqrt(H - t)
+    def g(s):
+        if s == 0:
+            dn = A / B / math.cosh(t / B) ** 2
+            return 2 * C / math.sqrt(2 * C * dn)
+        y = t + s * s
+        return 2 * s * C / math.sqrt(nidx(y) ** 2 - C * C)
+    hs = S / m
+    tot = g(0) + g(S) + sum((4 if k % 2 else 2) * g(k * hs) for k in range(1, m))
+    return 2 * tot * hs / 3
+
+
+ts = [-0.6 + 1.5999 * k / 400 for k in range(401)]
+ds = [reach(t) - L for t in ts]
+turns = [bisect(lambda u: reach(u) - L, ts[k], ts[k + 1], 60)
+         for k in range(len(ts) - 1) if ds[k] * ds[k + 1] < 0]
+mirage = os.path.join(os.path.dirname(data), "..", "examples", "scenes", "mirage.scene")
+with tempfile.TemporaryDirectory() as tmp:
+    c = os.path.join(tmp, "m.csv")
+    r = run("solve", mirage, "--all", "--work", "100", "--json", "-", "--csv", c)
+    if r.returncode == 0:
+        out = json.loads(r.stdout)
+        rows = list(csv.reader(open(c)))[1:]
+        lows = sorted(min(float(row[2]) for row in rows if row[0] == str(k + 1))
+                      for k in range(len(out["solutions"])))
+        check("mirage: three rays by Snell's invariant", len(turns) == 3, turns)
+        check("mirage: every ray found", len(lows) == len(turns), (lows, turns))
+        for t, lo in zip(sorted(turns), lows):
+            check("mirage: a ray turns at %.6f" % t, abs(t - lo) < 1e-5, (t, lo))
+        kinds = [s_["morse_index"] for s_ in out["solutions"]]
+        check("mirage: two minima and a saddle", sorted(kinds) == [0, 0, 1], kinds)
+
 # ---- a convex action: exactly one path
 out = with_nodes("convex.scene")
 if out:
