@@ -244,6 +244,8 @@ struct cv_solver {
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
   int near_sing[2];            /* ends found nearly singular after a solve */
+  double search_work;          /* cv_solve_all's work limit (cv_deflation.c) */
+  struct cv_pathset *paths;    /* the paths of the last cv_solve_all (cv_deflation.c) */
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
 /* The start of a solve (cv_start.c): cv_start_setup discretises the current mesh spec,
@@ -257,6 +259,8 @@ cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, d
  * the action under the singular-end rule there. */
 int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
                             double action, double *rel);
+/* The paths found by cv_solve_all (cv_deflation.c); NULL is a no-op. */
+void cv_pathset_free(struct cv_pathset *ps);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
 double cv_now(void);
 

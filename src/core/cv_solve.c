@@ -177,6 +177,8 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
 cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   if (!s) return CVAR_EINVAL;
   double t0 = cv_now();
+  cv_pathset_free(s->paths); /* a plain solve forgets the paths of cv_solve_all */
+  s->paths = NULL;
   s->err_est = NAN;
   s->rounds = 0;
   if (p && p->note) p->note(p->user, 1);
