@@ -247,16 +247,13 @@ struct cv_solver {
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
   int near_sing[2];            /* ends found nearly singular after a solve */
-<<<<<<< HEAD
   double search_work;          /* cv_solve_all's work limit (cv_deflation.c) */
   struct cv_pathset *paths;    /* the paths of the last cv_solve_all (cv_deflation.c) */
-=======
   /* The sparse LDL^T of the Hessian pattern of `disc` (CHOLMOD common, pattern, symbolic
    * analysis) and the y dof of each unknown: made by the first Newton run on the mesh and
    * reused by the next ones on it (retries, continuation steps); dropped with the mesh. */
   struct cv_ldlt *ldlt;
   int *gof;
->>>>>>> wip/trust
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
 /* Release the solver's factor of its mesh (before the mesh changes). */
