@@ -7,6 +7,7 @@
 
 #include "calcvar.h"
 #include "scene/scene.h"
+#include "scene/scene_report.h"
 
 /* Exit statuses of SCENES.md, and (an addition, docs/cli.md) 3 when a report or the
  * standard output could not be written. */
@@ -16,7 +17,7 @@ enum { EXIT_SOLVED = 0, EXIT_UNSOLVED = 1, EXIT_BADINPUT = 2, EXIT_IOERROR = 3 }
 typedef struct {
   const char *scene_path;
   int elements, degree, max_iterations;
-  int method; /* sc_method or -1 */
+  int method; /* cv_method or -1 */
   double tolerance;
   double adapt;
   int max_elements; /* --max-elements: the adaptive cap (0: 2e6) */
@@ -25,6 +26,8 @@ typedef struct {
   sc_set *set;
   const char *json, *csv, *plot;
   int quiet, help;
+  int all, max_paths; /* --all, --max K (0: default 8) */
+  double work;        /* --work F: the search's work limit (0: default 8) */
 } cli_opts;
 
 /* args.c: parse argv (after the command word). Returns 0, or EXIT_BADINPUT after printing
@@ -39,47 +42,6 @@ int cli_only_scene_options(const char *cmd, const cli_opts *o);
 int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver **svp,
                        cv_status *stp, char *cont_msg, size_t cmlen, char *err, size_t errlen);
 
-/* What `solve` reports; has_* flags say which keys apply (SCENES.md: keys that do not
- * apply are left out). report.c fills it from a solver and its scene. */
-typedef struct {
-  const scene *sc;
-  sc_method method;
-  cv_status st;
-  const char *status;
-  char message[640];
-  int elements, degree, nodes, n;
-  int has_action, has_gradient_norm, has_time;
-  double action, gradient_norm, time_s;
-  int iterations;
-  int has_morse;
-  int morse;
-  const char *kind;
-  int has_err_nodal, has_err_action, has_err_est;
-  double err_nodal, err_action, err_est;
-  int has_energy;
-  double emin, emax;
-  int *has_mom;
-  double *mom_min, *mom_max;
-  int *has_rep;
-  double *rep;
-  double *x, *y; /* nodes and node-major values y[j*n + i] */
-  double *lam;   /* multiplier fields lam[c*nodes + j] of [constraints], or NULL */
-  int *has_mu;   /* [integrals] multipliers */
-  double *mu;
-} cli_report;
-
-const char *cli_status_string(cv_status st);
-int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_status st);
-/* estimate.c: the max nodal error of a solve without [exact], from a reference solve on
- * a mesh whose element boundaries include every node (docs/cli.md). cli_estimate_error
- * gives the max over all nodes and over the element boundaries (NaN when the reference
- * solve fails); both return 0, or -1 on allocation failure. */
-int cli_report_estimate(cli_report *r, const scene *s, const cv_problem *p);
-int cli_estimate_error(const scene *s, const cv_problem *p, int nodes, int degree,
-                       const double *x, const double *y, double *e_all, double *e_vertex);
-void cli_report_free(cli_report *r);
-
-int cli_report_json(FILE *f, const cli_report *r);
 int cli_report_csv(FILE *f, const cli_report *r);
 void cli_report_text(FILE *f, const cli_report *r);
 
@@ -138,7 +100,10 @@ typedef struct {
 int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_converge_json(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_plot_converge(cli_outfile *o, const cli_conv_row *rows, int nrows);
-struct json_t *cli_report_json_object(const cli_report *r);
+
+/* cli_all.c: `solve --all`: the deflated search, its reports; returns the exit status. */
+int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, double adapt,
+                cli_outfile *jf, cli_outfile *cf, cli_outfile *pf);
 
 /* Subcommands. */
 int cli_converge(int argc, char **argv);
@@ -149,7 +114,7 @@ int cli_equations(int argc, char **argv); /* cli_equations.c */
 int cli_modes(int argc, char **argv);     /* cli_modes.c */
 int cli_unsupported(const char *cmd);
 
-/* gallery_scenes.c */
+/* gallery_scenes.c, generated from examples/scenes by src/cli/embed_scenes.py */
 typedef struct {
   const char *name;
   const char *text;

@@ -25,6 +25,9 @@ static void usage(FILE *f)
         "  --adapt TOL          refine until the estimated max nodal error < TOL\n"
         "  --max-elements N     cap of adaptive refinement (default 2000000)\n"
         "  --continue name=from:to   continuation in a parameter\n"
+        "  --all                every stationary path that can be found (deflation)\n"
+        "  --max K              at most K paths with --all (default 8)\n"
+        "  --work F             --all's work limit: F times the first solve's (default 8)\n"
         "  --json FILE          JSON report ('-' for stdout)\n"
         "  --csv FILE           nodal table ('-' for stdout)\n"
         "  --plot FILE          picture of the solution (.png or .svg)\n"
@@ -46,14 +49,24 @@ static int unsupported(const cli_opts *o, const scene *s)
             "(--adapt TOL or [mesh] adapt)\n");
     return EXIT_BADINPUT;
   }
-  if ((s->method == SC_LBFGS || s->method == SC_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
+  if (o->all && o->cont) {
+    fprintf(stderr, "calcvar solve: --all and --continue cannot be combined (the search "
+            "keeps one scene)\n");
+    return EXIT_BADINPUT;
+  }
+  if (o->all && s->method != CVAR_METHOD_NEWTON) {
+    fprintf(stderr, "calcvar solve: --all needs the Newton engine (method %s finds minima "
+            "only, not the saddles the search is for)\n", cv_method_name(s->method));
+    return EXIT_BADINPUT;
+  }
+  if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
     /* an unconstrained minimiser cannot impose [constraints] or [integrals] */
     if (o->method >= 0)
       fprintf(stderr, "calcvar solve: --method %s cannot impose constraints; use mma, ccsaq, "
-              "slsqp, auglag or newton\n", scene_method_name(s->method));
+              "slsqp, auglag or newton\n", cv_method_name(s->method));
     else
       fprintf(stderr, "%s:%d: method %s cannot impose constraints; use mma, ccsaq, slsqp, "
-              "auglag or newton\n", s->file, s->method_line, scene_method_name(s->method));
+              "auglag or newton\n", s->file, s->method_line, cv_method_name(s->method));
     return EXIT_BADINPUT;
   }
   return 0;
@@ -86,7 +99,7 @@ int cli_solve(int argc, char **argv)
   if (o.degree)
     s->degree = o.degree;
   if (o.method >= 0)
-    s->method = (sc_method)o.method;
+    s->method = (cv_method)o.method;
   if (o.tolerance > 0)
     s->tolerance = o.tolerance;
   if (o.max_iterations)
@@ -118,6 +131,10 @@ int cli_solve(int argc, char **argv)
   }
   cv_status st;
   char cont_msg[256] = "";
+  if (o.all) {
+    rc = cli_all_run(&o, s, p, sv, adapt, &jf, &cf, &pf);
+    goto done;
+  }
   if (o.cont) {
     /* continuation replaces scene, problem and solver by those of its last step */
     cv_solver_free(sv);
@@ -139,7 +156,7 @@ int cli_solve(int argc, char **argv)
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if (cli_report_collect(&r, s, sv, s->method, st) < 0) {
+  if (cli_report_build(&r, s, p, sv, st, adapt > 0) < 0) {
     fprintf(stderr, "calcvar solve: out of memory while reporting\n");
     rc = EXIT_UNSOLVED;
     goto done;
@@ -150,19 +167,6 @@ int cli_solve(int argc, char **argv)
                                                       : cont_msg[0];
     snprintf(r.message + used, sizeof r.message - used, "%s%c%s.", used ? " " : "", c0,
              cont_msg + 1);
-  }
-  int any_exact = 0;
-  for (int i = 0; i < s->n; i++)
-    any_exact |= s->exact[i] >= 0;
-  if (adapt > 0) {
-    /* the adaptive solve's own two-mesh estimate */
-    double est = cv_solver_get_error_estimate(sv);
-    r.has_err_est = !any_exact && isfinite(est);
-    r.err_est = est;
-  } else if (!any_exact && cli_report_estimate(&r, s, p) < 0) {
-    fprintf(stderr, "calcvar solve: out of memory while estimating the error\n");
-    rc = EXIT_UNSOLVED;
-    goto done;
   }
   rc = st == CVAR_OK ? EXIT_SOLVED : EXIT_UNSOLVED;
   if (jf.f && cli_outfile_finish(&jf, cli_report_json(jf.f, &r)) < 0) {

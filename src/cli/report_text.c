@@ -7,7 +7,7 @@ void cli_report_text(FILE *f, const cli_report *r)
   const scene *s = r->sc;
   fprintf(f, "%s\n", s->title);
   fprintf(f, "  status      %s: %s\n", r->status, r->message);
-  fprintf(f, "  method      %s, %d iteration%s", scene_method_name(r->method), r->iterations,
+  fprintf(f, "  method      %s, %d iteration%s", cv_method_name(r->method), r->iterations,
           r->iterations == 1 ? "" : "s");
   if (r->has_time)
     fprintf(f, ", %.3g s", r->time_s);
@@ -22,7 +22,7 @@ void cli_report_text(FILE *f, const cli_report *r)
             r->gradient_norm);
     /* Newton's convergence test is on the step, not on this number, which on fine meshes
      * sits at a round-off floor that grows with the number of elements (docs/faq.md). */
-    if (r->method == SC_NEWTON && r->st == CVAR_OK)
+    if (r->method == CVAR_METHOD_NEWTON && r->st == CVAR_OK)
       fprintf(f, "  test        Newton step within %.3g (relative to |y|); the residual is "
               "not tested\n", s->tolerance);
   }

@@ -32,14 +32,14 @@ static const char *kind_of(mode_t m)
 static char *read_all(int fd, const char *name, size_t *len, char *err, size_t errlen)
 {
   size_t cap = 4096, n = 0;
-  char *buf = malloc(cap);
+  char *buf = cv_malloc(cap);
   /* one byte more than the cap is read, to tell "exactly the cap" from "more" */
   while (buf && n <= SC_MAX_BYTES) {
     if (n == cap) {
       size_t ncap = cap * 2 > (size_t)SC_MAX_BYTES + 1 ? (size_t)SC_MAX_BYTES + 1 : cap * 2;
-      char *nb = realloc(buf, ncap);
+      char *nb = cv_realloc(buf, ncap);
       if (!nb)
-        free(buf);
+        cv_free(buf);
       buf = nb;
       cap = ncap;
       continue;
@@ -49,7 +49,7 @@ static char *read_all(int fd, const char *name, size_t *len, char *err, size_t e
       continue;
     if (k < 0) {
       int e = errno;
-      free(buf);
+      cv_free(buf);
       sc_err(err, errlen, name, 0, "read error: %s", strerror(e));
       return NULL;
     }
@@ -62,7 +62,7 @@ static char *read_all(int fd, const char *name, size_t *len, char *err, size_t e
     return NULL;
   }
   if (n > SC_MAX_BYTES) {
-    free(buf);
+    cv_free(buf);
     sc_err(err, errlen, name, 0, "the scene is larger than %d bytes (%d MiB), the most "
            "calcvar reads; is this a scene file?", SC_MAX_BYTES, SC_MAX_BYTES >> 20);
     return NULL;
@@ -118,6 +118,6 @@ scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
   if (!buf)
     return NULL;
   scene *s = scene_load_buffer(buf, len, name, nset, set, err, errlen);
-  free(buf);
+  cv_free(buf);
   return s;
 }

@@ -1,4 +1,4 @@
-/* src/cli/estimate.c — the nodal error of a solve without [exact], from a reference solve.
+/* src/scene/scene_estimate.c — the nodal error of a solve without [exact], from a reference solve.
  * SPDX-License-Identifier: MIT
  *
  * Why not plain Richardson between the mesh and its double: the interior GLL nodes of a
@@ -24,7 +24,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "cli/cli.h"
+#include "scene/scene_report.h"
 
 /* The reference mesh on [0, 1]: every node x[0..nn-1] of the judged mesh becomes an
  * element boundary; with degree 1, each element is also halved. Returns the element
@@ -32,7 +32,7 @@
 static int reference_mesh(const scene *s, int nn, const double *x, int degree, double **t)
 {
   int ne = degree == 1 ? 2 * (nn - 1) : nn - 1;
-  double *u = malloc((size_t)(ne + 1) * sizeof *u), L = s->b - s->a;
+  double *u = cv_malloc((size_t)(ne + 1) * sizeof *u), L = s->b - s->a;
   if (!u)
     return -1;
   for (int j = 0, k = 0; j < nn; j++) {
@@ -57,7 +57,7 @@ int cli_estimate_error(const scene *s, const cv_problem *p, int nn, int degree,
   cv_status why;
   double *t = NULL;
   cv_solver *f = cv_solver_new(&why);
-  double *yf = malloc((size_t)nn * n * sizeof *yf);
+  double *yf = cv_malloc((size_t)nn * n * sizeof *yf);
   int ne = reference_mesh(s, nn, x, degree, &t);
   if (!f || !yf || ne < 0)
     goto done;
@@ -84,8 +84,8 @@ int cli_estimate_error(const scene *s, const cv_problem *p, int nn, int degree,
   }
 done:
   cv_solver_free(f);
-  free(yf);
-  free(t);
+  cv_free(yf);
+  cv_free(t);
   return rc;
 }
 
