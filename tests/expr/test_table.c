@@ -59,7 +59,8 @@ static cv_table *sample(int dim, int n, const double *lo, const double *hi, fn3 
 }
 
 static double cubic3(const double *u) {
-  return 1 + u[0] - 2 * u[0] * u[0] * u[0] + u[0] * u[1] * u[1] * u[1] - 0.5 * u[2] * u[2] * u[2] * u[1] +
+  return 1 + u[0] - 2 * u[0] * u[0] * u[0] + u[0] * u[1] * u[1] * u[1] -
+         0.5 * u[2] * u[2] * u[2] * u[1] +
          u[0] * u[0] * u[1] * u[2];
 }
 /* its exact partials: grad and a few second/third orders */
@@ -89,7 +90,8 @@ static void test_cubic_exact(void) {
     double worst = 0;
     for (int s = 0; s < 50; s++) {
       double u[3];
-      for (int k = 0; k < 3; k++) u[k] = lo[k] + (hi[k] - lo[k]) * fmod(0.6180339887 * (s + 1) * (k + 1.3), 1.0);
+      for (int k = 0; k < 3; k++)
+        u[k] = lo[k] + (hi[k] - lo[k]) * fmod(0.6180339887 * (s + 1) * (k + 1.3), 1.0);
       for (size_t j = 0; j < sizeof ords / sizeof ords[0]; j++) {
         double v;
         CHECK(cv_table_eval(t, u, ords[j], &v) == 0, "eval inside the grid failed");
@@ -175,7 +177,8 @@ typedef struct {
 static const ray_case cases[] = {
     {"1-D n(y)", 1, 1, -1.2, 1.2, {1.5}, {2.05}, n1, ray1, "y", "n(y)*sqrt(1 + y'^2)",
      "sqrt(1 + y'^2)/y"},
-    {"2-D n(x, y)", 2, 1, -0.8, 0.8, {-0.8, 0.2}, {0.8, 0.65}, n2, ray2, "y", "n(x, y)*sqrt(1 + y'^2)",
+    {"2-D n(x, y)", 2, 1, -0.8, 0.8, {-0.8, 0.2}, {0.8, 0.65}, n2, ray2, "y",
+     "n(x, y)*sqrt(1 + y'^2)",
      "2/(1 + x^2 + y^2)*sqrt(1 + y'^2)"},
     {"3-D n(x, y, z)", 3, 2, -0.8, 0.8, {-0.8, 0.2, 0.15}, {0.8, 0.52, 0.39}, n3, ray3, "y, z",
      "n(x, y, z)*sqrt(1 + y'^2 + z'^2)", "2/(1 + x^2 + y^2 + z^2)*sqrt(1 + y'^2 + z'^2)"},
@@ -263,7 +266,8 @@ static void test_outside(void) {
   cv_table *t = sample(2, 8, c->lo, c->hi, c->f, 0);
   char msg[700];
   int it;
-  double e = solve_ray(c, t, &it, msg, sizeof msg, 0.2); /* ends at y = 0.2, but the middle at 0.82 > 0.65 */
+  /* ends at y = 0.48, inside; the ray's middle would be at 0.82 > 0.65 */
+  double e = solve_ray(c, t, &it, msg, sizeof msg, 0.2);
   printf("outside the grid: %s\n", msg);
   CHECK(e < 0, "a solve with its ends outside the grid succeeded");
   CHECK(strstr(msg, "table 'n'") != NULL, "the message does not name the table: %s", msg);
