@@ -279,6 +279,31 @@ if out:
     check("convex: exactly one path", len(out["solutions"]) == 1, len(out["solutions"]))
     check("convex: a minimum", out["solutions"][0]["stationary_kind"] == "minimum", out)
 
+
+# ---- nothing converged (Bratu has no solution beyond lambda = 3.51...): exit 1, a
+# sentence on stderr, a JSON with no solutions and the search record
+with tempfile.TemporaryDirectory() as tmp:
+    j = os.path.join(tmp, "none.json")
+    r = run("solve", os.path.join(data, "bratu.scene"), "--all", "--set", "lambda=4",
+            "--json", j, expect_rc=1)
+    check("no path: a sentence", "no converged stationary path" in r.stderr, r.stderr)
+    if os.path.exists(j):
+        d = json.load(open(j))
+        check("no path: empty list", d.get("solutions") == [] and d["search"]["found"] == 0, d)
+
+# ---- with --adapt: both catenaries, each on its own adapted mesh with its own estimate
+r = run("solve", os.path.join(data, "catenary_two.scene"), "--all", "--adapt", "1e-9",
+        "--elements", "8", "--degree", "4", "--json", "-")
+if r.returncode == 0:
+    sols = json.loads(r.stdout)["solutions"]
+    check("adapt: two paths", len(sols) == 2, len(sols))
+    check("adapt: Morse 0 and 1", [s_["morse_index"] for s_ in sols] == [0, 1], sols)
+    f = lambda c: c * math.cosh(1 / c) - 2
+    for s_, c in zip(sols, (bisect(f, 0.9, 5.0), bisect(f, 0.2, 0.85))):
+        area = c * (1 + c / 2 * math.sinh(2 / c))
+        check("adapt: estimate at most the tolerance", s_.get("error_estimate", 1) <= 1e-9, s_)
+        check("adapt: action", abs(s_["action"] - area) < 1e-8, (s_["action"], area))
+
 # ---- --max 1 returns the lowest-action path found
 for scene in ("bratu.scene", "pendulum_swings.scene", "catenary_two.scene"):
     full = solve_all(scene)
