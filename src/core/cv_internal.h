@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include "calcvar.h"
 #include "cv_memory.h" /* the one allocator (tests may inject failures) */
+#include "cv_table_internal.h"
 
 /* Largest batch handed to an integrand callback (documented in calcvar.h). */
 #define CV_BATCH 256
@@ -40,6 +41,10 @@ struct cv_problem {
   double *endval;  /* endval[2*k + end] */
   cv_guess_fn guess;
   void *guess_user;
+  cv_note_fn note;   /* the integrand's failure note (cv_table_internal.h), or NULL */
+  int ntables;       /* tables added by cv_problem_add_table, each with a reference */
+  char **table_name;
+  cv_table **table;
 };
 
 /* ---- reference element: GLL nodes, Gauss-Legendre rule, basis tables (cv_quadrature.c) */
@@ -242,6 +247,8 @@ struct cv_solver {
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
   int near_sing[2];            /* ends found nearly singular after a solve */
+  double search_work;          /* cv_solve_all's work limit (cv_deflation.c) */
+  struct cv_pathset *paths;    /* the paths of the last cv_solve_all (cv_deflation.c) */
   /* The sparse LDL^T of the Hessian pattern of `disc` (CHOLMOD common, pattern, symbolic
    * analysis) and the y dof of each unknown: made by the first Newton run on the mesh and
    * reused by the next ones on it (retries, continuation steps); dropped with the mesh. */
@@ -262,6 +269,8 @@ cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, d
  * the action under the singular-end rule there. */
 int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
                             double action, double *rel);
+/* The paths found by cv_solve_all (cv_deflation.c); NULL is a no-op. */
+void cv_pathset_free(struct cv_pathset *ps);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
 double cv_now(void);
 

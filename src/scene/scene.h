@@ -21,6 +21,9 @@
 #include "expr/expr.h"
 
 enum { SC_ERRLEN = 1024 };
+/* The largest scene file read (bytes): a scene is a page of text; the cap keeps
+ * `solve /dev/zero` or a wrong file from eating the memory (docs/scenes.md). */
+enum { SC_MAX_BYTES = 4 << 20 };
 
 /** One `--set name=value` override; value is a constant expression. */
 typedef struct {
@@ -82,7 +85,10 @@ typedef struct scene {
   int max_iterations;  /* default 50 */
 } scene;
 
-/** Load a scene file. `name` for messages is the path itself. nset overrides (may be 0). */
+/** Load a scene file. `name` for messages is the path itself; the path "-" reads standard
+ * input, named "<stdin>" in messages (read once; later loads of "-" in the process reuse
+ * its text). Only regular files (and "-") of at most SC_MAX_BYTES are read. nset overrides
+ * (may be 0). */
 scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
                        size_t errlen);
 /** Load a scene from memory: len bytes (NUL bytes inside are rejected), `name` is used in
@@ -116,12 +122,6 @@ int scene_F_depends_on_unknown(const scene *s, int i);
 int scene_eval_exact(const scene *s, int m, const double *x, double *exact);
 /** The guess (the [guess] expression or the default) at m abscissae: y[i*m + k]. */
 int scene_eval_guess(const scene *s, int m, const double *x, double *y);
-/** H = sum_i y'_i dF/dy'_i - F at m points. */
-int scene_eval_energy(scene *s, int m, const double *x, const double *y, const double *dy,
-                      double *H);
-/** p[i*m + k] = dF/dy'_i at m points, every unknown. */
-int scene_eval_momenta(scene *s, int m, const double *x, const double *y, const double *dy,
-                       double *p);
 /** K_r at m points: out[r*m + k] for each [report] entry r. */
 int scene_eval_reports(scene *s, int m, const double *x, const double *y, const double *dy,
                        double *out);

@@ -43,28 +43,28 @@ static int cmp_double(const void *a, const void *b)
 static int load_breakpoints(sc_loader *L, const sc_entry *e)
 {
   scene *s = L->s;
-  sc_list list;
-  if (sc_list_split(e->value, &list) < 0 ||
+  ex_list list;
+  if (ex_list_split(e->value, &list) < 0 ||
       !(s->breakpoints = cv_malloc((size_t)list.n * sizeof *s->breakpoints))) {
-    sc_list_free(&list);
+    ex_list_free(&list);
     sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
     return -1;
   }
   for (int i = 0; i < list.n; i++) {
     double v;
     if (sc_parse_const(L, e, list.off[i], list.item[i], "breakpoint", &v) < 0) {
-      sc_list_free(&list);
+      ex_list_free(&list);
       return -1;
     }
     if (!(v > s->a && v < s->b)) {
       sc_err(L->err, L->errlen, L->file, e->line,
              "breakpoint %.17g is not inside the interval (%.17g, %.17g)", v, s->a, s->b);
-      sc_list_free(&list);
+      ex_list_free(&list);
       return -1;
     }
     s->breakpoints[s->nbreak++] = v;
   }
-  sc_list_free(&list);
+  ex_list_free(&list);
   qsort(s->breakpoints, (size_t)s->nbreak, sizeof *s->breakpoints, cmp_double);
   for (int i = 1; i < s->nbreak; i++)
     if (s->breakpoints[i] == s->breakpoints[i - 1]) {

@@ -11,59 +11,6 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-void sc_list_free(sc_list *list)
-{
-  for (int i = 0; i < list->n; i++)
-    cv_free(list->item[i]);
-  cv_free(list->item);
-  cv_free(list->off);
-  memset(list, 0, sizeof *list);
-}
-
-/* Split at commas outside parentheses (SCENES.md: `atan2(1, 2), 0` is two values); each
- * item is trimmed. Returns the item count, or -1 on allocation failure. */
-int sc_list_split(const char *value, sc_list *list)
-{
-  int depth = 0, cap = 0;
-  const char *start = value;
-  memset(list, 0, sizeof *list);
-  for (const char *p = value;; p++) {
-    if (*p == '(')
-      depth++;
-    else if (*p == ')' && depth > 0)
-      depth--;
-    if (*p == '\0' || (*p == ',' && depth == 0)) {
-      const char *a = start, *b = p;
-      while (a < b && (*a == ' ' || *a == '\t'))
-        a++;
-      while (b > a && (b[-1] == ' ' || b[-1] == '\t'))
-        b--;
-      if (list->n == cap) {
-        cap = cap ? 2 * cap : 4;
-        char **it = cv_realloc(list->item, (size_t)cap * sizeof *it);
-        if (it)
-          list->item = it;
-        int *off = cv_realloc(list->off, (size_t)cap * sizeof *off);
-        if (off)
-          list->off = off;
-        if (!it || !off)
-          goto nomem;
-      }
-      list->item[list->n] = sc_strndup(a, (size_t)(b - a));
-      if (!list->item[list->n])
-        goto nomem;
-      list->off[list->n++] = (int)(a - value);
-      if (*p == '\0')
-        break;
-      start = p + 1;
-    }
-  }
-  return list->n;
-nomem:
-  sc_list_free(list);
-  return -1;
-}
-
 /* The name of a slot for messages: the variable, y or y'. */
 const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap)
 {
@@ -175,8 +122,26 @@ ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const
     return -1;
   }
   ex_id r = ex_parse(L->s->dag, text, resolve, L, 0, msg, sizeof msg);
-  if (r >= 0)
-    return r;
+  if (r >= 0) {
+    /* A constant that is not finite (0/0, log(0), sqrt(-1)*0) is bad input, never a NaN
+     * carried into the solve (theory (EX-1)). */
+    ex_id bad = ex_nonfinite_const(L->s->dag, r);
+    if (bad == -1)
+      return r;
+    char sub[160] = "?";
+    double v = NAN;
+    if (bad >= 0) {
+      ex_print(L->s->dag, bad, NULL, sub, sizeof sub);
+      ex_eval_const(L->s->dag, bad, &v);
+    }
+    sc_entry_locate(e, off, &line, &col);
+    if (bad == -2)
+      sc_err(L->err, L->errlen, L->file, line, "%s: out of memory", what);
+    else
+      sc_err(L->err, L->errlen, L->file, line, "%s: the constant '%s' is not a finite number "
+             "(%s)", what, sub, isnan(v) ? "NaN" : v > 0 ? "+inf" : "-inf");
+    return -1;
+  }
   int c = 0, k = 0;
   if (sscanf(msg, "column %d: %n", &c, &k) >= 1 && k > 0 && c >= 1) {
     sc_entry_locate(e, off + c - 1, &line, &col);
@@ -207,8 +172,8 @@ int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
     return -1;
   }
   if (!isfinite(*value)) {
-    sc_err(L->err, L->errlen, L->file, line, "%s '%s' is not a finite number (%g)", what,
-           text, *value);
+    sc_err(L->err, L->errlen, L->file, line, "%s '%s' is not a finite number (%s)", what,
+           text, isnan(*value) ? "NaN" : *value > 0 ? "+inf" : "-inf");
     return -1;
   }
   return 0;

@@ -96,15 +96,15 @@ int main(void)
                                        sizeof err);
     cv_status st = pb ? scene_solver_configure(s, sv, err, sizeof err) : CVAR_ENOMEM;
     if (pb && st == CVAR_OK) st = cv_solve(sv, pb);
-    int ev = st == CVAR_OK ? scene_eval_energy(s, 2, x, y, dy, H) : -1;
-    if (ev == 0) ev = scene_eval_momenta(s, 2, x, y, dy, p);
+    cv_status ev = st == CVAR_OK ? cv_problem_eval_energy(pb, 2, x, y, dy, H, p) : CVAR_ENOMEM;
     cv_debug_fail_alloc_after(-1);
     snprintf(what, sizeof what, "problem/solve/energy, allocation %d fails", k);
     if (!pb) truth(what, err[0] != '\0', "NULL problem without a message");
     else if (st != CVAR_OK)
       truth(what, st == CVAR_ENOMEM || st == CVAR_EDEPENDENCY || st == CVAR_ECALLBACK,
             cv_status_name(st));
-    else if (ev == 0) ok = 1;
+    else if (ev == CVAR_OK) ok = 1;
+    else truth(what, ev == CVAR_ENOMEM, cv_status_name(ev));
     cv_problem_free(pb);
     cv_solver_free(sv);
     scene_free(s);
