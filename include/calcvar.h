@@ -444,9 +444,10 @@ CVAR_API cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, do
 /** A loaded scene. Opaque; made by cv_scene_load_file or cv_scene_load_text, released by
  * cv_scene_free. */
 typedef struct cv_scene cv_scene;
-/** Load the scene file at path. set: nset strings "name=value" (value a constant
- * expression) overriding [parameters]; NULL when nset is 0. NULL on failure, with the
- * sentence in err. */
+/** Load the scene file at path: a regular file of at most 4 MiB, or "-" for standard
+ * input (read once per process; "<stdin>" in messages). set: nset strings "name=value"
+ * (value a constant expression) overriding [parameters]; NULL when nset is 0. NULL on
+ * failure, with the sentence in err. */
 CVAR_API cv_scene *cv_scene_load_file(const char *path, int nset, const char *const *set,
                                       char *err, size_t errlen);
 /** Load a scene from NUL-terminated text; name (NULL: "<text>") stands for the file in
@@ -488,6 +489,42 @@ CVAR_API cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *
 CVAR_API const char *cv_report_json(const cv_report *r);
 /** Release a report; NULL is a no-op. */
 CVAR_API void cv_report_free(cv_report *r);
+/**@}*/
+
+/** \name Every stationary path: deflation (theory DF-1..DF-5) */
+/**@{*/
+/** How a cv_solve_all search went. */
+typedef struct {
+  int starts;     /**< starting points tried (the plain solve from the guess counts as one) */
+  int failed;     /**< starts from which no stationary path converged */
+  int duplicates; /**< starts that converged to a path already found */
+  int found;      /**< distinct converged paths kept (cv_solver_get_num_solutions) */
+  char stop[200]; /**< why the search stopped, one sentence */
+} cv_search_info;
+
+/** Search for up to max >= 1 distinct stationary paths of p (minima and saddles) with the
+ * same ends: a plain cv_solve from the guess, then Newton on the deflated system (DF-3) from
+ * the guess, the straight line and perturbations of every path found along its softest
+ * Hessian directions (DF-4); every path is polished by plain Newton (adaptively when
+ * cv_solver_set_adapt is on) and reported with its own Morse index. Two paths are the same
+ * when their nodal values differ by at most the larger of their error estimates (adaptive
+ * solves) and 1e-6 of their size (DF-5). Newton engine only (else CVAR_EINVAL).
+ * Returns CVAR_OK when at least one path converged; the paths are then ordered by
+ * increasing action and path 0 is selected: every getter above reads the selected path.
+ * Otherwise the status and getters describe the failed plain solve. A later cv_solve
+ * forgets the paths. */
+CVAR_API cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max);
+/** Work limit of cv_solve_all: its Newton iterations after the first solve (deflated and
+ * polishing) stop at factor (>= 1, default 8) times the iterations of that first solve
+ * (counted as at least 8). */
+CVAR_API cv_status cv_solver_set_search_work(cv_solver *s, double factor);
+/** Number of distinct converged paths of the last cv_solve_all (0 otherwise). */
+CVAR_API int cv_solver_get_num_solutions(const cv_solver *s);
+/** Make path k (0 <= k < cv_solver_get_num_solutions) the one the getters read (nodes,
+ * values, action, Morse index, multipliers, ...). CVAR_ESTATE without a cv_solve_all. */
+CVAR_API cv_status cv_solver_select_solution(cv_solver *s, int k);
+/** What the last cv_solve_all tried and why it stopped. CVAR_ESTATE without one. */
+CVAR_API cv_status cv_solver_get_search(const cv_solver *s, cv_search_info *info);
 /**@}*/
 
 #ifdef __cplusplus

@@ -19,6 +19,7 @@ static void results_reset(cv_solver *s) {
   cv_free(s->y);
   cv_free(s->mult);
   s->y = s->mult = NULL;
+  cv_solver_drop_factor(s);
   cv_disc_free(&s->disc);
   s->have = 0;
   s->iterations = 0;
@@ -177,6 +178,8 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
 cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   if (!s) return CVAR_EINVAL;
   double t0 = cv_now();
+  cv_pathset_free(s->paths); /* a plain solve forgets the paths of cv_solve_all */
+  s->paths = NULL;
   s->err_est = NAN;
   s->rounds = 0;
   for (int k = 0; p && k < p->nnotes; k++) p->notes[k].fn(p->notes[k].user, 1);
