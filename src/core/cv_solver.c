@@ -27,8 +27,16 @@ cv_solver *cv_solver_new(cv_status *why) {
   return s;
 }
 
+void cv_solver_drop_factor(cv_solver *s) {
+  cv_ldlt_free(s->ldlt);
+  cv_free(s->gof);
+  s->ldlt = NULL;
+  s->gof = NULL;
+}
+
 void cv_solver_free(cv_solver *s) {
   if (!s) return;
+  cv_solver_drop_factor(s);
   cv_free(s->mesh.t);
   cv_free(s->mesh.breaks);
   cv_free(s->start);
