@@ -128,6 +128,7 @@ struct json_t *cli_report_json_object(const cli_report *r);
 
 /* Subcommands. */
 int cli_converge(int argc, char **argv);
+int cli_batch(int argc, char **argv);     /* cli_batch.c */
 int cli_gallery(void);
 int cli_solve(int argc, char **argv);
 int cli_check(int argc, char **argv);
