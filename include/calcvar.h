@@ -361,20 +361,21 @@ cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y, 
  * expressions; each row (values of some parameters) is then solved as `calcvar solve
  * SCENE --set name=value ...` would solve it, on several threads (docs/scale-out.md).
  * @{ */
+/** A compiled scene and its per-thread solvers. */
 typedef struct cv_batch cv_batch;
 
 /** One solved row. outputs is the caller's: NULL, or room for cv_batch_num_outputs()
  * values (the [report] integrals, then the [integrals] multipliers), NaN where absent. */
 typedef struct {
   cv_status status;       /**< CVAR_OK only when converged */
-  int iterations;
+  int iterations;         /**< Newton (or minimiser) iterations */
   double time_s;          /**< wall-clock seconds of this row */
   int has_result;         /**< converged: action, morse_index, errors, outputs are set */
-  double action;
+  double action;          /**< the discrete action */
   int morse_index;        /**< -1 when unknown (a method other than Newton) */
   double error_max_nodal; /**< against [exact]; NaN without it */
   double error_estimate;  /**< of an adaptive solve; NaN otherwise */
-  double *outputs;
+  double *outputs;        /**< see above */
   int warm;               /**< 1: started from the previous row's solution */
   char message[400];      /**< the report's sentence */
 } cv_batch_result;
@@ -382,12 +383,15 @@ typedef struct {
 /** Read and compile the scene file (exit-2 kind of problems come back NULL with
  * "FILE:LINE: what is wrong" in err). */
 cv_batch *cv_batch_new(const char *scene_path, char *err, size_t errlen);
+/** Release; NULL is a no-op. */
 void cv_batch_free(cv_batch *b);
-/** The scene's [parameters], in file order. */
+/** The number of the scene's [parameters]. */
 int cv_batch_num_parameters(const cv_batch *b);
+/** Name of parameter i (file order), NULL when out of range. */
 const char *cv_batch_parameter_name(const cv_batch *b, int i);
 /** Result columns besides the fixed ones: [report] names, then "mu_" + integral name. */
 int cv_batch_num_outputs(const cv_batch *b);
+/** Name of output k, NULL when out of range. */
 const char *cv_batch_output_name(const cv_batch *b, int k);
 /** Which parameters a row gives, in order (default: none, i.e. the scene's values). */
 cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names, char *err,

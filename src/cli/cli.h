@@ -34,8 +34,11 @@ void cli_opts_free(cli_opts *o);
 int cli_only_scene_options(const char *cmd, const cli_opts *o);
 
 /* cli_continue.c: `solve --continue name=from:to` (see there). */
-int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver **svp,
-                       cv_status *stp, char *cont_msg, size_t cmlen, char *err, size_t errlen);
+/* The scene is read and compiled once (parameters as inputs); *bp owns it and *sp is its
+ * instance at the reported value: free *pp and *svp, then cv_batch_free(*bp). */
+int cli_continue_solve(const cli_opts *o, cv_batch **bp, const scene **sp, cv_problem **pp,
+                       cv_solver **svp, cv_status *stp, char *cont_msg, size_t cmlen,
+                       char *err, size_t errlen);
 
 /* What `solve` reports; has_* flags say which keys apply (SCENES.md: keys that do not
  * apply are left out). report.c fills it from a solver and its scene. */

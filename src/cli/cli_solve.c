@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "cli/cli.h"
+#include "scene/scene_batch.h"
 
 static void usage(FILE *f)
 {
@@ -67,6 +68,7 @@ int cli_solve(int argc, char **argv)
   scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
   cv_problem *p = NULL;
   cv_solver *sv = NULL;
+  cv_batch *cb = NULL; /* --continue: the compiled scene */
   cli_outfile jf = {0}, cf = {0}, pf = {0};
   cli_report r;
   memset(&r, 0, sizeof r);
@@ -116,12 +118,14 @@ int cli_solve(int argc, char **argv)
     cv_problem_free(p);
     scene_free(s);
     s = NULL, p = NULL, sv = NULL;
-    if (cli_continue_solve(&o, &s, &p, &sv, &st, cont_msg, sizeof cont_msg, err,
+    const scene *si = NULL;
+    if (cli_continue_solve(&o, &cb, &si, &p, &sv, &st, cont_msg, sizeof cont_msg, err,
                            sizeof err) < 0) {
       fprintf(stderr, "%s\n", err);
       rc = EXIT_BADINPUT;
       goto done;
     }
+    s = (scene *)si; /* the batch's instance: cb owns it (its DAG may grow for the report) */
   } else {
     st = cv_solve(sv, p);
   }
@@ -182,7 +186,9 @@ done:
   cli_report_free(&r);
   cv_solver_free(sv);
   cv_problem_free(p);
-  scene_free(s);
+  if (!cb)
+    scene_free(s);
+  cv_batch_free(cb);
   cli_opts_free(&o);
   return rc;
 }

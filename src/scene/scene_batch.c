@@ -592,6 +592,49 @@ done:
   r->time_s = now() - t0;
 }
 
+/* Make sure workers 0..T-1 exist. */
+static cv_status workers(cv_batch *b, int T)
+{
+  if (T <= b->nworkers)
+    return CVAR_OK;
+  worker *nw = realloc(b->w, (size_t)T * sizeof *nw);
+  if (!nw)
+    return CVAR_ENOMEM;
+  b->w = nw;
+  while (b->nworkers < T) {
+    if (worker_init(b, &b->w[b->nworkers]) < 0) {
+      worker_free(b, &b->w[b->nworkers]);
+      return CVAR_ENOMEM;
+    }
+    b->nworkers++;
+  }
+  return CVAR_OK;
+}
+
+cv_problem *scene_batch_problem(cv_batch *b, const double *row, const scene **inst,
+                                char *err, size_t errlen)
+{
+  if (err && errlen)
+    err[0] = '\0';
+  if (!b || workers(b, 1) != CVAR_OK) {
+    snprintf(err, errlen, "out of memory");
+    return NULL;
+  }
+  worker *w = &b->w[0];
+  if (set_row(b, w->inst, w->pv, row, err, errlen) < 0)
+    return NULL;
+  cv_problem *p = row_problem(b, w);
+  int any_guess = 0;
+  for (int i = 0; p && i < w->inst->n; i++)
+    any_guess |= w->inst->guess[i] >= 0;
+  if (p && any_guess)
+    cv_problem_set_guess(p, guess_cb, w->inst);
+  if (!p)
+    snprintf(err, errlen, "%s: out of memory while setting up the problem", b->s->file);
+  *inst = w->inst;
+  return p;
+}
+
 typedef struct {
   cv_batch *b;
   int nrows, block;
@@ -627,19 +670,8 @@ cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_re
   if (nrows == 0)
     return CVAR_OK;
   int T = b->nthreads < nrows ? b->nthreads : nrows;
-  if (T > b->nworkers) {
-    worker *nw = realloc(b->w, (size_t)T * sizeof *nw);
-    if (!nw)
-      return CVAR_ENOMEM;
-    b->w = nw;
-    while (b->nworkers < T) {
-      if (worker_init(b, &b->w[b->nworkers]) < 0) {
-        worker_free(b, &b->w[b->nworkers]);
-        return CVAR_ENOMEM;
-      }
-      b->nworkers++;
-    }
-  }
+  if (workers(b, T) != CVAR_OK)
+    return CVAR_ENOMEM;
   /* Blocks of consecutive rows, claimed in turn: about 8 per thread keeps the threads
    * busy to the end; inside a block each row may warm-start from the one before. */
   job j = {b, nrows, nrows / (8 * T) > 0 ? nrows / (8 * T) : 1, rows, res, 0};

@@ -17,4 +17,13 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen);
 /** The scene of the batch (the values of its fields are those of the last check). */
 const scene *scene_batch_scene(const cv_batch *b);
 
+/** The problem of one row for the caller's own solver (continuation, which carries its
+ * mesh and start from step to step): the batch's first worker takes the row's values
+ * and a problem over its compiled clones is built, without reading or compiling the
+ * scene again. *inst receives the worker's scene instance (its values are this row's
+ * until the next call). Free the problem (cv_problem_free) before the next call and
+ * before the batch. NULL with a sentence in err when the values are invalid. */
+cv_problem *scene_batch_problem(cv_batch *b, const double *row, const scene **inst,
+                                char *err, size_t errlen);
+
 #endif /* CV_SCENE_BATCH_H */
