@@ -34,9 +34,10 @@ void cli_opts_free(cli_opts *o);
 int cli_only_scene_options(const char *cmd, const cli_opts *o);
 
 /* cli_continue.c: `solve --continue name=from:to` (see there). */
-/* The scene is read and compiled once (parameters as inputs); *bp owns it and *sp is its
- * instance at the reported value: free *pp and *svp, then cv_batch_free(*bp). */
-int cli_continue_solve(const cli_opts *o, cv_batch **bp, const scene **sp, cv_problem **pp,
+/* s0: the scene, loaded once with parameters as inputs (scene_load_file_inputs) and
+ * owned from here on; it is compiled once. *bp owns it and *sp is its instance at the
+ * reported value: free *pp and *svp, then cv_batch_free(*bp). */
+int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene **sp, cv_problem **pp,
                        cv_solver **svp, cv_status *stp, char *cont_msg, size_t cmlen,
                        char *err, size_t errlen);
 

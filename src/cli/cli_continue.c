@@ -12,16 +12,10 @@
 #define FIRST_STEPS 10
 #define MIN_FRACTION (1.0 / 4096)
 
-/* The scene read and compiled once, its parameters as inputs (issue 18): every step
+/* The scene (read once by the caller) compiled once, its parameters as inputs (issue 18): every step
  * only sets the continued parameter and builds a problem over the compiled integrand. */
-static cv_batch *load_once(const cli_opts *o, const char *name, char *err, size_t errlen) {
-  scene *s = scene_load_file_inputs(o->scene_path, o->nset, o->set, err, errlen);
-  if (!s) return NULL;
-  if (o->elements) s->elements = o->elements;
-  if (o->degree) s->degree = o->degree;
-  if (o->method >= 0) s->method = (sc_method)o->method;
-  if (o->tolerance > 0) s->tolerance = o->tolerance;
-  if (o->max_iterations) s->max_iterations = o->max_iterations;
+static cv_batch *load_once(const cli_opts *o, scene *s, const char *name, char *err,
+                           size_t errlen) {
   int found = 0;
   for (int i = 0; i < s->nparams; i++) found |= strcmp(s->params[i].name, name) == 0;
   if (!found) {
@@ -63,7 +57,7 @@ static int carry_over(cv_solver *from, cv_solver *to, int n) {
 /* Solve by continuation. On return *sp, *pp, *svp hold the last scene, problem and solver
  * (the one to report); the return value is the status of the last solve, or -1 with err
  * set when the input is bad (exit 2). cont_msg receives what was done. */
-int cli_continue_solve(const cli_opts *o, cv_batch **bp, const scene **sp, cv_problem **pp,
+int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene **sp, cv_problem **pp,
                        cv_solver **svp, cv_status *stp, char *cont_msg, size_t cmlen,
                        char *err, size_t errlen) {
   char name[128];
@@ -78,7 +72,7 @@ int cli_continue_solve(const cli_opts *o, cv_batch **bp, const scene **sp, cv_pr
   cv_problem *p = NULL;
   cv_solver *sv = NULL, *last = NULL;
   cv_status st = CVAR_OK;
-  cv_batch *b = load_once(o, name, err, errlen);
+  cv_batch *b = load_once(o, s0, name, err, errlen);
   if (!b) return -1;
   double at = NAN; /* the value the batch's instance holds */
   for (;;) {
