@@ -154,9 +154,9 @@ int main(int argc, char **argv)
     return 1;
   std::fprintf(fc, "lat1,lon1,lat2,lon2\n");
   for (long i = 0; i < N; i++) {
-    std::fprintf(fc, "%.12f,%.12f,%.12f,%.12f\n", P[4 * i], P[4 * i + 1], P[4 * i + 2],
+    std::fprintf(fc, "%.17g,%.17g,%.17g,%.17g\n", P[4 * i], P[4 * i + 1], P[4 * i + 2],
                  P[4 * i + 3]);
-    std::fprintf(ft, "%.12f %.12f %.12f %.12f\n", P[4 * i], P[4 * i + 1], P[4 * i + 2],
+    std::fprintf(ft, "%.17g %.17g %.17g %.17g\n", P[4 * i], P[4 * i + 1], P[4 * i + 2],
                  P[4 * i + 3]);
   }
   std::fclose(fc);

@@ -11,6 +11,7 @@ struct ex_integrand {
   int np;           /* parameters: tape slots 2n+1 .. 2n+np */
   int owns_tapes;   /* 0 for a clone (ex_integrand_clone) */
   double *pbuf;     /* np batches, each filled with one parameter's value */
+  unsigned char *used; /* used[j]: the expression reads parameter j (shared by clones) */
   unsigned max_need;
   ex_tape *tape[3]; /* level 0: F; 1: F, Fy, Fp; 2: also Fyy (upper), Fyp, Fpp (upper) */
   int nout[3];
@@ -67,7 +68,9 @@ ex_integrand *ex_integrand_clone(const ex_integrand *g) {
 
 void ex_integrand_set_params(ex_integrand *g, const double *p) {
   for (int j = 0; j < g->np; j++)
-    for (int k = 0; k < EX_INTEGRAND_BATCH; k++) g->pbuf[(size_t)j * EX_INTEGRAND_BATCH + k] = p[j];
+    if (g->used[j])
+      for (int k = 0; k < EX_INTEGRAND_BATCH; k++)
+        g->pbuf[(size_t)j * EX_INTEGRAND_BATCH + k] = p[j];
 }
 
 ex_integrand *ex_integrand_new_params(ex_dag *d, int n, int np, ex_id F, unsigned max_need,
@@ -85,6 +88,9 @@ ex_integrand *ex_integrand_new_params(ex_dag *d, int n, int np, ex_id F, unsigne
   g->n = n;
   g->np = np;
   g->owns_tapes = 1;
+  /* the partials read no slot that F does not */
+  if (!(g->used = calloc((size_t)np + 1, 1))) goto nomem;
+  for (int j = 0; j < np; j++) g->used[j] = (unsigned char)ex_depends_on(d, F, 1 + 2 * n + j);
   g->max_need = max_need | CVAR_NEED_F;
   for (int i = 0; i < n; i++) g->depends_on_dy |= ex_depends_on(d, F, 1 + n + i);
   outs[0] = F;
@@ -129,8 +135,10 @@ nomem:
 
 void ex_integrand_free(ex_integrand *g) {
   if (!g) return;
-  if (g->owns_tapes)
+  if (g->owns_tapes) {
     for (int l = 0; l < 3; l++) ex_tape_free(g->tape[l]);
+    free(g->used);
+  }
   free(g->pbuf);
   free(g->work);
   free(g->scratch);

@@ -25,6 +25,7 @@
 enum { QBATCH = EX_INTEGRAND_BATCH };
 
 typedef struct {
+  const struct cv_batch *owner;
   scene *inst;
   ex_integrand *F, **cons, **ints; /* clones of the batch's compiled objects */
   cv_solver *sv;
@@ -34,7 +35,9 @@ typedef struct {
   double *qx, *qw, *qy, *qdy, *qv;
   double *prev;                    /* warm start: last converged nodal values */
   int prev_len, prev_row;
-  double prev_a, prev_b, *prev_end; /* its interval and end values [2n] */
+  double *prev_end;                /* its end values [2n] */
+  double *rv, *rw;                 /* row tape outputs and work */
+  double *gv, *gw;                 /* guess tape outputs (one batch each) and work */
 } worker;
 
 struct cv_batch {
@@ -49,6 +52,15 @@ struct cv_batch {
   int *col;                        /* parameter index of each column */
   unsigned char *given;            /* given[i]: some column sets parameter i */
   int nthreads, warm, any_exact, nworkers;
+  /* The row tape: every value that follows the parameters (their values, then a, b, the
+   * fixed end values, the [integrals] constants, the exact action) as expressions of the
+   * given parameters only, evaluated at one point per row (theory: none; plain algebra). */
+  ex_tape *rowt;
+  int nrowt;
+  /* The [guess] expressions compiled once (unknowns without one: the default line). */
+  ex_tape *guesst;
+  int nguess;
+  int *guess_of;                   /* tape output of unknown i's guess, or -1 */
   worker *w;
   scene *check;                    /* instance for cv_batch_check_row */
 };
@@ -81,6 +93,10 @@ static void worker_free(cv_batch *b, worker *w)
   free(w->qv);
   free(w->prev);
   free(w->prev_end);
+  free(w->rv);
+  free(w->rw);
+  free(w->gv);
+  free(w->gw);
   memset(w, 0, sizeof *w);
 }
 
@@ -88,6 +104,7 @@ static int worker_init(cv_batch *b, worker *w)
 {
   const scene *s = b->s;
   memset(w, 0, sizeof *w);
+  w->owner = b;
   w->prev_row = -2;
   w->inst = scene_instance_new(s);
   w->F = ex_integrand_clone(b->F);
@@ -98,8 +115,14 @@ static int worker_init(cv_batch *b, worker *w)
   w->pb = malloc(((size_t)b->np * QBATCH + 1) * sizeof *w->pb);
   w->tw = b->rep ? malloc((ex_tape_work_size(b->rep, QBATCH) + 1) * sizeof *w->tw) : NULL;
   w->prev_end = calloc(2 * (size_t)b->n, sizeof *w->prev_end);
+  w->rv = malloc(((size_t)b->nrowt + 1) * sizeof *w->rv);
+  w->rw = b->rowt ? malloc((ex_tape_work_size(b->rowt, 1) + 1) * sizeof *w->rw) : NULL;
+  w->gv = malloc(((size_t)b->nguess * QBATCH + 1) * sizeof *w->gv);
+  w->gw = b->guesst ? malloc((ex_tape_work_size(b->guesst, QBATCH) + 1) * sizeof *w->gw)
+                    : NULL;
   if (!w->inst || !w->F || !w->cons || !w->ints || !w->sv || !w->pv || !w->pb ||
-      (b->rep && !w->tw) || !w->prev_end)
+      (b->rep && !w->tw) || !w->prev_end || !w->rv || (b->rowt && !w->rw) || !w->gv ||
+      (b->guesst && !w->gw))
     return -1;
   for (int k = 0; k < s->ncons; k++)
     if (!(w->cons[k] = ex_integrand_clone(b->cons[k])))
@@ -126,6 +149,9 @@ void cv_batch_free(cv_batch *b)
   free(b->cons);
   free(b->ints);
   ex_tape_free(b->rep);
+  ex_tape_free(b->rowt);
+  ex_tape_free(b->guesst);
+  free(b->guess_of);
   for (int k = 0; b->outname && k < b->nout; k++)
     free(b->outname[k]);
   free(b->outname);
@@ -200,6 +226,26 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen)
     if (!b->rep)
       goto nomem;
   }
+  b->guess_of = malloc(((size_t)s->n + 1) * sizeof *b->guess_of);
+  if (!b->guess_of)
+    goto nomem;
+  {
+    ex_id *outs = malloc(((size_t)s->n + 1) * sizeof *outs);
+    if (!outs)
+      goto nomem;
+    for (int i = 0; i < s->n; i++) {
+      b->guess_of[i] = s->guess[i] >= 0 ? b->nguess : -1;
+      if (s->guess[i] >= 0)
+        outs[b->nguess++] = s->guess[i];
+    }
+    if (b->nguess > 0)
+      b->guesst = ex_tape_new(s->dag, 1 + 2 * s->n + b->np, b->nguess, outs);
+    free(outs);
+    if (b->nguess > 0 && !b->guesst)
+      goto nomem;
+  }
+  if (cv_batch_set_columns(b, 0, NULL, err, errlen) != CVAR_OK)
+    goto nomem;
   for (int r = 0; r < s->nreports; r++)
     if (!(b->outname[r] = strdup(s->reports[r].name)))
       goto nomem;
@@ -239,6 +285,58 @@ const char *cv_batch_output_name(const cv_batch *b, int k)
   return b && k >= 0 && k < b->nout ? b->outname[k] : NULL;
 }
 
+/* The row tape for the current given[] (see struct cv_batch): a parameter that no column
+ * gives is replaced by its definition, recursively, so the outputs depend only on the
+ * given parameters' slots. Adds nodes to the DAG: single-threaded, before any worker. */
+static int build_row_tape(cv_batch *b)
+{
+  scene *s = b->s;
+  int n = s->n, np = b->np, rc = -1;
+  int cap = np + 2 + 2 * n + s->nints + 1;
+  ex_id *def = malloc(((size_t)np + 1) * sizeof *def), *outs = malloc((size_t)cap * sizeof *outs);
+  if (!def || !outs)
+    goto done;
+  int k = 0;
+  for (int j = 0; j < np; j++) {
+    ex_id e = b->given[j] ? s->params[j].expr : s->params[j].expr2;
+    for (int i = 0; i < j && e >= 0 && !b->given[j]; i++)
+      if (!b->given[i] && ex_depends_on(s->dag, e, 1 + 2 * n + i))
+        e = ex_subst(s->dag, e, 1 + 2 * n + i, def[i]);
+    if ((def[j] = e) < 0)
+      goto done;
+    outs[k++] = e;
+  }
+  ex_id targets[2] = {s->a_expr, s->b_expr};
+  int nt = 0;
+  ex_id *t = outs + k;
+  t[nt++] = targets[0];
+  t[nt++] = targets[1];
+  for (int i = 0; i < n; i++)
+    for (int end = 0; end < 2; end++)
+      if (!s->bc[i].free_end[end])
+        t[nt++] = s->bc[i].expr[end];
+  for (int q = 0; q < s->nints; q++)
+    t[nt++] = s->ints[q].expr2;
+  if (s->has_exact_action)
+    t[nt++] = s->exact_action_expr;
+  for (int q = 0; q < nt; q++)
+    for (int i = 0; i < np && t[q] >= 0; i++)
+      if (!b->given[i] && ex_depends_on(s->dag, t[q], 1 + 2 * n + i))
+        t[q] = ex_subst(s->dag, t[q], 1 + 2 * n + i, def[i]);
+  for (int q = 0; q < nt; q++)
+    if (t[q] < 0)
+      goto done;
+  k += nt;
+  ex_tape_free(b->rowt);
+  b->rowt = ex_tape_new(s->dag, 1 + 2 * n + np, k, outs);
+  b->nrowt = k;
+  rc = b->rowt ? 0 : -1;
+done:
+  free(def);
+  free(outs);
+  return rc;
+}
+
 cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names, char *err,
                                size_t errlen)
 {
@@ -246,6 +344,10 @@ cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names,
     err[0] = '\0';
   if (!b || ncols < 0 || (ncols > 0 && !names))
     return CVAR_EINVAL;
+  if (b->nworkers > 0) { /* workers hold buffers sized for the current row tape */
+    snprintf(err, errlen, "the columns are set before the first solve");
+    return CVAR_EINVAL;
+  }
   int *col = malloc(((size_t)ncols + 1) * sizeof *col);
   if (!col)
     return CVAR_ENOMEM;
@@ -264,6 +366,10 @@ cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names,
       return CVAR_EINVAL;
     }
     b->given[col[c]] = 1;
+  }
+  if (build_row_tape(b) < 0) {
+    free(col);
+    return CVAR_ENOMEM;
   }
   free(b->col);
   b->col = col;
@@ -303,13 +409,60 @@ cv_status cv_batch_set_mesh(cv_batch *b, int elements, int degree)
 }
 
 /* Parameter values of a row into inst (every parameter: given ones from the row, the
- * others from their definitions). */
-static int set_row(const cv_batch *b, scene *inst, double *pv, const double *row, char *err,
-                   size_t errlen)
+ * others from their definitions) and everything computed from them, by the row tape.
+ * rv, rw: the tape's outputs and work. The checks and messages of scene_set_parameters. */
+static int set_row(const cv_batch *b, scene *inst, double *pv, double *rv, double *rw,
+                   const double *row, char *err, size_t errlen)
 {
-  for (int c = 0; c < b->ncols; c++)
+  int n = inst->n, np = b->np;
+  const double *in[1 + 2 * n + np];
+  double *out[b->nrowt];
+  for (int q = 0; q < 1 + 2 * n + np; q++)
+    in[q] = NULL;
+  for (int c = 0; c < b->ncols; c++) {
     pv[b->col[c]] = row[c];
-  return scene_set_parameters(inst, b->given, pv, err, errlen);
+    in[1 + 2 * n + b->col[c]] = &row[c];
+  }
+  for (int q = 0; q < b->nrowt; q++)
+    out[q] = rv + q;
+  ex_tape_eval(b->rowt, 1, in, out, rw);
+  int k = 0;
+  for (int j = 0; j < np; j++) {
+    inst->params[j].value = rv[k++];
+    if (!isfinite(inst->params[j].value)) {
+      snprintf(err, errlen, "%s: parameter '%s' is not a finite number (%g)", inst->file,
+               inst->params[j].name, inst->params[j].value);
+      return -1;
+    }
+  }
+  inst->a = rv[k++];
+  inst->b = rv[k++];
+  if (!(inst->a < inst->b)) {
+    snprintf(err, errlen, "%s: interval needs a < b, got a = %.17g, b = %.17g", inst->file,
+             inst->a, inst->b);
+    return -1;
+  }
+  for (int i = 0; i < n; i++)
+    for (int end = 0; end < 2; end++)
+      if (!inst->bc[i].free_end[end]) {
+        inst->bc[i].value[end] = rv[k++];
+        if (!isfinite(inst->bc[i].value[end])) {
+          snprintf(err, errlen, "%s:%d: [boundary] %s at %s is not a finite number",
+                   inst->file, inst->bc[i].line, inst->unknowns[i], end ? "b" : "a");
+          return -1;
+        }
+      }
+  for (int q = 0; q < inst->nints; q++) {
+    inst->ints[q].value = rv[k++];
+    if (!isfinite(inst->ints[q].value)) {
+      snprintf(err, errlen, "%s:%d: [integrals] %s: the value c is not a finite number",
+               inst->file, inst->ints[q].line, inst->ints[q].name);
+      return -1;
+    }
+  }
+  if (inst->has_exact_action)
+    inst->exact_action = rv[k++];
+  return 0;
 }
 
 cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err, size_t errlen)
@@ -317,10 +470,14 @@ cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err, size_t e
   if (!b || (b->ncols > 0 && !row))
     return CVAR_EINVAL;
   double *pv = calloc((size_t)b->np + 1, sizeof *pv);
-  if (!pv)
-    return CVAR_ENOMEM;
-  int rc = set_row(b, b->check, pv, row, err, errlen);
+  double *rv = malloc(((size_t)b->nrowt + 1) * sizeof *rv);
+  double *rw = malloc((ex_tape_work_size(b->rowt, 1) + 1) * sizeof *rw);
+  int rc = pv && rv && rw ? set_row(b, b->check, pv, rv, rw, row, err, errlen) : -2;
   free(pv);
+  free(rv);
+  free(rw);
+  if (rc == -2)
+    return CVAR_ENOMEM;
   return rc < 0 ? CVAR_EINVAL : CVAR_OK;
 }
 
@@ -358,9 +515,45 @@ static cv_problem *row_problem(const cv_batch *b, worker *w)
   return p;
 }
 
+/* cv_guess_fn over the compiled [guess] tape; the default (the straight line between
+ * fixed ends, SCENES.md [guess]) for unknowns without one. user: the worker's context. */
 static int guess_cb(int m, const double *x, double *y, void *user)
 {
-  return scene_eval_guess(user, m, x, y) < 0 ? -1 : 0;
+  worker *w = user;
+  const cv_batch *b = w->owner;
+  const scene *s = w->inst;
+  int n = s->n, np = b->np;
+  const double *in[1 + 2 * n + np];
+  double *out[b->nguess + 1];
+  for (int q = 0; q < 1 + 2 * n + np; q++)
+    in[q] = NULL;
+  for (int j = 0; j < np; j++) {
+    for (int k = 0; k < QBATCH; k++)
+      w->pb[(size_t)j * QBATCH + k] = s->params[j].value;
+    in[1 + 2 * n + j] = w->pb + (size_t)j * QBATCH;
+  }
+  for (int k0 = 0; k0 < m; k0 += QBATCH) {
+    int mm = m - k0 < QBATCH ? m - k0 : QBATCH;
+    in[0] = x + k0;
+    for (int i = 0; i < n; i++) {
+      double *yi = y + (size_t)i * m + k0;
+      if (b->guess_of[i] >= 0) {
+        out[b->guess_of[i]] = yi;
+        continue;
+      }
+      const sc_boundary *bc = &s->bc[i];
+      for (int k = 0; k < mm; k++) {
+        double t = (x[k0 + k] - s->a) / (s->b - s->a);
+        yi[k] = !bc->free_end[0] && !bc->free_end[1]
+                    ? bc->value[0] + t * (bc->value[1] - bc->value[0])
+                : !bc->free_end[0] ? bc->value[0]
+                : !bc->free_end[1] ? bc->value[1] : 0.0;
+      }
+    }
+    if (b->guesst)
+      ex_tape_eval(b->guesst, mm, in, out, w->gw);
+  }
+  return 0;
 }
 
 /* The [report] integrals (sum of w K over the quadrature points) into out[0..nreports-1]. */
@@ -521,7 +714,7 @@ static void solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_ba
   char err[400];
   cv_problem *p = NULL;
   const char *note = NULL;
-  if (set_row(b, w->inst, w->pv, vals, err, sizeof err) < 0) {
+  if (set_row(b, w->inst, w->pv, w->rv, w->rw, vals, err, sizeof err) < 0) {
     r->status = CVAR_EINVAL;
     snprintf(r->message, sizeof r->message, "%s", err);
     goto done;
@@ -531,11 +724,8 @@ static void solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_ba
     snprintf(r->message, sizeof r->message, "out of memory while setting up the problem");
     goto done;
   }
-  int any_guess = 0;
-  for (int i = 0; i < w->inst->n; i++)
-    any_guess |= w->inst->guess[i] >= 0;
-  if (any_guess)
-    cv_problem_set_guess(p, guess_cb, w->inst);
+  if (b->nguess > 0)
+    cv_problem_set_guess(p, guess_cb, w);
   if (scene_solver_configure(w->inst, w->sv, err, sizeof err) != CVAR_OK) {
     r->status = CVAR_EINVAL;
     snprintf(r->message, sizeof r->message, "%s", err);
@@ -621,14 +811,11 @@ cv_problem *scene_batch_problem(cv_batch *b, const double *row, const scene **in
     return NULL;
   }
   worker *w = &b->w[0];
-  if (set_row(b, w->inst, w->pv, row, err, errlen) < 0)
+  if (set_row(b, w->inst, w->pv, w->rv, w->rw, row, err, errlen) < 0)
     return NULL;
   cv_problem *p = row_problem(b, w);
-  int any_guess = 0;
-  for (int i = 0; p && i < w->inst->n; i++)
-    any_guess |= w->inst->guess[i] >= 0;
-  if (p && any_guess)
-    cv_problem_set_guess(p, guess_cb, w->inst);
+  if (p && b->nguess > 0)
+    cv_problem_set_guess(p, guess_cb, w);
   if (!p)
     snprintf(err, errlen, "%s: out of memory while setting up the problem", b->s->file);
   *inst = w->inst;
