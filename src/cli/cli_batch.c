@@ -366,16 +366,17 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
   if (o->degree)
     s->degree = o->degree;
   if (o->method >= 0)
-    s->method = (sc_method)o->method;
+    s->method = (cv_method)o->method;
   if (o->tolerance > 0)
     s->tolerance = o->tolerance;
   if (o->max_iterations)
     s->max_iterations = o->max_iterations;
   if (o->adapt > 0)
     s->adapt = o->adapt;
-  if ((s->method == SC_LBFGS || s->method == SC_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
+  if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) &&
+      (s->ncons > 0 || s->nints > 0)) {
     fprintf(stderr, "calcvar batch: method %s cannot impose constraints; use mma, ccsaq, "
-            "slsqp, auglag or newton\n", scene_method_name(s->method));
+            "slsqp, auglag or newton\n", cv_method_name(s->method));
     scene_free(s);
     goto done;
   }

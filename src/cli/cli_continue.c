@@ -12,8 +12,8 @@
 #define FIRST_STEPS 10
 #define MIN_FRACTION (1.0 / 4096)
 
-/* The scene (read once by the caller) compiled once, its parameters as inputs (issue 18): every step
- * only sets the continued parameter and builds a problem over the compiled integrand. */
+/* The scene (read once by the caller) compiled once, its parameters as inputs (issue 18):
+ * every step only sets the continued parameter and builds a problem over the compiled integrand. */
 static cv_batch *load_once(const cli_opts *o, scene *s, const char *name, char *err,
                            size_t errlen) {
   int found = 0;
@@ -57,8 +57,8 @@ static int carry_over(cv_solver *from, cv_solver *to, int n) {
 /* Solve by continuation. On return *sp, *pp, *svp hold the last scene, problem and solver
  * (the one to report); the return value is the status of the last solve, or -1 with err
  * set when the input is bad (exit 2). cont_msg receives what was done. */
-int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene **sp, cv_problem **pp,
-                       cv_solver **svp, cv_status *stp, char *cont_msg, size_t cmlen,
+int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene **sp,
+                       cv_problem **pp, cv_solver **svp, cv_status *stp, char *cont_msg, size_t cmlen,
                        char *err, size_t errlen) {
   char name[128];
   const char *e = strchr(o->cont, '='), *c = strchr(e, ':');

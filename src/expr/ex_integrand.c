@@ -38,11 +38,11 @@ static int alloc_buffers(ex_integrand *g) {
       if (w > work) work = w;
     }
   int nout = g->nout[2] ? g->nout[2] : g->nout[1] ? g->nout[1] : 1;
-  g->work = malloc((work ? work : 1) * sizeof *g->work);
-  g->scratch = malloc((size_t)nout * EX_INTEGRAND_BATCH * sizeof *g->scratch);
-  g->in = malloc((size_t)(2 * g->n + 1 + g->np) * sizeof *g->in);
-  g->outp = malloc((size_t)nout * sizeof *g->outp);
-  g->pbuf = calloc((size_t)(g->np ? g->np : 1) * EX_INTEGRAND_BATCH, sizeof *g->pbuf);
+  g->work = cv_malloc((work ? work : 1) * sizeof *g->work);
+  g->scratch = cv_malloc((size_t)nout * EX_INTEGRAND_BATCH * sizeof *g->scratch);
+  g->in = cv_malloc((size_t)(2 * g->n + 1 + g->np) * sizeof *g->in);
+  g->outp = cv_malloc((size_t)nout * sizeof *g->outp);
+  g->pbuf = cv_calloc((size_t)(g->np ? g->np : 1) * EX_INTEGRAND_BATCH, sizeof *g->pbuf);
   return g->work && g->scratch && g->in && g->outp && g->pbuf ? 0 : -1;
 }
 
@@ -52,7 +52,7 @@ ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, cha
 }
 
 ex_integrand *ex_integrand_clone(const ex_integrand *g) {
-  ex_integrand *c = g ? malloc(sizeof *c) : NULL;
+  ex_integrand *c = g ? cv_malloc(sizeof *c) : NULL;
   if (!c) return NULL;
   *c = *g;
   c->owns_tapes = 0;
@@ -82,14 +82,14 @@ ex_integrand *ex_integrand_new_params(ex_dag *d, int n, int np, ex_id F, unsigne
   int ntri = n * (n + 1) / 2;
   int level = max_need & CVAR_NEED_HESS ? 2 : max_need & CVAR_NEED_GRAD ? 1 : 0;
   int nout = level == 2 ? 1 + 2 * n + 2 * ntri + n * n : level == 1 ? 1 + 2 * n : 1;
-  ex_integrand *g = calloc(1, sizeof *g);
-  ex_id *outs = malloc((size_t)nout * sizeof *outs);
+  ex_integrand *g = cv_calloc(1, sizeof *g);
+  ex_id *outs = cv_malloc((size_t)nout * sizeof *outs);
   if (!g || !outs) goto nomem;
   g->n = n;
   g->np = np;
   g->owns_tapes = 1;
   /* the partials read no slot that F does not */
-  if (!(g->used = calloc((size_t)np + 1, 1))) goto nomem;
+  if (!(g->used = cv_calloc((size_t)np + 1, 1))) goto nomem;
   for (int j = 0; j < np; j++) g->used[j] = (unsigned char)ex_depends_on(d, F, 1 + 2 * n + j);
   g->max_need = max_need | CVAR_NEED_F;
   for (int i = 0; i < n; i++) g->depends_on_dy |= ex_depends_on(d, F, 1 + n + i);
@@ -124,11 +124,11 @@ ex_integrand *ex_integrand_new_params(ex_dag *d, int n, int np, ex_id F, unsigne
     if (!g->tape[l]) goto nomem;
   }
   if (alloc_buffers(g) < 0) goto nomem;
-  free(outs);
+  cv_free(outs);
   return g;
 nomem:
   set_err(err, errlen, "out of memory while compiling the expression");
-  free(outs);
+  cv_free(outs);
   ex_integrand_free(g);
   return NULL;
 }
@@ -137,14 +137,14 @@ void ex_integrand_free(ex_integrand *g) {
   if (!g) return;
   if (g->owns_tapes) {
     for (int l = 0; l < 3; l++) ex_tape_free(g->tape[l]);
-    free(g->used);
+    cv_free(g->used);
   }
-  free(g->pbuf);
-  free(g->work);
-  free(g->scratch);
-  free(g->in);
-  free(g->outp);
-  free(g);
+  cv_free(g->pbuf);
+  cv_free(g->work);
+  cv_free(g->scratch);
+  cv_free(g->in);
+  cv_free(g->outp);
+  cv_free(g);
 }
 
 void ex_integrand_release(void *g) { ex_integrand_free(g); }
@@ -173,7 +173,8 @@ static int eval_into(ex_integrand *g, int m, const double *x, const double *y,
       g->in[1 + i] = y + i * M + k0;
       g->in[1 + n + i] = dy ? dy + i * M + k0 : NULL; /* NULL: a constraint G(x, y) */
     }
-    for (int j = 0; j < g->np; j++) g->in[1 + 2 * n + j] = g->pbuf + (size_t)j * EX_INTEGRAND_BATCH;
+    for (int j = 0; j < g->np; j++)
+      g->in[1 + 2 * n + j] = g->pbuf + (size_t)j * EX_INTEGRAND_BATCH;
     g->outp[0] = dest(g, F, (size_t)k0, 0);
     if (level >= 1) {
       for (int i = 0; i < n; i++) {

@@ -21,6 +21,7 @@
 
 #include "expr/ex_integrand.h"
 #include "scene/scene_batch.h"
+#include "scene/scene_internal.h"
 
 enum { QBATCH = EX_INTEGRAND_BATCH };
 
@@ -79,24 +80,24 @@ static void worker_free(cv_batch *b, worker *w)
     ex_integrand_free(w->cons[k]);
   for (int k = 0; w->ints && k < b->s->nints; k++)
     ex_integrand_free(w->ints[k]);
-  free(w->cons);
-  free(w->ints);
+  cv_free(w->cons);
+  cv_free(w->ints);
   cv_solver_free(w->sv);
   scene_free(w->inst);
-  free(w->pv);
-  free(w->tw);
-  free(w->pb);
-  free(w->qx);
-  free(w->qw);
-  free(w->qy);
-  free(w->qdy);
-  free(w->qv);
-  free(w->prev);
-  free(w->prev_end);
-  free(w->rv);
-  free(w->rw);
-  free(w->gv);
-  free(w->gw);
+  cv_free(w->pv);
+  cv_free(w->tw);
+  cv_free(w->pb);
+  cv_free(w->qx);
+  cv_free(w->qw);
+  cv_free(w->qy);
+  cv_free(w->qdy);
+  cv_free(w->qv);
+  cv_free(w->prev);
+  cv_free(w->prev_end);
+  cv_free(w->rv);
+  cv_free(w->rw);
+  cv_free(w->gv);
+  cv_free(w->gw);
   memset(w, 0, sizeof *w);
 }
 
@@ -108,17 +109,17 @@ static int worker_init(cv_batch *b, worker *w)
   w->prev_row = -2;
   w->inst = scene_instance_new(s);
   w->F = ex_integrand_clone(b->F);
-  w->cons = calloc((size_t)s->ncons + 1, sizeof *w->cons);
-  w->ints = calloc((size_t)s->nints + 1, sizeof *w->ints);
+  w->cons = cv_calloc((size_t)s->ncons + 1, sizeof *w->cons);
+  w->ints = cv_calloc((size_t)s->nints + 1, sizeof *w->ints);
   w->sv = cv_solver_new(NULL);
-  w->pv = calloc((size_t)b->np + 1, sizeof *w->pv);
-  w->pb = malloc(((size_t)b->np * QBATCH + 1) * sizeof *w->pb);
-  w->tw = b->rep ? malloc((ex_tape_work_size(b->rep, QBATCH) + 1) * sizeof *w->tw) : NULL;
-  w->prev_end = calloc(2 * (size_t)b->n, sizeof *w->prev_end);
-  w->rv = malloc(((size_t)b->nrowt + 1) * sizeof *w->rv);
-  w->rw = b->rowt ? malloc((ex_tape_work_size(b->rowt, 1) + 1) * sizeof *w->rw) : NULL;
-  w->gv = malloc(((size_t)b->nguess * QBATCH + 1) * sizeof *w->gv);
-  w->gw = b->guesst ? malloc((ex_tape_work_size(b->guesst, QBATCH) + 1) * sizeof *w->gw)
+  w->pv = cv_calloc((size_t)b->np + 1, sizeof *w->pv);
+  w->pb = cv_malloc(((size_t)b->np * QBATCH + 1) * sizeof *w->pb);
+  w->tw = b->rep ? cv_malloc((ex_tape_work_size(b->rep, QBATCH) + 1) * sizeof *w->tw) : NULL;
+  w->prev_end = cv_calloc(2 * (size_t)b->n, sizeof *w->prev_end);
+  w->rv = cv_malloc(((size_t)b->nrowt + 1) * sizeof *w->rv);
+  w->rw = b->rowt ? cv_malloc((ex_tape_work_size(b->rowt, 1) + 1) * sizeof *w->rw) : NULL;
+  w->gv = cv_malloc(((size_t)b->nguess * QBATCH + 1) * sizeof *w->gv);
+  w->gw = b->guesst ? cv_malloc((ex_tape_work_size(b->guesst, QBATCH) + 1) * sizeof *w->gw)
                     : NULL;
   if (!w->inst || !w->F || !w->cons || !w->ints || !w->sv || !w->pv || !w->pb ||
       (b->rep && !w->tw) || !w->prev_end || !w->rv || (b->rowt && !w->rw) || !w->gv ||
@@ -139,26 +140,26 @@ void cv_batch_free(cv_batch *b)
     return;
   for (int t = 0; t < b->nworkers; t++)
     worker_free(b, &b->w[t]);
-  free(b->w);
+  cv_free(b->w);
   scene_free(b->check);
   ex_integrand_free(b->F);
   for (int k = 0; b->cons && k < b->s->ncons; k++)
     ex_integrand_free(b->cons[k]);
   for (int k = 0; b->ints && k < b->s->nints; k++)
     ex_integrand_free(b->ints[k]);
-  free(b->cons);
-  free(b->ints);
+  cv_free(b->cons);
+  cv_free(b->ints);
   ex_tape_free(b->rep);
   ex_tape_free(b->rowt);
   ex_tape_free(b->guesst);
-  free(b->guess_of);
+  cv_free(b->guess_of);
   for (int k = 0; b->outname && k < b->nout; k++)
-    free(b->outname[k]);
-  free(b->outname);
-  free(b->col);
-  free(b->given);
+    cv_free(b->outname[k]);
+  cv_free(b->outname);
+  cv_free(b->col);
+  cv_free(b->given);
   scene_free(b->s);
-  free(b);
+  cv_free(b);
 }
 
 cv_batch *scene_batch_new(scene *s, char *err, size_t errlen)
@@ -174,7 +175,7 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen)
     scene_free(s);
     return NULL;
   }
-  cv_batch *b = calloc(1, sizeof *b);
+  cv_batch *b = cv_calloc(1, sizeof *b);
   if (!b) {
     scene_free(s);
     snprintf(err, errlen, "out of memory");
@@ -185,11 +186,11 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen)
   b->np = s->nparams;
   b->nthreads = 1;
   b->need = scene_method_need(s->method);
-  b->cons = calloc((size_t)s->ncons + 1, sizeof *b->cons);
-  b->ints = calloc((size_t)s->nints + 1, sizeof *b->ints);
+  b->cons = cv_calloc((size_t)s->ncons + 1, sizeof *b->cons);
+  b->ints = cv_calloc((size_t)s->nints + 1, sizeof *b->ints);
   b->nout = s->nreports + s->nints;
-  b->outname = calloc((size_t)b->nout + 1, sizeof *b->outname);
-  b->given = calloc((size_t)b->np + 1, 1);
+  b->outname = cv_calloc((size_t)b->nout + 1, sizeof *b->outname);
+  b->given = cv_calloc((size_t)b->np + 1, 1);
   b->check = scene_instance_new(s);
   if (!b->cons || !b->ints || !b->outname || !b->given || !b->check)
     goto nomem;
@@ -216,21 +217,21 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen)
       goto fail;
     }
   if (s->nreports > 0) {
-    ex_id *outs = malloc((size_t)s->nreports * sizeof *outs);
+    ex_id *outs = cv_malloc((size_t)s->nreports * sizeof *outs);
     if (!outs)
       goto nomem;
     for (int r = 0; r < s->nreports; r++)
       outs[r] = s->reports[r].expr;
     b->rep = ex_tape_new(s->dag, 1 + 2 * s->n + b->np, s->nreports, outs);
-    free(outs);
+    cv_free(outs);
     if (!b->rep)
       goto nomem;
   }
-  b->guess_of = malloc(((size_t)s->n + 1) * sizeof *b->guess_of);
+  b->guess_of = cv_malloc(((size_t)s->n + 1) * sizeof *b->guess_of);
   if (!b->guess_of)
     goto nomem;
   {
-    ex_id *outs = malloc(((size_t)s->n + 1) * sizeof *outs);
+    ex_id *outs = cv_malloc(((size_t)s->n + 1) * sizeof *outs);
     if (!outs)
       goto nomem;
     for (int i = 0; i < s->n; i++) {
@@ -240,18 +241,18 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen)
     }
     if (b->nguess > 0)
       b->guesst = ex_tape_new(s->dag, 1 + 2 * s->n + b->np, b->nguess, outs);
-    free(outs);
+    cv_free(outs);
     if (b->nguess > 0 && !b->guesst)
       goto nomem;
   }
   if (cv_batch_set_columns(b, 0, NULL, err, errlen) != CVAR_OK)
     goto nomem;
   for (int r = 0; r < s->nreports; r++)
-    if (!(b->outname[r] = strdup(s->reports[r].name)))
+    if (!(b->outname[r] = sc_strdup(s->reports[r].name)))
       goto nomem;
   for (int k = 0; k < s->nints; k++) {
     size_t len = strlen(s->ints[k].name) + 4;
-    if (!(b->outname[s->nreports + k] = malloc(len)))
+    if (!(b->outname[s->nreports + k] = cv_malloc(len)))
       goto nomem;
     snprintf(b->outname[s->nreports + k], len, "mu_%s", s->ints[k].name);
   }
@@ -293,7 +294,8 @@ static int build_row_tape(cv_batch *b)
   scene *s = b->s;
   int n = s->n, np = b->np, rc = -1;
   int cap = np + 2 + 2 * n + s->nints + 1;
-  ex_id *def = malloc(((size_t)np + 1) * sizeof *def), *outs = malloc((size_t)cap * sizeof *outs);
+  ex_id *def = cv_malloc(((size_t)np + 1) * sizeof *def);
+  ex_id *outs = cv_malloc((size_t)cap * sizeof *outs);
   if (!def || !outs)
     goto done;
   int k = 0;
@@ -332,8 +334,8 @@ static int build_row_tape(cv_batch *b)
   b->nrowt = k;
   rc = b->rowt ? 0 : -1;
 done:
-  free(def);
-  free(outs);
+  cv_free(def);
+  cv_free(outs);
   return rc;
 }
 
@@ -348,7 +350,7 @@ cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names,
     snprintf(err, errlen, "the columns are set before the first solve");
     return CVAR_EINVAL;
   }
-  int *col = malloc(((size_t)ncols + 1) * sizeof *col);
+  int *col = cv_malloc(((size_t)ncols + 1) * sizeof *col);
   if (!col)
     return CVAR_ENOMEM;
   memset(b->given, 0, (size_t)b->np + 1);
@@ -361,17 +363,17 @@ cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names,
       snprintf(err, errlen, col[c] < 0 ? "'%s' is not a parameter of %s"
                                        : "'%s' is given twice", names[c] ? names[c] : "",
                b->s->file);
-      free(col);
+      cv_free(col);
       memset(b->given, 0, (size_t)b->np + 1);
       return CVAR_EINVAL;
     }
     b->given[col[c]] = 1;
   }
   if (build_row_tape(b) < 0) {
-    free(col);
+    cv_free(col);
     return CVAR_ENOMEM;
   }
-  free(b->col);
+  cv_free(b->col);
   b->col = col;
   b->ncols = ncols;
   return CVAR_OK;
@@ -469,13 +471,13 @@ cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err, size_t e
 {
   if (!b || (b->ncols > 0 && !row))
     return CVAR_EINVAL;
-  double *pv = calloc((size_t)b->np + 1, sizeof *pv);
-  double *rv = malloc(((size_t)b->nrowt + 1) * sizeof *rv);
-  double *rw = malloc((ex_tape_work_size(b->rowt, 1) + 1) * sizeof *rw);
+  double *pv = cv_calloc((size_t)b->np + 1, sizeof *pv);
+  double *rv = cv_malloc(((size_t)b->nrowt + 1) * sizeof *rv);
+  double *rw = cv_malloc((ex_tape_work_size(b->rowt, 1) + 1) * sizeof *rw);
   int rc = pv && rv && rw ? set_row(b, b->check, pv, rv, rw, row, err, errlen) : -2;
-  free(pv);
-  free(rv);
-  free(rw);
+  cv_free(pv);
+  cv_free(rv);
+  cv_free(rw);
   if (rc == -2)
     return CVAR_ENOMEM;
   return rc < 0 ? CVAR_EINVAL : CVAR_OK;
@@ -565,12 +567,12 @@ static int eval_reports(const cv_batch *b, worker *w, double *out)
     return -1;
   size_t q = (size_t)nq;
   if (q > w->cap) {
-    free(w->qx), free(w->qw), free(w->qy), free(w->qdy), free(w->qv);
-    w->qx = malloc(q * sizeof *w->qx);
-    w->qw = malloc(q * sizeof *w->qw);
-    w->qy = malloc(q * n * sizeof *w->qy);
-    w->qdy = malloc(q * n * sizeof *w->qdy);
-    w->qv = malloc((size_t)QBATCH * s->nreports * sizeof *w->qv);
+    cv_free(w->qx), cv_free(w->qw), cv_free(w->qy), cv_free(w->qdy), cv_free(w->qv);
+    w->qx = cv_malloc(q * sizeof *w->qx);
+    w->qw = cv_malloc(q * sizeof *w->qw);
+    w->qy = cv_malloc(q * n * sizeof *w->qy);
+    w->qdy = cv_malloc(q * n * sizeof *w->qdy);
+    w->qv = cv_malloc((size_t)QBATCH * s->nreports * sizeof *w->qv);
     w->cap = w->qx && w->qw && w->qy && w->qdy && w->qv ? q : 0;
     if (!w->cap)
       return -1;
@@ -609,8 +611,8 @@ static double nodal_error(worker *w)
 {
   const scene *s = w->inst;
   int nn = cv_solver_get_num_nodes(w->sv), n = s->n;
-  double *x = malloc((size_t)nn * sizeof *x), *y = malloc((size_t)nn * n * sizeof *y);
-  double *ex = malloc((size_t)nn * n * sizeof *ex), e = 0.0;
+  double *x = cv_malloc((size_t)nn * sizeof *x), *y = cv_malloc((size_t)nn * n * sizeof *y);
+  double *ex = cv_malloc((size_t)nn * n * sizeof *ex), e = 0.0;
   if (!x || !y || !ex || cv_solver_get_nodes(w->sv, x) != CVAR_OK ||
       cv_solver_get_values(w->sv, y) != CVAR_OK || scene_eval_exact(s, nn, x, ex) < 0)
     e = NAN;
@@ -620,9 +622,9 @@ static double nodal_error(worker *w)
         double d = fabs(y[(size_t)j * n + i] - ex[(size_t)i * nn + j]);
         e = d > e || !isfinite(d) ? d : e;
       }
-  free(x);
-  free(y);
-  free(ex);
+  cv_free(x);
+  cv_free(y);
+  cv_free(ex);
   return e;
 }
 
@@ -632,7 +634,7 @@ static int warm_start(worker *w)
 {
   const scene *s = w->inst;
   int n = s->n, nn = w->prev_len / n;
-  double *y = malloc((size_t)w->prev_len * sizeof *y);
+  double *y = cv_malloc((size_t)w->prev_len * sizeof *y);
   if (!y)
     return -1;
   for (int j = 0; j < nn; j++) {
@@ -644,7 +646,7 @@ static int warm_start(worker *w)
     }
   }
   cv_status st = cv_solver_set_start(w->sv, w->prev_len, y);
-  free(y);
+  cv_free(y);
   return st == CVAR_OK ? 0 : -1;
 }
 
@@ -655,8 +657,8 @@ static void keep_for_warm(worker *w, int row)
   if (len <= 0)
     return;
   if (len != w->prev_len) {
-    free(w->prev);
-    w->prev = malloc((size_t)len * sizeof *w->prev);
+    cv_free(w->prev);
+    w->prev = cv_malloc((size_t)len * sizeof *w->prev);
     w->prev_len = w->prev ? len : 0;
   }
   if (!w->prev || cv_solver_get_values(w->sv, w->prev) != CVAR_OK) {
@@ -755,7 +757,7 @@ static void solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_ba
   if (st == CVAR_OK) {
     r->has_result = 1;
     r->action = cv_solver_get_action(w->sv);
-    if (w->inst->method == SC_NEWTON) {
+    if (w->inst->method == CVAR_METHOD_NEWTON) {
       morse = cv_solver_get_morse_index(w->sv);
       nfree = cv_solver_get_num_free(w->sv);
       degenerate = cv_solver_get_degenerate(w->sv);
@@ -787,7 +789,7 @@ static cv_status workers(cv_batch *b, int T)
 {
   if (T <= b->nworkers)
     return CVAR_OK;
-  worker *nw = realloc(b->w, (size_t)T * sizeof *nw);
+  worker *nw = cv_realloc(b->w, (size_t)T * sizeof *nw);
   if (!nw)
     return CVAR_ENOMEM;
   b->w = nw;
@@ -862,11 +864,11 @@ cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_re
   /* Blocks of consecutive rows, claimed in turn: about 8 per thread keeps the threads
    * busy to the end; inside a block each row may warm-start from the one before. */
   job j = {b, nrows, nrows / (8 * T) > 0 ? nrows / (8 * T) : 1, rows, res, 0};
-  task *tk = malloc((size_t)T * sizeof *tk);
-  pthread_t *th = malloc((size_t)T * sizeof *th);
+  task *tk = cv_malloc((size_t)T * sizeof *tk);
+  pthread_t *th = cv_malloc((size_t)T * sizeof *th);
   if (!tk || !th) {
-    free(tk);
-    free(th);
+    cv_free(tk);
+    cv_free(th);
     return CVAR_ENOMEM;
   }
   int started = 0;
@@ -882,7 +884,7 @@ cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_re
   run(&tk[0]);
   for (int t = 1; t <= started; t++)
     pthread_join(th[t], NULL);
-  free(tk);
-  free(th);
+  cv_free(tk);
+  cv_free(th);
   return CVAR_OK;
 }

@@ -1,4 +1,4 @@
-/* src/cli/estimate.c — the nodal error of a solve without [exact], from a reference solve.
+/* src/scene/scene_estimate.c — the nodal error of a solve without [exact], from a reference solve.
  * SPDX-License-Identifier: MIT
  *
  * Why not plain Richardson between the mesh and its double: the interior GLL nodes of a
@@ -24,7 +24,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "cli/cli.h"
+#include "scene/scene_report.h"
 
 /* The reference mesh on [0, 1]: every node x[0..nn-1] of the judged mesh becomes an
  * element boundary; with degree 1, each element is also halved. Returns the element
