@@ -286,7 +286,7 @@ const char *cv_batch_output_name(const cv_batch *b, int k)
   return b && k >= 0 && k < b->nout ? b->outname[k] : NULL;
 }
 
-/* The row tape for the current given[] (see struct cv_batch): a parameter that no column
+/* The row tape (theory (B-1)) for the current given[]: a parameter that no column
  * gives is replaced by its definition, recursively, so the outputs depend only on the
  * given parameters' slots. Adds nodes to the DAG: single-threaded, before any worker. */
 static int build_row_tape(cv_batch *b)
@@ -628,8 +628,8 @@ static double nodal_error(worker *w)
   return e;
 }
 
-/* The start of a warm row: the previous solution, shifted by the straight line that moves
- * its fixed end values onto this row's (node by node on the same reference layout). */
+/* The start of a warm row (theory (B-2)): the previous solution, shifted by the line that
+ * moves its fixed end values onto this row's (node by node on the same layout). */
 static int warm_start(worker *w)
 {
   const scene *s = w->inst;
