@@ -492,7 +492,8 @@ CVAR_API const char *cv_batch_parameter_name(const cv_batch *b, int i);
 CVAR_API int cv_batch_num_outputs(const cv_batch *b);
 /** Name of output k, NULL when out of range. */
 CVAR_API const char *cv_batch_output_name(const cv_batch *b, int k);
-/** Which parameters a row gives, in order (default: none, i.e. the scene's values). */
+/** Which parameters a row gives, in order (default: none, i.e. the scene's values). Set
+ * before the first cv_batch_solve (CVAR_EINVAL after it). */
 CVAR_API cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names,
                                         char *err, size_t errlen);
 /** Threads (default 1; 0 = the cores available). */
