@@ -11,6 +11,7 @@ import io
 import math
 import os
 import random
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -168,6 +169,16 @@ bad_case("dupheader.csv", "A,A\n1,2\n", 1)
 bad_case("badnumber.csv", "A,B\n1,2\n\n3,x\n", 4)
 bad_case("badcount.csv", "A,B\n1,2\n3\n", 3)
 bad_case("badinterval.csv", "A,L\n1,2\n1,-1\n", 3)
+
+# ---- the progress line: only when stderr is a terminal (a pty from script(1)) ----------
+script = shutil.which("script")
+if script:
+    outp = os.path.join(tmp, "tty.csv")
+    cmd = " ".join([calcvar, "batch", os.path.join(data, "line.scene"), table, "--out", outp])
+    r = subprocess.run([script, "-qc", cmd, "/dev/null"], capture_output=True, text=True,
+                       timeout=120)
+    check("progress line on a terminal", "40/40 rows" in r.stdout and "rows/s" in r.stdout
+          and "0 failed" in r.stdout, "... 40/40 rows, N rows/s, 0 failed", r.stdout[-200:])
 
 # ---- solve --continue reads its scene once ------------------------------------------
 fifo = os.path.join(tmp, "catenary.scene")
