@@ -428,7 +428,12 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     threads = cli_cores_available();
   cv_batch_set_threads(b, threads);
   cv_batch_set_warm_start(b, warm);
-  if (mpi->rank == 0 && out_path && cli_outfile_open(&of, out_path) < 0)
+  if (out_path && strcmp(out_path, table_path) == 0) {
+    fprintf(stderr, "calcvar batch: --out %s would overwrite the table being read\n",
+            out_path);
+    goto done;
+  }
+  if (mpi->rank == 0 && out_path && cli_outfile_open(&of, out_path, o->scene_path) < 0)
     goto done;
   FILE *f = mpi->rank == 0 ? (out_path ? of.f : stdout) : NULL;
 
