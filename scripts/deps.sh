@@ -11,6 +11,7 @@ $SUDO apt-get install -y -qq --no-install-recommends \
   libplplot-dev plplot-driver-cairo \
   doxygen groff-base \
   libopenmpi-dev openmpi-bin \
-  g++ libgeographiclib-dev geographiclib-tools >/dev/null
+  g++ libgeographiclib-dev geographiclib-tools strace >/dev/null
 # doxygen, groff: the API reference and the man page (tests 'docs'); OpenMPI: calcvar batch
-# under mpirun (test batch_mpi); g++ and GeographicLib: bench/bench_geodesic only.
+# under mpirun (test batch_mpi); strace: --continue opens its scene once (test cli_batch);
+# g++ and GeographicLib: bench/bench_geodesic only.

@@ -199,9 +199,12 @@ if strace:
                         scene_copy, "--continue", "c=3:1.6", "--degree", "4", "--elements",
                         "16", "--json", "-"], capture_output=True, text=True, timeout=120,
                        env=env)
-    opens = sum(1 for line in open(log) if scene_copy in line) if os.path.exists(log) else -1
+    traced = open(log).read() if os.path.exists(log) else ""
+    opens = sum(1 for line in traced.splitlines() if scene_copy in line)
     steps = r.stdout.split("in ")[-1].split(" steps")[0] if " steps" in r.stdout else "?"
-    if r.returncode == 0 or opens >= 0:
+    if "open" not in traced:   # ptrace not permitted here (some containers)
+        print("strace could not trace: the --continue read count is not checked")
+    else:
         check("--continue converged in several steps", r.returncode == 0 and steps != "?" and
               int(steps) > 1, "exit 0, > 1 step", (r.returncode, steps, r.stderr[:200]))
         check("--continue opens the scene once", opens == 1, 1, opens)
