@@ -74,14 +74,12 @@ int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene 
   cv_status st = CVAR_OK;
   cv_batch *b = load_once(o, s0, name, err, errlen);
   if (!b) return -1;
-  double at = NAN; /* the value the batch's instance holds */
   for (;;) {
     const scene *s2 = NULL;
     /* p references the compiled clones only: free it before they change */
     cv_problem_free(p);
     p = NULL;
     cv_problem *p2 = scene_batch_problem(b, &v, &s2, err, errlen);
-    at = v;
     if (!p2) goto bad;
     cv_solver *sv2 = cv_solver_new(NULL);
     if (!sv2 || scene_solver_configure(s2, sv2, err, errlen) != CVAR_OK ||
@@ -130,7 +128,6 @@ int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene 
   /* The problem to report on: the instance back at the accepted value (a rejected step
    * may have set another). */
   double acc = steps > 0 ? done_at : from;
-  (void)at;
   if (!(p = scene_batch_problem(b, &acc, &s, err, errlen))) goto bad;
   *bp = b, *sp = s, *pp = p, *svp = sv;
   return 0;
