@@ -1,5 +1,5 @@
 /* src/expr/ex_integrand.c — partials of F(x, y, y') compiled to tapes, evaluated through
- * the core's integrand callback. SPDX-License-Identifier: MIT */
+ * the core's integrand callback (docs/theory.md (X-4)). SPDX-License-Identifier: MIT */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,7 +22,7 @@ static void set_err(char *err, size_t errlen, const char *msg) {
   if (err && errlen) snprintf(err, errlen, "%s", msg);
 }
 
-/* Upper-triangle index of (i, j), i <= j, in row-major order. */
+/* Upper-triangle index of (i, j), i <= j, in row-major order. */
 static int tri(int n, int i, int j) { return i * n - i * (i - 1) / 2 + (j - i); }
 
 ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, char *err,
