@@ -52,6 +52,10 @@ typedef struct {
 int cli_outfile_open(cli_outfile *o, const char *path);
 int cli_outfile_commit(cli_outfile *o);
 void cli_outfile_abandon(cli_outfile *o);
+/* Move the closed temporary file into place (failed: its writer failed). Returns 0, or -1
+ * after printing "calcvar: cannot write PATH" (with the reason if give_reason) and removing
+ * the temporary file. */
+int cli_outfile_publish(cli_outfile *o, int failed, int give_reason);
 /* args.c: the start of a command that reads one scene (equations, modes): parse the
  * arguments (--help prints usage), accept only the scene options, load the scene into *s
  * and open --json's file in *jf. Returns -1 to go on, else the exit status (after a

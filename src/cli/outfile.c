@@ -51,6 +51,24 @@ int cli_outfile_open(cli_outfile *o, const char *path)
   return 0;
 }
 
+int cli_outfile_publish(cli_outfile *o, int failed, int give_reason)
+{
+  if (failed || rename(o->tmp, o->path) != 0) {
+    if (give_reason)
+      fprintf(stderr, "calcvar: cannot write %s: %s\n", o->path,
+              failed ? "write error" : strerror(errno));
+    else
+      fprintf(stderr, "calcvar: cannot write %s\n", o->path);
+    unlink(o->tmp);
+    free(o->tmp);
+    o->tmp = NULL;
+    return -1;
+  }
+  free(o->tmp);
+  o->tmp = NULL;
+  return 0;
+}
+
 /* Close and move into place. Returns 0, or -1 after printing why (nothing is left). */
 int cli_outfile_commit(cli_outfile *o)
 {
@@ -63,17 +81,7 @@ int cli_outfile_commit(cli_outfile *o)
   int bad = ferror(o->f);
   bad |= fclose(o->f) != 0;
   o->f = NULL;
-  if (bad || rename(o->tmp, o->path) != 0) {
-    fprintf(stderr, "calcvar: cannot write %s: %s\n", o->path,
-            bad ? "write error" : strerror(errno));
-    unlink(o->tmp);
-    free(o->tmp);
-    o->tmp = NULL;
-    return -1;
-  }
-  free(o->tmp);
-  o->tmp = NULL;
-  return 0;
+  return cli_outfile_publish(o, bad, 1);
 }
 
 void cli_outfile_abandon(cli_outfile *o)

@@ -211,14 +211,5 @@ int cli_plot_write(cli_outfile *o, int npanels, const cli_plot_panel *panels)
     draw_panel(&panels[k]);
   plend();
   exit_tmp = NULL;
-  if (access(o->tmp, F_OK) != 0 || rename(o->tmp, o->path) != 0) {
-    fprintf(stderr, "calcvar: cannot write %s\n", o->path);
-    unlink(o->tmp);
-    free(o->tmp);
-    o->tmp = NULL;
-    return -1;
-  }
-  free(o->tmp);
-  o->tmp = NULL;
-  return 0;
+  return cli_outfile_publish(o, access(o->tmp, F_OK) != 0, 0);
 }
