@@ -2,6 +2,7 @@
  * and continuation policy when Newton fails from the start.
  * SPDX-License-Identifier: MIT */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 #include <time.h>
 
@@ -18,6 +19,7 @@ static void results_reset(cv_solver *s) {
   cv_free(s->y);
   cv_free(s->mult);
   s->y = s->mult = NULL;
+  cv_solver_drop_factor(s);
   cv_disc_free(&s->disc);
   s->have = 0;
   s->iterations = 0;
@@ -108,8 +110,8 @@ static void prefix_note(cv_solver *s) {
   memcpy(s->msg, m, sizeof m);
 }
 
-/* One solve on the mesh of s->mesh (no adaptation). */
-cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
+/* One solve on the mesh of s->mesh, with the singular ends known so far. */
+static cv_status solve_once(cv_solver *s, const cv_problem *p) {
   cv_status st;
   results_reset(s);
   if (!p || !p->F) {
@@ -143,6 +145,31 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
   }
   if (lost && unconstrained && s->continuation) st = continue_from_start(s, p, st);
 done:
+  return st;
+}
+
+/* One solve on the mesh of s->mesh (no adaptation). A converged solve whose end element
+ * under-integrates a nearly singular integrand (theory Q-3) is solved again with that end
+ * treated as singular (Q-2 rule, and grading on a uniform mesh, M-2). */
+cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
+  s->near_sing[0] = s->near_sing[1] = 0;
+  cv_status st = solve_once(s, p);
+  double rel[2] = {0.0, 0.0};
+  int un[2] = {0, 0};
+  for (int end = 0; end < 2 && st == CVAR_OK; end++)
+    un[end] = cv_start_end_unresolved(p, &s->disc, s->y, end, s->action, &rel[end]);
+  if (un[0] || un[1]) {
+    s->near_sing[0] = un[0], s->near_sing[1] = un[1];
+    st = solve_once(s, p);
+    char first[sizeof s->note];
+    memcpy(first, s->note, sizeof first);
+    cv_set_msg(s->note, sizeof s->note,
+               "the integrand is nearly singular at %s (the singular-end rule changed the "
+               "action by %.1e of itself there), so it is integrated as singular; %s",
+               un[0] && un[1] ? "both ends" : un[0] ? "the start" : "the end",
+               fmax(rel[0], rel[1]), first);
+    s->near_sing[0] = s->near_sing[1] = 0;
+  }
   prefix_note(s);
   s->status = st;
   return st;
@@ -151,10 +178,22 @@ done:
 cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   if (!s) return CVAR_EINVAL;
   double t0 = cv_now();
+  cv_pathset_free(s->paths); /* a plain solve forgets the paths of cv_solve_all */
+  s->paths = NULL;
   s->err_est = NAN;
   s->rounds = 0;
+  if (p && p->note) p->note(p->user, 1);
   cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
   s->status = st;
+  /* A failure the integrand can explain (a table's grid left): the cause first, then what
+   * the engine saw. */
+  const char *note = st != CVAR_OK && p && p->note ? p->note(p->user, 0) : NULL;
+  if (note && note[0]) {
+    char m[2 * sizeof s->msg];
+    snprintf(m, sizeof m, "%s%s%s", note, s->msg[0] ? "; " : "", s->msg);
+    memcpy(s->msg, m, sizeof s->msg - 1); /* truncated to the message buffer */
+    s->msg[sizeof s->msg - 1] = '\0';
+  }
   s->time = cv_now() - t0;
   return st;
 }
