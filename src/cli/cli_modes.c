@@ -194,9 +194,9 @@ int cli_modes(int argc, char **argv)
     goto done;
   }
   if (o.json) {
-    if (write_json(jf.f, s, &md) < 0 || cli_outfile_commit(&jf) < 0) {
+    if (cli_outfile_finish(&jf, write_json(jf.f, s, &md)) < 0) {
       fprintf(stderr, "calcvar modes: the JSON could not be written\n");
-      rc = EXIT_UNSOLVED;
+      rc = EXIT_IOERROR;
       goto done;
     }
   }
