@@ -37,6 +37,8 @@ void cli_opts_free(cli_opts *o);
 /* For commands that only read a scene: EXIT_BADINPUT (after a message) if a solve-only
  * option was given, else 0. */
 int cli_only_scene_options(const char *cmd, const cli_opts *o);
+/* --method, --tolerance and --max-iterations, where given, override the scene's [solver]. */
+void cli_apply_solver_options(const cli_opts *o, scene *s);
 
 /* cli_continue.c: `solve --continue name=from:to` (see there). */
 /* s0: the scene, loaded once with parameters as inputs (scene_load_file_inputs) and
@@ -70,6 +72,12 @@ int cli_outfile_finish(cli_outfile *o, int wrote);
 int cli_outfile_render_name(cli_outfile *o, const char **name);
 int cli_outfile_commit_rendered(cli_outfile *o);
 void cli_outfile_abandon(cli_outfile *o);
+/* args.c: the start of a command that reads one scene (equations, modes): parse the
+ * arguments (--help prints usage), accept only the scene options, load the scene into *s
+ * and open --json's file in *jf. Returns -1 to go on, else the exit status (after a
+ * message); the caller releases o, *s and *jf in either case. */
+int cli_scene_command_start(const char *cmd, int argc, char **argv, void (*usage)(FILE *),
+                            cli_opts *o, scene **s, cli_outfile *jf);
 
 /* plot.c: curves on panels stacked top to bottom, written with PLplot to the temporary
  * file of an open cli_outfile (.svg or .png by its path) and renamed into place. */

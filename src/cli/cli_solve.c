@@ -102,12 +102,7 @@ int cli_solve(int argc, char **argv)
     s->elements = o.elements;
   if (o.degree)
     s->degree = o.degree;
-  if (o.method >= 0)
-    s->method = (cv_method)o.method;
-  if (o.tolerance > 0)
-    s->tolerance = o.tolerance;
-  if (o.max_iterations)
-    s->max_iterations = o.max_iterations;
+  cli_apply_solver_options(&o, s);
   if ((rc = unsupported(&o, s)) != 0)
     goto done;
   cv_status why;
