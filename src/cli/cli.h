@@ -23,7 +23,7 @@ typedef struct {
   int nset;
   sc_set *set;
   const char *json, *csv, *plot;
-  int quiet, help;
+  int quiet, help, verbose;
 } cli_opts;
 
 /* args.c: parse argv (after the command word). Returns 0, or EXIT_BADINPUT after printing
@@ -33,6 +33,11 @@ void cli_opts_free(cli_opts *o);
 /* For commands that only read a scene: EXIT_BADINPUT (after a message) if a solve-only
  * option was given, else 0. */
 int cli_only_scene_options(const char *cmd, const cli_opts *o);
+
+/* progress.c: --verbose lines and the terminal status line (see there). */
+void cli_progress_setup(int verbose);
+void cli_progress_attach(cv_solver *sv);
+void cli_progress_end(void);
 
 /* cli_continue.c: `solve --continue name=from:to` (see there). */
 int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver **svp,

@@ -101,6 +101,7 @@ int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver
       scene_free(s2);
       goto bad;
     }
+    cli_progress_attach(sv2);
     st = cv_solve(sv2, p2);
     if (st == CVAR_OK || !last) {
       /* accepted (or the very first solve, reported as it is if it failed) */

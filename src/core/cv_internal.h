@@ -244,6 +244,8 @@ struct cv_solver {
   int adapt_max, rounds;
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
+  cv_progress_fn progress;     /* cv_solver_set_progress; NULL: none */
+  void *progress_user;
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
