@@ -101,6 +101,10 @@ typedef enum { CVAR_STATUS_LIST(CVAR_ENUM_ITEM) CVAR_NUM_STATUS } cv_status;
 CVAR_API const char *cv_strerror(cv_status s);
 /** The symbolic name of a status, e.g. "CVAR_EMAXITER"; never NULL. */
 CVAR_API const char *cv_status_name(cv_status s);
+/** The libraries linked into libcalcvar with their versions, as the libraries report them
+ * at run time, e.g. "CHOLMOD 3.0.14, NLopt 2.7.1, LAPACK 3.11.0, jansson 2.14, inih", into
+ * buf (len bytes; 160 is ample). CVAR_EINVAL when it does not fit. */
+CVAR_API cv_status cv_dependency_versions(char *buf, size_t len);
 /**@}*/
 
 /** \name Integrand callbacks */

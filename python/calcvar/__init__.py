@@ -25,6 +25,7 @@ from . import _lib
 from ._lib import lib
 
 __all__ = ["solve", "Solution", "Problem", "CalcvarError", "InputError", "version",
+           "dependency_versions",
            "METHODS"]
 
 METHODS = ("newton", "lbfgs", "tnewton", "mma", "ccsaq", "slsqp", "auglag")
@@ -48,6 +49,13 @@ class InputError(CalcvarError, ValueError):
 def version():
     """The library's version as a string, e.g. "0.1.0"."""
     return "%d.%d.%d" % _lib.version()
+
+
+def dependency_versions():
+    """The libraries linked into libcalcvar, as they report their versions."""
+    buf = ctypes.create_string_buffer(256)
+    lib.cv_dependency_versions(buf, len(buf))
+    return buf.value.decode()
 
 
 def _status_name(code):

@@ -56,6 +56,7 @@ def _sig(name, restype, *argtypes):
 _sig("cv_version", None, POINTER(c_int), POINTER(c_int), POINTER(c_int))
 _sig("cv_strerror", c_char_p, c_int)
 _sig("cv_status_name", c_char_p, c_int)
+_sig("cv_dependency_versions", c_int, c_char_p, c_size_t)
 _sig("cv_method_from_name", c_int, c_char_p, POINTER(c_int))
 _sig("cv_method_name", c_char_p, c_int)
 

@@ -3,6 +3,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include <plplot.h>
+
 #include "cli/cli.h"
 
 static void usage(FILE *f)
@@ -14,7 +16,8 @@ static void usage(FILE *f)
         "  calcvar converge SCENE [opts]   error and run time over a sequence of meshes\n"
         "  calcvar equations SCENE         momenta, Euler-Lagrange equations, Hamiltonian\n"
         "  calcvar modes SCENE             equilibrium and small-oscillation frequencies\n"
-        "  calcvar --help | --version\n"
+        "  calcvar -h | --help             this text\n"
+        "  calcvar -V | --version          versions of calcvar and the libraries linked\n"
         "Scene files: docs/scenes.md. Exit status: 0 solved, 1 not solved, 2 bad input.\n",
         f);
 }
@@ -28,10 +31,13 @@ int main(int argc, char **argv)
     usage(stdout);
     return EXIT_SOLVED;
   }
-  if (strcmp(cmd, "--version") == 0) {
+  if (strcmp(cmd, "--version") == 0 || strcmp(cmd, "-V") == 0) {
     int a, b, c;
+    char deps[256] = "", pl[80] = "";
     cv_version(&a, &b, &c);
-    printf("calcvar %d.%d.%d\n", a, b, c);
+    cv_dependency_versions(deps, sizeof deps);
+    plgver(pl); /* the pictures (--plot, --svg) */
+    printf("calcvar %d.%d.%d\nlinked with %s, PLplot %s\n", a, b, c, deps, pl);
     return EXIT_SOLVED;
   }
   if (strcmp(cmd, "solve") == 0)

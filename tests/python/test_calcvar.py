@@ -190,6 +190,11 @@ def test_bad_options_raise():
         calcvar.Problem(integrand="y'^2", interval=(0, 1), boundary={"y": (0, "oops(")})
 
 
+def test_versions():
+    assert calcvar.version() == "0.1.0"
+    assert calcvar.dependency_versions().startswith("CHOLMOD ")
+
+
 def test_not_yet_built_options_refuse():
     with pytest.raises(NotImplementedError, match="tol"):
         calcvar.solve(CATENARY, tol=1e-8)
