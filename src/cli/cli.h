@@ -68,11 +68,19 @@ typedef struct {
 typedef struct {
   const char *title, *xlabel, *ylabel;
   int logx, logy;
+  int equal;        /* one unit is as long on both axes (a path) */
+  int xdown, ydown; /* the axis increases leftward / downward */
+  int no_legend;    /* the axis labels say it all (one curve) */
+  double vp[4];     /* x0, x1, y0, y1 of the axes on the page (0..1); all 0: stacked */
   int nlines;
   const cli_plot_line *lines;
 } cli_plot_panel;
 int cli_plot_path_ok(const char *path); /* ends in .svg or .png */
-int cli_plot_write(cli_outfile *o, int npanels, const cli_plot_panel *panels);
+/* Panels stacked top to bottom on a page 960 wide (the vp of each panel is set here). */
+int cli_plot_write(cli_outfile *o, int npanels, cli_plot_panel *panels);
+/* Panels where their vp says, on a page of width x height pixels. */
+int cli_plot_write_page(cli_outfile *o, int width, int height, int npanels,
+                        const cli_plot_panel *panels);
 
 int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv);
 

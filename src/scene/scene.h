@@ -85,6 +85,10 @@ typedef struct scene {
   int method_line;     /* 0 when not given */
   double tolerance;    /* default 1e-10 */
   int max_iterations;  /* default 50 */
+
+  /* [plot] (an addition, docs/scenes.md): slots 0 = the variable, 1..n = the unknowns */
+  int plot_path[2];    /* path = U, V: V drawn against U; -1, -1 when not given */
+  int *plot_down;      /* [n + 1]: nonzero for a name drawn increasing downward */
 } scene;
 
 /** Load a scene file. `name` for messages is the path itself. nset overrides (may be 0). */

@@ -16,6 +16,7 @@ int sc_load_constraints(sc_loader *L);
 int sc_load_report(sc_loader *L);
 int sc_load_mesh(sc_loader *L);
 int sc_load_solver(sc_loader *L);
+int sc_load_plot(sc_loader *L);
 
 static void items_free(sc_item *it, int n)
 {
@@ -34,6 +35,7 @@ void scene_free(scene *s)
   for (int i = 0; i < s->n; i++)
     free(s->unknowns[i]);
   free(s->unknowns);
+  free(s->plot_down);
   free(s->bc);
   free(s->guess);
   free(s->exact);
@@ -326,7 +328,7 @@ scene *scene_load_buffer(const char *text, size_t len, const char *name, int nse
       load_definitions(&L) < 0 || load_interval_integrand(&L) < 0 ||
       sc_load_boundary(&L) < 0 || sc_load_guess_exact(&L) < 0 ||
       sc_load_constraints(&L) < 0 || sc_load_report(&L) < 0 || sc_load_mesh(&L) < 0 ||
-      sc_load_solver(&L) < 0) {
+      sc_load_solver(&L) < 0 || sc_load_plot(&L) < 0) {
     sc_raw_free(&L.raw);
     scene_free(s);
     return NULL;
