@@ -18,6 +18,18 @@
  * solve runs CHOLMOD's symbolic analysis of the sparse pattern on one extra thread of its
  * own, which it joins before it returns; no user code runs there.
  *
+ * Array layouts (one per kind of array, the same in every call):
+ *  - values at the mesh nodes are node-major: y[j*n + i] is unknown i at node j
+ *    (cv_solver_get_values, cv_solver_set_start); so a node's n values are adjacent, and a
+ *    C array y[nodes][n] (numpy shape (nodes, n), C order) is this layout;
+ *  - one value per node (nodes, multiplier fields) is a plain array x[j], lambda[j];
+ *  - values at a batch of m points are unknown-major: y[i*m + k] (the integrand, guess and
+ *    constraint callbacks, cv_solver_get_qpoints, cv_solver_eval), so that each unknown's m
+ *    values are adjacent for vectorised evaluation.
+ *
+ * Only the names declared here are exported from libcalcvar.so (CVAR_API); everything else
+ * in the library is internal.
+ *
  * Minimal use (the catenary, see examples/catenary.c):
  * \code
  *   cv_status why;
