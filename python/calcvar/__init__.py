@@ -17,7 +17,6 @@ import os
 import shutil
 import subprocess
 import tempfile
-import weakref
 
 import numpy as np
 
@@ -86,8 +85,9 @@ def _free_all(solver, problem, scene):
         lib.cv_scene_free(scene)
 
 
-def _load(scene, set):
-    err = ctypes.create_string_buffer(_lib.ERRLEN)
+def _load(scene, set, err=None):
+    if err is None:
+        err = ctypes.create_string_buffer(_lib.ERRLEN)
     pairs = []
     for name, value in (set or {}).items():
         if isinstance(value, bool) or not isinstance(value, (int, float, str)):
@@ -95,7 +95,7 @@ def _load(scene, set):
                              "constant expression" % (value, name))
         pairs.append(("%s=%s" % (name, repr(float(value)) if not isinstance(value, str)
                                  else value)).encode())
-    arr = (ctypes.c_char_p * max(1, len(pairs)))(*pairs)
+    arr = (ctypes.c_char_p * len(pairs))(*pairs) if pairs else None
     if isinstance(scene, os.PathLike):
         scene = os.fspath(scene)
     if isinstance(scene, bytes):
@@ -167,10 +167,10 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
     if all:
         raise NotImplementedError("all=True: several solutions per scene (`calcvar solve "
                                   "--all`) are not in this build of the library yet")
-    scene_h = _load(scene, set)
+    err = ctypes.create_string_buffer(_lib.ERRLEN)
+    scene_h = _load(scene, set, err)
     problem = solver = None
     try:
-        err = ctypes.create_string_buffer(_lib.ERRLEN)
         options = {"elements": elements, "degree": degree, "tolerance": tolerance,
                    "max_iterations": max_iterations, "adapt": adapt}
         if method is not None:
@@ -191,10 +191,9 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
         problem = lib.cv_scene_problem_new(scene_h, err, _lib.ERRLEN)
         if not problem:
             raise InputError("CVAR_EINVAL", err.value.decode())
-        why = ctypes.c_int()
-        solver = lib.cv_solver_new(ctypes.byref(why))
+        solver = lib.cv_solver_new(None)
         if not solver:
-            _fail(why.value, "out of memory")
+            _fail(_lib.ENOMEM, "out of memory")
         st = lib.cv_scene_configure_solver(scene_h, solver, err, _lib.ERRLEN)
         if st != _lib.OK:
             _fail(st, err.value.decode())
@@ -238,37 +237,67 @@ class Solution:
 
     def __init__(self, scene, problem, solver):
         self._h = (scene, problem, solver)
-        self._finalizer = weakref.finalize(self, _free_all, solver, problem, scene)
         self._report = None
-        n = lib.cv_scene_get_num_unknowns(scene)
-        self.unknowns = tuple(lib.cv_scene_get_unknown(scene, i).decode() for i in range(n))
-        self.variable = lib.cv_scene_get_variable(scene).decode()
-        self.title = lib.cv_scene_get_title(scene).decode()
+        self._unknowns = None
         nn = lib.cv_solver_get_num_nodes(solver)
+        n = lib.cv_scene_get_num_unknowns(scene)
         # numpy buffers filled by the library in place: node-major values (calcvar.h)
         self.x = np.empty(nn)
         self.values = np.empty((nn, n))
         if nn > 0:
-            lib.cv_solver_get_nodes(solver, self.x.ctypes.data_as(_lib.dp))
-            lib.cv_solver_get_values(solver, self.values.ctypes.data_as(_lib.dp))
+            lib.cv_solver_get_nodes(solver, self.x.ctypes.data)
+            lib.cv_solver_get_values(solver, self.values.ctypes.data)
         self.x.flags.writeable = False
         self.values.flags.writeable = False
-        code = lib.cv_solver_get_status(solver)
-        self.status_code = _status_name(code)
-        self.status = _status_word(code)
-        self.success = code == _lib.OK
-        self.message = lib.cv_solver_last_error(solver).decode(errors="replace")
-        self.method = lib.cv_method_name(lib.cv_solver_get_method(solver)).decode()
-        self.elements = lib.cv_solver_get_num_elements(solver)
-        self.degree = lib.cv_solver_get_degree(solver)
-        self.iterations = lib.cv_solver_get_num_iterations(solver)
-        self.action = lib.cv_solver_get_action(solver)
-        morse = lib.cv_solver_get_morse_index(solver)
-        self.morse_index = (morse if self.success and self.method == "newton" and morse >= 0
-                            else None)
+        self._code = lib.cv_solver_get_status(solver)
+        self.success = self._code == _lib.OK
+
+    def __del__(self):
+        h = self.__dict__.get("_h")
+        if h:
+            self._h = None
+            try:
+                _free_all(h[2], h[1], h[0])
+            except (AttributeError, TypeError):  # the interpreter is shutting down
+                pass
+
+    # Everything else is read from the solver when asked for (the call stays cheap).
+    unknowns = property(lambda self: self._names(), doc="the unknowns' names, in order")
+    variable = property(lambda self: lib.cv_scene_get_variable(self._h[0]).decode(),
+                        doc="the independent variable's name")
+    title = property(lambda self: lib.cv_scene_get_title(self._h[0]).decode())
+    status = property(lambda self: _status_word(self._code),
+                      doc='"converged", "max_iterations", "diverged", "singular" or '
+                          '"no_progress" (the report\'s words)')
+    status_code = property(lambda self: _status_name(self._code), doc="e.g. CVAR_EMAXITER")
+    message = property(lambda self: lib.cv_solver_last_error(self._h[2]).decode(
+        errors="replace"), doc="the solver's sentence")
+    method = property(lambda self: lib.cv_method_name(
+        lib.cv_solver_get_method(self._h[2])).decode())
+    elements = property(lambda self: lib.cv_solver_get_num_elements(self._h[2]))
+    degree = property(lambda self: lib.cv_solver_get_degree(self._h[2]))
+    iterations = property(lambda self: lib.cv_solver_get_num_iterations(self._h[2]))
+    action = property(lambda self: lib.cv_solver_get_action(self._h[2]),
+                      doc="the discrete action at the solution")
+
+    @property
+    def morse_index(self):
+        """Negative eigenvalues of the Hessian at a converged Newton solve, else None."""
+        morse = lib.cv_solver_get_morse_index(self._h[2])
+        return morse if self.success and self.method == "newton" and morse >= 0 else None
+
+    @property
+    def interval(self):
         a, b = ctypes.c_double(), ctypes.c_double()
-        lib.cv_problem_get_interval(problem, ctypes.byref(a), ctypes.byref(b))
-        self.interval = (a.value, b.value)
+        lib.cv_problem_get_interval(self._h[1], ctypes.byref(a), ctypes.byref(b))
+        return (a.value, b.value)
+
+    def _names(self):
+        if self._unknowns is None:
+            sc = self._h[0]
+            self._unknowns = tuple(lib.cv_scene_get_unknown(sc, i).decode()
+                                   for i in range(self.values.shape[1]))
+        return self._unknowns
 
     def __getitem__(self, name):
         if name in self.unknowns:
@@ -280,7 +309,7 @@ class Solution:
 
     def __getattr__(self, name):
         # only called for names that are not attributes
-        if name.startswith("_") or "unknowns" not in self.__dict__:
+        if name.startswith("_") or "_h" not in self.__dict__ or not self._h:
             raise AttributeError(name)
         if name in self.unknowns:
             return self[name]
@@ -300,9 +329,8 @@ class Solution:
         y = np.empty((n, m))
         dy = np.empty((n, m)) if derivative else None
         if m > 0:
-            st = lib.cv_solver_eval(self._h[2], m, xv.ctypes.data_as(_lib.dp),
-                                    y.ctypes.data_as(_lib.dp),
-                                    dy.ctypes.data_as(_lib.dp) if derivative else None)
+            st = lib.cv_solver_eval(self._h[2], m, xv.ctypes.data, y.ctypes.data,
+                                    dy.ctypes.data if derivative else None)
             if st != _lib.OK:
                 a, b = self.interval
                 raise InputError(_status_name(st), "cannot evaluate the solution there: the "

@@ -87,12 +87,13 @@ _sig("cv_solver_last_error", c_char_p, c_void_p)
 _sig("cv_solver_get_num_nodes", c_int, c_void_p)
 _sig("cv_solver_get_num_elements", c_int, c_void_p)
 _sig("cv_solver_get_degree", c_int, c_void_p)
-_sig("cv_solver_get_nodes", c_int, c_void_p, dp)
-_sig("cv_solver_get_values", c_int, c_void_p, dp)
+# arrays are passed as addresses (numpy's arr.ctypes.data): cheaper than data_as
+_sig("cv_solver_get_nodes", c_int, c_void_p, c_void_p)
+_sig("cv_solver_get_values", c_int, c_void_p, c_void_p)
 _sig("cv_solver_get_action", c_double, c_void_p)
 _sig("cv_solver_get_num_iterations", c_int, c_void_p)
 _sig("cv_solver_get_morse_index", c_int, c_void_p)
-_sig("cv_solver_eval", c_int, c_void_p, c_int, dp, dp, dp)
+_sig("cv_solver_eval", c_int, c_void_p, c_int, c_void_p, c_void_p, c_void_p)
 
 STATUS = {}
 _k = 0
