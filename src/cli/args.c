@@ -79,11 +79,11 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     memcpy(name, a, nl);
     name[nl] = '\0';
     int flag = strcmp(name, "--quiet") == 0 || strcmp(name, "--help") == 0 ||
-               strcmp(name, "-h") == 0 || strcmp(name, "--verbose") == 0 ||
-               strcmp(name, "-v") == 0;
+               strcmp(name, "-h") == 0 || strcmp(name, "--all") == 0 ||
+               strcmp(name, "--verbose") == 0 || strcmp(name, "-v") == 0;
     static const char *const valued[] = {
       "--elements", "--degree", "--method", "--tolerance", "--max-iterations", "--set",
-      "--adapt", "--continue", "--json", "--csv", "--plot", NULL};
+      "--adapt", "--continue", "--json", "--csv", "--plot", "--max", "--work", NULL};
     int known = flag;
     for (int k = 0; valued[k]; k++)
       known |= strcmp(name, valued[k]) == 0;
@@ -94,6 +94,8 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
         return bad(cmd, "%s takes no value", name);
       if (strcmp(name, "--quiet") == 0)
         o->quiet = 1;
+      else if (strcmp(name, "--all") == 0)
+        o->all = 1;
       else if (strcmp(name, "--verbose") == 0 || strcmp(name, "-v") == 0)
         o->verbose = 1;
       else
@@ -114,13 +116,21 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     } else if (strcmp(name, "--degree") == 0) {
       if (parse_int(v, 1, 8, &o->degree) < 0)
         return bad(cmd, "--degree needs a whole number from 1 to 8, got '%s'", v);
+    } else if (strcmp(name, "--max") == 0) {
+      if (parse_int(v, 1, 1000, &o->max_paths) < 0)
+        return bad(cmd, "--max needs a whole number of paths from 1 to 1000, got '%s'", v);
+    } else if (strcmp(name, "--work") == 0) {
+      if (parse_pos_double(v, &o->work) < 0 || o->work < 1 || o->work > 1e6)
+        return bad(cmd, "--work needs a factor from 1 to 1e6, got '%s'", v);
     } else if (strcmp(name, "--max-iterations") == 0) {
       if (parse_int(v, 1, INT_MAX, &o->max_iterations) < 0)
         return bad(cmd, "--max-iterations needs a whole number >= 1, got '%s'", v);
     } else if (strcmp(name, "--method") == 0) {
-      if ((o->method = scene_method_from_name(v)) < 0)
+      cv_method m;
+      if (cv_method_from_name(v, &m) != CVAR_OK)
         return bad(cmd, "unknown method '%s' (known: newton, lbfgs, tnewton, mma, ccsaq, "
                    "slsqp, auglag)", v);
+      o->method = (int)m;
     } else if (strcmp(name, "--tolerance") == 0) {
       if (parse_pos_double(v, &o->tolerance) < 0 || o->tolerance < 10 * DBL_EPSILON ||
           o->tolerance >= 1)
@@ -171,6 +181,8 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     return 0;
   if (!o->scene_path)
     return bad(cmd, "a scene file is missing: calcvar %s SCENE [options]", cmd);
+  if ((o->max_paths || o->work > 0) && !o->all)
+    return bad(cmd, "--max and --work belong to --all; give --all too");
   if (o->json && o->csv && strcmp(o->json, "-") == 0 && strcmp(o->csv, "-") == 0)
     return bad(cmd, "--json - and --csv - cannot both write to stdout");
   if (o->json && o->csv && strcmp(o->json, o->csv) == 0 && strcmp(o->json, "-") != 0)
@@ -182,7 +194,7 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
 int cli_only_scene_options(const char *cmd, const cli_opts *o)
 {
   if (o->csv || o->plot || o->adapt > 0 || o->cont || o->elements || o->degree ||
-      o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->verbose) {
+      o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all || o->verbose) {
     fprintf(stderr, "calcvar %s: only --set, --json and --quiet apply to %s\n", cmd, cmd);
     return EXIT_BADINPUT;
   }

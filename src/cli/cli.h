@@ -16,7 +16,7 @@ enum { EXIT_SOLVED = 0, EXIT_UNSOLVED = 1, EXIT_BADINPUT = 2 };
 typedef struct {
   const char *scene_path;
   int elements, degree, max_iterations;
-  int method; /* sc_method or -1 */
+  int method; /* cv_method or -1 */
   double tolerance;
   double adapt;
   const char *cont; /* --continue name=from:to */
@@ -24,6 +24,8 @@ typedef struct {
   sc_set *set;
   const char *json, *csv, *plot;
   int quiet, help, verbose;
+  int all, max_paths; /* --all, --max K (0: default 8) */
+  double work;        /* --work F: the search's work limit (0: default 8) */
 } cli_opts;
 
 /* args.c: parse argv (after the command word). Returns 0, or EXIT_BADINPUT after printing
@@ -98,6 +100,10 @@ int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_converge_json(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_plot_converge(cli_outfile *o, const cli_conv_row *rows, int nrows);
 
+/* cli_all.c: `solve --all`: the deflated search, its reports; returns the exit status. */
+int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, double adapt,
+                cli_outfile *jf, cli_outfile *cf, cli_outfile *pf);
+
 /* Subcommands. */
 int cli_converge(int argc, char **argv);
 int cli_gallery(void);
@@ -107,7 +113,7 @@ int cli_equations(int argc, char **argv); /* cli_equations.c */
 int cli_modes(int argc, char **argv);     /* cli_modes.c */
 int cli_unsupported(const char *cmd);
 
-/* gallery_scenes.c */
+/* gallery_scenes.c, generated from examples/scenes by src/cli/embed_scenes.py */
 typedef struct {
   const char *name;
   const char *text;

@@ -24,6 +24,9 @@ static void usage(FILE *f)
         "  --set name=value     override a parameter (repeatable)\n"
         "  --adapt TOL          refine until the estimated max nodal error < TOL\n"
         "  --continue name=from:to   continuation in a parameter\n"
+        "  --all                every stationary path that can be found (deflation)\n"
+        "  --max K              at most K paths with --all (default 8)\n"
+        "  --work F             --all's work limit: F times the first solve's (default 8)\n"
         "  --json FILE          JSON report ('-' for stdout)\n"
         "  --csv FILE           nodal table ('-' for stdout)\n"
         "  --plot FILE          picture of the solution (.png or .svg)\n"
@@ -42,14 +45,24 @@ static int unsupported(const cli_opts *o, const scene *s)
             "(continuation keeps one mesh)\n");
     return EXIT_BADINPUT;
   }
-  if ((s->method == SC_LBFGS || s->method == SC_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
+  if (o->all && o->cont) {
+    fprintf(stderr, "calcvar solve: --all and --continue cannot be combined (the search "
+            "keeps one scene)\n");
+    return EXIT_BADINPUT;
+  }
+  if (o->all && s->method != CVAR_METHOD_NEWTON) {
+    fprintf(stderr, "calcvar solve: --all needs the Newton engine (method %s finds minima "
+            "only, not the saddles the search is for)\n", cv_method_name(s->method));
+    return EXIT_BADINPUT;
+  }
+  if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
     /* an unconstrained minimiser cannot impose [constraints] or [integrals] */
     if (o->method >= 0)
       fprintf(stderr, "calcvar solve: --method %s cannot impose constraints; use mma, ccsaq, "
-              "slsqp, auglag or newton\n", scene_method_name(s->method));
+              "slsqp, auglag or newton\n", cv_method_name(s->method));
     else
       fprintf(stderr, "%s:%d: method %s cannot impose constraints; use mma, ccsaq, slsqp, "
-              "auglag or newton\n", s->file, s->method_line, scene_method_name(s->method));
+              "auglag or newton\n", s->file, s->method_line, cv_method_name(s->method));
     return EXIT_BADINPUT;
   }
   return 0;
@@ -82,7 +95,7 @@ int cli_solve(int argc, char **argv)
   if (o.degree)
     s->degree = o.degree;
   if (o.method >= 0)
-    s->method = (sc_method)o.method;
+    s->method = (cv_method)o.method;
   if (o.tolerance > 0)
     s->tolerance = o.tolerance;
   if (o.max_iterations)
@@ -114,6 +127,11 @@ int cli_solve(int argc, char **argv)
   char cont_msg[256] = "";
   cli_progress_setup(o.verbose);
   cli_progress_attach(sv);
+  if (o.all) {
+    rc = cli_all_run(&o, s, p, sv, adapt, &jf, &cf, &pf);
+    cli_progress_end();
+    goto done;
+  }
   if (o.cont) {
     /* continuation replaces scene, problem and solver by those of its last step */
     cv_solver_free(sv);

@@ -1,10 +1,9 @@
-/* src/core/cv_solver.c — the solver object: options, the solve driver, results and getters.
+/* src/core/cv_solver.c — the solver handle: options (setters), results (getters) and the
+ * evaluation of the last solution. The solve itself is in cv_solve.c, its start in cv_start.c.
  * SPDX-License-Identifier: MIT */
 #include <float.h>
-#include <stdio.h>
 #include <math.h>
 #include <string.h>
-#include <time.h>
 
 #include "cv_internal.h"
 
@@ -19,6 +18,7 @@ cv_solver *cv_solver_new(cv_status *why) {
   s->rtol = s->atol = 1e-10;
   s->maxit = 50;
   s->continuation = 1;
+  s->search_work = 8.0;
   s->adapt_max = 1000000;
   s->err_est = NAN;
   s->status = CVAR_ESTATE;
@@ -27,14 +27,23 @@ cv_solver *cv_solver_new(cv_status *why) {
   return s;
 }
 
+void cv_solver_drop_factor(cv_solver *s) {
+  cv_ldlt_free(s->ldlt);
+  cv_free(s->gof);
+  s->ldlt = NULL;
+  s->gof = NULL;
+}
+
 void cv_solver_free(cv_solver *s) {
   if (!s) return;
+  cv_solver_drop_factor(s);
   cv_free(s->mesh.t);
   cv_free(s->mesh.breaks);
   cv_free(s->start);
   cv_free(s->y);
   cv_free(s->mult);
   cv_disc_free(&s->disc);
+  cv_pathset_free(s->paths);
   cv_free(s);
 }
 
@@ -161,270 +170,6 @@ cv_status cv_solver_set_start(cv_solver *s, int len, const double *y) {
   s->start = c;
   s->start_len = len;
   return CVAR_OK;
-}
-
-/* The default start at fraction t of the interval: the straight line between the end
- * values (a free end takes the other end's value; both free: 0). */
-static void straight_line(const cv_problem *p, double t, double *y) {
-  for (int i = 0; i < p->n; i++) {
-    int fa = p->fixed[2 * i], fb = p->fixed[2 * i + 1];
-    double ya = p->endval[2 * i], yb = p->endval[2 * i + 1];
-    if (!fa) ya = fb ? yb : 0.0;
-    if (!fb) yb = ya;
-    y[i] = ya + (yb - ya) * t;
-  }
-}
-
-/* Initial nodal values: user start, guess callback, or (always with line = 1) the
- * straight line. Fixed ends always win. */
-static cv_status initial_values(cv_solver *s, const cv_problem *p, const cv_disc *d,
-                                double *Y, int line) {
-  int n = p->n;
-  if (s->start && !line) {
-    if (s->start_len != d->ndof) {
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "start vector has %d values but the mesh has %d nodes x %d unknowns",
-                 s->start_len, d->nodes, n);
-      return CVAR_EINVAL;
-    }
-    memcpy(Y, s->start, (size_t)d->ndof * sizeof *Y);
-  } else if (p->guess && !line) {
-    double xb[CV_BATCH], *yb = cv_malloc((size_t)n * CV_BATCH * sizeof *yb);
-    if (!yb) return CVAR_ENOMEM;
-    for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
-      int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
-      for (int k = 0; k < m; k++) xb[k] = cv_disc_node_x(d, j0 + k);
-      int rc = p->guess(m, xb, yb, p->guess_user);
-      for (int k = 0; k < m && rc == 0; k++)
-        for (int i = 0; i < n; i++) {
-          if (!isfinite(yb[i * m + k])) rc = 1;
-          Y[(j0 + k) * n + i] = yb[i * m + k];
-        }
-      if (rc) {
-        cv_free(yb);
-        cv_set_msg(s->msg, sizeof s->msg,
-                   "the initial guess is not finite (or its callback failed) near x = %g",
-                   xb[0]);
-        return CVAR_ECALLBACK;
-      }
-    }
-    cv_free(yb);
-  } else {
-    /* node by node, element by element: no array of abscissae (a large solve faults in
-     * every page it allocates, docs/performance.md) */
-    double rl = 1.0 / (d->b - d->a);
-    for (long e = 0; e < d->E; e++) {
-      double x0 = d->xe[e], h = d->xe[e + 1] - x0;
-      for (int l = 0; l < d->p; l++) {
-        double x = l ? x0 + 0.5 * (d->ref.xi[l] + 1.0) * h : x0;
-        straight_line(p, (x - d->a) * rl, Y + (e * d->p + l) * n);
-      }
-    }
-    straight_line(p, 1.0, Y + (d->nodes - 1) * n);
-    for (int i = 0; i < n; i++) { /* exactly, so that no blend below is needed */
-      if (p->fixed[2 * i]) Y[i] = p->endval[2 * i];
-      if (p->fixed[2 * i + 1]) Y[(d->nodes - 1) * n + i] = p->endval[2 * i + 1];
-    }
-  }
-  /* A start or guess that misses the fixed end values is shifted onto them by a linear
-   * blend, da (1 - t) + db t, rather than having its end nodes overwritten: a kink in the
-   * end elements makes a poor Newton start (measured: a catenary warm-started from its
-   * neighbour in a continuation diverged with the end nodes overwritten). */
-  long last = d->nodes - 1;
-  for (int i = 0; i < n; i++) {
-    double da = p->fixed[2 * i] ? p->endval[2 * i] - Y[i] : 0.0;
-    double db = p->fixed[2 * i + 1] ? p->endval[2 * i + 1] - Y[last * n + i] : 0.0;
-    if (da == 0.0 && db == 0.0) continue;
-    for (long j = 0; j <= last; j++) {
-      double t = (cv_disc_node_x(d, j) - d->a) / (d->b - d->a);
-      Y[j * n + i] += da * (1.0 - t) + db * t;
-    }
-    if (p->fixed[2 * i]) Y[i] = p->endval[2 * i];
-    if (p->fixed[2 * i + 1]) Y[last * n + i] = p->endval[2 * i + 1];
-  }
-  return CVAR_OK;
-}
-
-/* An end where F itself is not finite at the end value (the brachistochrone's 1/sqrt(y) at
- * y = 0) gets the singular-end rule (Q-2) on its element; Gauss points avoid the end, but a
- * fixed Gauss rule under-integrates there and the discrete minimiser exploits it. */
-static void detect_singular_ends(const cv_problem *p, cv_disc *d, const double *Y) {
-  int n = p->n;
-  double x, *buf = cv_malloc((2 * (size_t)n + 1) * sizeof *buf);
-  if (!buf) return;
-  for (int end = 0; end < 2; end++) {
-    long node = end ? d->nodes - 1 : 0;
-    long e = end ? d->E - 1 : 0;
-    double h = d->xe[e + 1] - d->xe[e], phi[CV_MAX_DEGREE + 1], dphi[CV_MAX_DEGREE + 1];
-    cv_lagrange(d->p, d->ref.xi, end ? 1.0 : -1.0, phi, dphi);
-    for (int i = 0; i < n; i++) {
-      double dv = 0.0;
-      for (int l = 0; l <= d->p; l++) dv += Y[(e * d->p + l) * n + i] * dphi[l];
-      buf[i] = Y[node * n + i];
-      buf[n + i] = dv * 2.0 / h;
-    }
-    x = end ? d->b : d->a;
-    cv_partials o = {buf + 2 * n, NULL, NULL, NULL, NULL, NULL};
-    int rc = p->F(1, &x, buf, buf + n, CVAR_NEED_F, &o, p->user);
-    /* infinite (or "cannot evaluate here"), not NaN: a NaN end is undefined, not singular */
-    int singular = rc > 0 || (rc == 0 && isinf(o.F[0]));
-    if (end) d->sing_b = singular;
-    else d->sing_a = singular;
-  }
-  cv_free(buf);
-}
-
-double cv_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-/* Discretisation, starting values and singular-end detection for the current mesh spec. */
-static cv_status setup(cv_solver *s, const cv_problem *p) {
-  cv_status st;
-  cv_free(s->y);
-  cv_free(s->mult);
-  s->y = s->mult = NULL;
-  cv_disc_free(&s->disc);
-  s->have = 0;
-  st = cv_disc_init(&s->disc, p, s, s->msg, sizeof s->msg);
-  if (st) {
-    if (st == CVAR_ENOMEM) cv_set_msg(s->msg, sizeof s->msg, "out of memory building the mesh");
-    return st;
-  }
-  s->y = cv_malloc((size_t)s->disc.ndof * sizeof *s->y);
-  s->mult = cv_calloc((size_t)s->disc.nodes * p->nc + p->ni + 1, sizeof *s->mult);
-  if (!s->y || !s->mult) {
-    cv_set_msg(s->msg, sizeof s->msg, "out of memory for %d nodal values", s->disc.ndof);
-    return CVAR_ENOMEM;
-  }
-  st = initial_values(s, p, &s->disc, s->y, 0);
-  if (st) return st;
-  s->have = 1;
-  detect_singular_ends(p, &s->disc, s->y);
-  st = cv_disc_build_singular_rules(&s->disc);
-  if (st) cv_set_msg(s->msg, sizeof s->msg, "out of memory for the singular-end quadrature");
-  return st;
-}
-
-/* One solve on the mesh of s->mesh (no adaptation). */
-cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
-  cv_status st;
-  cv_free(s->y);
-  cv_free(s->mult);
-  s->y = s->mult = NULL;
-  cv_disc_free(&s->disc);
-  s->have = 0;
-  s->iterations = 0;
-  s->morse = -1;
-  s->degenerate = 0;
-  s->action = s->gnorm = NAN;
-  s->t_assemble = s->t_factor = 0.0;
-  s->csteps = 0;
-  s->note[0] = '\0';
-  if (!p || !p->F) {
-    st = CVAR_EINVAL;
-    cv_set_msg(s->msg, sizeof s->msg, p ? "no integrand set" : "problem is NULL");
-    goto done;
-  }
-  s->n = p->n;
-  st = setup(s, p);
-  if (st) goto done;
-  /* An integrand singular at an end (Q-2) on a plain uniform mesh: grade the mesh towards
-   * that end, x_i = a + (b - a)(i/E)^k with k = min(4, 2 + p/2) (theory M-2). */
-  if ((s->disc.sing_a || s->disc.sing_b) && s->mesh.kind == CV_MESH_UNIFORM && !s->start) {
-    cv_meshspec keep = s->mesh;
-    int both = s->disc.sing_a && s->disc.sing_b, at_a = s->disc.sing_a;
-    double k = fmin(4.0, 2.0 + 0.5 * s->degree);
-    s->mesh.kind = CV_MESH_GRADED;
-    s->mesh.grading = k;
-    s->mesh.grade_end = both ? CVAR_GRADE_BOTH : at_a ? CVAR_GRADE_A : CVAR_GRADE_B;
-    st = setup(s, p);
-    s->mesh = keep;
-    if (st) goto done;
-    cv_set_msg(s->note, sizeof s->note,
-               "the integrand is singular at %s, so the mesh was graded towards it (k = %g); ",
-               both ? "both ends" : at_a ? "the start" : "the end", k);
-  }
-  if (s->method != CVAR_METHOD_NEWTON) {
-    st = cv_nlopt_run(s, p, &s->disc, s->y);
-    goto done;
-  }
-  /* Newton from the start; if it fails to converge (not on bad input or a callback's
-   * abort), Newton from the straight line when the start was given, then continuation
-   * from the start, computed again, before giving up (theory HC-2). */
-  st = cv_newton_run(s, p, &s->disc, s->y, s->mult, NULL);
-  /* Globalisation failures only: not a Hessian singular at the start itself (continuation
-   * cannot cure an invariance; one met on the way is the wandering iterate's), not an
-   * integrand failing at the start, and not an iteration limit the caller chose below 20
-   * (then the limit is what they asked for). */
-  int lost = st == CVAR_ESTALL || st == CVAR_EDIVERGED ||
-             ((st == CVAR_ENONFINITE || st == CVAR_ESINGULAR) && s->iterations > 0) ||
-             (st == CVAR_EMAXITER && s->maxit >= 20);
-  /* A given start or guess that leads nowhere: once more from the straight line between
-   * the end values (a guess steeper than the solution at a singular end starts Newton
-   * where the Hessian is indefinite, docs/faq.md): one Newton run, cheaper than the
-   * continuation below. If it fails too, the first attempt is what continues. */
-  if (lost && (s->start || p->guess) && p->nc == 0 && p->ni == 0) {
-    double *Y1 = cv_malloc((size_t)s->disc.ndof * sizeof *Y1);
-    if (Y1 && !initial_values(s, p, &s->disc, Y1, 1)) {
-      char keep[sizeof s->msg];
-      int it = s->iterations, morse = s->morse, deg = s->degenerate;
-      double act = s->action, gn = s->gnorm, *Yfail = s->y;
-      memcpy(keep, s->msg, sizeof keep);
-      s->y = Y1;
-      if (cv_newton_run(s, p, &s->disc, s->y, s->mult, NULL) == CVAR_OK) {
-        size_t ln = strlen(s->note);
-        cv_set_msg(s->note + ln, sizeof s->note - ln,
-                   "from the given start Newton failed after %d iterations (%s), from the "
-                   "straight line it converged; ", it, cv_strerror(st));
-        cv_free(Yfail);
-        st = CVAR_OK;
-        lost = 0;
-      } else {
-        cv_free(s->y);
-        s->y = Yfail;
-        s->iterations = it, s->morse = morse, s->degenerate = deg;
-        s->action = act, s->gnorm = gn;
-        memcpy(s->msg, keep, sizeof keep);
-      }
-    } else {
-      cv_free(Y1);
-    }
-  }
-  if (lost && p->nc == 0 && p->ni == 0 && s->continuation) {
-    double *Y0 = cv_malloc((size_t)s->disc.ndof * sizeof *Y0);
-    char keep[sizeof s->msg];
-    memcpy(keep, s->msg, sizeof keep);
-    cv_status st0 = Y0 ? initial_values(s, p, &s->disc, Y0, 0) : CVAR_ENOMEM;
-    if (!st0) st = cv_continuation_run(s, p, &s->disc, s->y, s->mult, Y0);
-    else memcpy(s->msg, keep, sizeof keep); /* report Newton's failure */
-    cv_free(Y0);
-  }
-done:
-  if (s->note[0]) {
-    char m[sizeof s->msg];
-    size_t ln = strlen(s->note), lm = strlen(s->msg);
-    if (ln + lm >= sizeof m) lm = sizeof m - 1 - ln;
-    memcpy(m, s->note, ln);
-    memcpy(m + ln, s->msg, lm);
-    m[ln + lm] = '\0';
-    memcpy(s->msg, m, sizeof m);
-  }
-  s->status = st;
-  return st;
-}
-
-cv_status cv_solve(cv_solver *s, const cv_problem *p) {
-  if (!s) return CVAR_EINVAL;
-  double t0 = cv_now();
-  s->err_est = NAN;
-  s->rounds = 0;
-  cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
-  s->status = st;
-  s->time = cv_now() - t0;
-  return st;
 }
 
 cv_status cv_solver_get_status(const cv_solver *s) { return s ? s->status : CVAR_EINVAL; }

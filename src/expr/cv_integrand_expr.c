@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "calcvar.h"
-#include "core/cv_internal_owned.h"
+#include "core/cv_table_internal.h"
 #include "expr/ex_integrand.h"
 
 /* Names known while parsing: the variable (slot 0), the unknowns (slots 1..n, primed
@@ -67,64 +67,13 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
   return e;
 }
 
-/* Split s at commas outside parentheses into a NULL-terminated array of trimmed copies,
- * released with free_list. Returns NULL on allocation failure. */
-static char **split(const char *s, int *count) {
-  size_t len = strlen(s);
-  int parts = 1, depth = 0;
-  for (size_t i = 0; i < len; i++) {
-    if (s[i] == '(') depth++;
-    else if (s[i] == ')') depth--;
-    else if (s[i] == ',' && depth == 0) parts++;
-  }
-  char **list = calloc((size_t)parts + 1, sizeof *list);
-  if (!list) return NULL;
-  size_t start = 0;
-  int k = 0;
-  depth = 0;
-  for (size_t i = 0; i <= len; i++) {
-    if (i < len && s[i] == '(') depth++;
-    else if (i < len && s[i] == ')') depth--;
-    if (i == len || (s[i] == ',' && depth == 0)) {
-      size_t a = start, b = i;
-      while (a < b && isspace((unsigned char)s[a])) a++;
-      while (b > a && isspace((unsigned char)s[b - 1])) b--;
-      list[k] = malloc(b - a + 1);
-      if (!list[k]) {
-        for (int j = 0; j < k; j++) free(list[j]);
-        free(list);
-        return NULL;
-      }
-      memcpy(list[k], s + a, b - a);
-      list[k][b - a] = 0;
-      k++;
-      start = i + 1;
-    }
-  }
-  *count = k;
-  return list;
-}
-
-static void free_list(char **list) {
-  if (!list) return;
-  for (int i = 0; list[i]; i++) free(list[i]);
-  free(list);
-}
-
-static const char *const reserved[] = {"pi", "sin", "cos", "tan", "asin", "acos", "atan",
-                                       "sinh", "cosh", "tanh", "asinh", "acosh", "atanh",
-                                       "exp", "log", "sqrt", "abs", "atan2", "pow", "min",
-                                       "max", "if"};
-
 /* A usable name: an identifier that is neither a function nor pi. Returns the reason
  * it is not, or NULL. */
 static const char *bad_name(const char *s) {
   if (!s[0]) return "is empty";
   if (!(isalpha((unsigned char)s[0]) || s[0] == '_')) return "does not start with a letter";
-  for (const char *q = s; *q; q++)
-    if (!(isalnum((unsigned char)*q) || *q == '_')) return "is not a name (letters, digits, _)";
-  for (size_t i = 0; i < sizeof reserved / sizeof reserved[0]; i++)
-    if (strcmp(s, reserved[i]) == 0) return "is reserved (a function or pi)";
+  if (!ex_is_identifier(s)) return "is not a name (letters, digits, _)";
+  if (ex_is_reserved(s)) return "is reserved (a function or pi)";
   return NULL;
 }
 
@@ -146,7 +95,7 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
   }
   cv_status st = CVAR_EINVAL;
   names c = {variable ? variable : "x", 0, NULL, 0, NULL, NULL, 0};
-  char **plist = NULL;
+  ex_list unk = {0, NULL, NULL}, plist = {0, NULL, NULL};
   ex_dag *d = NULL;
   int np = 0;
   const char *why;
@@ -156,8 +105,8 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
     msg(err, errlen, "variable: '%s' %s", c.var, why);
     goto cleanup;
   }
-  c.unk = split(unknowns, &c.n);
-  if (!c.unk) goto nomem;
+  if ((c.n = ex_list_split(unknowns, &unk)) < 0) goto nomem;
+  c.unk = unk.item;
   if (c.n != cv_problem_get_num_unknowns(p)) {
     msg(err, errlen, "unknowns: %d name%s given, but the problem has %d unknown%s", c.n,
         c.n == 1 ? "" : "s", cv_problem_get_num_unknowns(p),
@@ -181,26 +130,35 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
   }
   d = ex_dag_new();
   if (!d) goto nomem;
+  for (int i = 0; i < cv_problem_num_tables(p); i++) {
+    const char *tn = cv_problem_table_name(p, i);
+    int clash = strcmp(tn, c.var) == 0;
+    for (int j = 0; j < c.n; j++) clash |= strcmp(tn, c.unk[j]) == 0;
+    if (clash || (why = bad_name(tn))) {
+      msg(err, errlen, "table '%s': %s", tn, clash ? "the name is already used" : why);
+      goto cleanup;
+    }
+    if (ex_dag_add_table(d, tn, (cv_table *)cv_problem_table(p, i)) < 0) goto nomem;
+  }
   if (parameters && parameters[0]) {
-    plist = split(parameters, &np);
-    if (!plist) goto nomem;
-    c.pname = calloc((size_t)np, sizeof *c.pname);
-    c.pval = calloc((size_t)np, sizeof *c.pval);
+    if ((np = ex_list_split(parameters, &plist)) < 0) goto nomem;
+    c.pname = cv_calloc((size_t)np, sizeof *c.pname);
+    c.pval = cv_calloc((size_t)np, sizeof *c.pval);
     if (!c.pname || !c.pval) goto nomem;
     for (int i = 0; i < np; i++) {
-      char *eq = strchr(plist[i], '=');
+      char *eq = strchr(plist.item[i], '=');
       if (!eq) {
-        msg(err, errlen, "parameters: '%s' is not of the form name = value", plist[i]);
+        msg(err, errlen, "parameters: '%s' is not of the form name = value", plist.item[i]);
         goto cleanup;
       }
-      char *name = plist[i], *end = eq;
+      char *name = plist.item[i], *end = eq;
       *eq = 0;
       while (end > name && isspace((unsigned char)end[-1])) *--end = 0;
       if ((why = bad_name(name))) {
         msg(err, errlen, "parameters: '%s' %s", name, why);
         goto cleanup;
       }
-      int clash = strcmp(name, c.var) == 0;
+      int clash = strcmp(name, c.var) == 0 || ex_dag_find_table(d, name) >= 0;
       for (int j = 0; j < c.n; j++) clash |= strcmp(name, c.unk[j]) == 0;
       for (int j = 0; j < i; j++) clash |= strcmp(name, c.pname[j]) == 0;
       if (clash) {
@@ -251,14 +209,16 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
     goto cleanup;
   }
   /* The problem owns g from here on, also when the call fails (it releases it). */
-  if (kind == FORMULA_INTEGRAND)
+  if (kind == FORMULA_INTEGRAND) {
     st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
-  else if (kind == FORMULA_CONSTRAINT)
+    if (st == CVAR_OK) st = cv_problem_set_integrand_note(p, ex_integrand_note);
+  } else if (kind == FORMULA_CONSTRAINT) {
     st = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g,
                                          ex_integrand_release, index);
-  else
+  } else {
     st = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release, c_rhs,
                                        index);
+  }
   if (st != CVAR_OK) msg(err, errlen, "%s", cv_strerror(st));
   goto cleanup;
 nomem:
@@ -266,10 +226,10 @@ nomem:
   st = CVAR_ENOMEM;
 cleanup:
   ex_dag_free(d);
-  free_list(c.unk);
-  free_list(plist);
-  free(c.pname);
-  free(c.pval);
+  ex_list_free(&unk);
+  ex_list_free(&plist);
+  cv_free(c.pname);
+  cv_free(c.pval);
   return st;
 }
 

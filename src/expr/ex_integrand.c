@@ -16,6 +16,7 @@ struct ex_integrand {
   double *scratch;  /* one batch per output, for groups the caller did not ask for */
   const double **in;
   double **outp;
+  char note[320];   /* why the last failing evaluation failed (a table's grid left) */
 };
 
 static void set_err(char *err, size_t errlen, const char *msg) {
@@ -34,8 +35,8 @@ ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, cha
   int ntri = n * (n + 1) / 2;
   int level = max_need & CVAR_NEED_HESS ? 2 : max_need & CVAR_NEED_GRAD ? 1 : 0;
   int nout = level == 2 ? 1 + 2 * n + 2 * ntri + n * n : level == 1 ? 1 + 2 * n : 1;
-  ex_integrand *g = calloc(1, sizeof *g);
-  ex_id *outs = malloc((size_t)nout * sizeof *outs);
+  ex_integrand *g = cv_calloc(1, sizeof *g);
+  ex_id *outs = cv_malloc((size_t)nout * sizeof *outs);
   if (!g || !outs) goto nomem;
   g->n = n;
   g->max_need = max_need | CVAR_NEED_F;
@@ -73,16 +74,16 @@ ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, cha
     size_t w = ex_tape_work_size(g->tape[l], EX_INTEGRAND_BATCH);
     if (w > work) work = w;
   }
-  g->work = malloc((work ? work : 1) * sizeof *g->work);
-  g->scratch = malloc((size_t)nout * EX_INTEGRAND_BATCH * sizeof *g->scratch);
-  g->in = malloc((size_t)(2 * n + 1) * sizeof *g->in);
-  g->outp = malloc((size_t)nout * sizeof *g->outp);
+  g->work = cv_malloc((work ? work : 1) * sizeof *g->work);
+  g->scratch = cv_malloc((size_t)nout * EX_INTEGRAND_BATCH * sizeof *g->scratch);
+  g->in = cv_malloc((size_t)(2 * n + 1) * sizeof *g->in);
+  g->outp = cv_malloc((size_t)nout * sizeof *g->outp);
   if (!g->work || !g->scratch || !g->in || !g->outp) goto nomem;
-  free(outs);
+  cv_free(outs);
   return g;
 nomem:
   set_err(err, errlen, "out of memory while compiling the expression");
-  free(outs);
+  cv_free(outs);
   ex_integrand_free(g);
   return NULL;
 }
@@ -90,14 +91,21 @@ nomem:
 void ex_integrand_free(ex_integrand *g) {
   if (!g) return;
   for (int l = 0; l < 3; l++) ex_tape_free(g->tape[l]);
-  free(g->work);
-  free(g->scratch);
-  free(g->in);
-  free(g->outp);
-  free(g);
+  cv_free(g->work);
+  cv_free(g->scratch);
+  cv_free(g->in);
+  cv_free(g->outp);
+  cv_free(g);
 }
 
 void ex_integrand_release(void *g) { ex_integrand_free(g); }
+
+const char *ex_integrand_note(void *user, int reset) {
+  ex_integrand *g = user;
+  if (!g) return NULL;
+  if (reset) g->note[0] = 0;
+  return g->note;
+}
 
 int ex_integrand_num_unknowns(const ex_integrand *g) { return g ? g->n : 0; }
 unsigned ex_integrand_max_need(const ex_integrand *g) { return g ? g->max_need : 0; }
@@ -140,6 +148,9 @@ static int eval_into(ex_integrand *g, int m, const double *x, const double *y,
         for (int j = i; j < n; j++, o++) g->outp[o] = dest(g, Fpp, (i * n + j) * M + k0, o);
     }
     ex_tape_eval(g->tape[level], mm, g->in, g->outp, g->work);
+    /* A table met a point outside its grid: "cannot evaluate here" (the line search
+     * shortens the step), and the note names the table. */
+    if (ex_tape_fault(g->tape[level], mm, g->work, g->note, sizeof g->note)) return 1;
   }
   /* Symmetric blocks: the lower triangle is a copy of the upper. */
   for (int i = 0; i < n; i++)

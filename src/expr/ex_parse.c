@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "calcvar.h"
 #include "expr/ex_internal.h"
 
 /* Nesting bound: each level costs a handful of small stack frames, so 200 levels is far
@@ -103,27 +104,6 @@ static ex_id parse_number(parser *p) {
   return built(p, ex_num(p->d, v));
 }
 
-typedef struct {
-  const char *name;
-  ex_op op;
-  int nargs;
-} func;
-
-static const func funcs[] = {
-    {"sin", EX_SIN, 1},     {"cos", EX_COS, 1},     {"tan", EX_TAN, 1},
-    {"asin", EX_ASIN, 1},   {"acos", EX_ACOS, 1},   {"atan", EX_ATAN, 1},
-    {"sinh", EX_SINH, 1},   {"cosh", EX_COSH, 1},   {"tanh", EX_TANH, 1},
-    {"asinh", EX_ASINH, 1}, {"acosh", EX_ACOSH, 1}, {"atanh", EX_ATANH, 1},
-    {"exp", EX_EXP, 1},     {"log", EX_LOG, 1},     {"sqrt", EX_SQRT, 1},
-    {"abs", EX_ABS, 1},     {"atan2", EX_ATAN2, 2}, {"pow", EX_POW, 2},
-    {"min", EX_MIN, 2},     {"max", EX_MAX, 2},     {"if", EX_IF, 3}};
-
-static const func *find_func(const char *name) {
-  for (size_t i = 0; i < sizeof funcs / sizeof funcs[0]; i++)
-    if (strcmp(funcs[i].name, name) == 0) return &funcs[i];
-  return NULL;
-}
-
 /* sum [relop sum]: a condition's value is 1 or 0; a bare sum counts as true when != 0. */
 static ex_id parse_cond(parser *p) {
   ex_id a = parse_sum(p);
@@ -141,7 +121,7 @@ static ex_id parse_cond(parser *p) {
   return built(p, ex_binary(p->d, op, a, b));
 }
 
-static ex_id parse_call(parser *p, const func *f, size_t at) {
+static ex_id parse_call(parser *p, const ex_function *f, size_t at) {
   ex_id args[3];
   int n = 0;
   p->pos++; /* '(' */
@@ -174,6 +154,56 @@ static ex_id parse_call(parser *p, const func *f, size_t at) {
   }
 }
 
+/* A table call name(args) or name.K(args) (expr.h): K lists the coordinates (1..dim) to
+ * differentiate by, e.g. h.12 = d2h/du dv. pos is at the '.' or '('. */
+static ex_id parse_table_call(parser *p, int index, const char *name, size_t at) {
+  const cv_table *t = p->d->tabs[index];
+  int dim = cv_table_get_dim(t), ord[3] = {0, 0, 0};
+  if (p->s[p->pos] == '.') {
+    size_t k0 = ++p->pos;
+    while (isdigit((unsigned char)p->s[p->pos])) {
+      int k = p->s[p->pos] - '1';
+      if (k < 0 || k >= dim)
+        return fail(p, p->pos, "'%s' has %d coordinate%s: a derivative index is 1%s", name,
+                    dim, dim == 1 ? "" : "s", dim == 1 ? "" : dim == 2 ? " or 2" : ", 2 or 3");
+      ord[k]++;
+      p->pos++;
+    }
+    if (p->pos == k0 || p->pos - k0 > 6)
+      return fail(p, k0, "after '%s.' write the coordinates to differentiate by (e.g. %s.1)",
+                  name, name);
+    skip_ws(p);
+    if (p->s[p->pos] != '(')
+      return fail(p, at, "'%s' is a table: write %s(...)", name, name);
+  }
+  ex_id args[3];
+  int n = 0;
+  p->pos++; /* '(' */
+  for (;;) {
+    if (n == 3) break;
+    args[n] = parse_sum(p);
+    if (args[n] < 0) return -1;
+    n++;
+    skip_ws(p);
+    if (p->s[p->pos] == ',') {
+      p->pos++;
+      continue;
+    }
+    if (p->s[p->pos] == ')') {
+      p->pos++;
+      break;
+    }
+    char buf[16];
+    return fail(p, p->pos, "expected ',' or ')' in the arguments of '%s' but found %s", name,
+                found(p, buf, sizeof buf));
+  }
+  if (n != dim || (n == 3 && p->s[p->pos - 1] != ')'))
+    return fail(p, at, "table '%s' has %d coordinate%s, so it takes %d argument%s%s", name,
+                dim, dim == 1 ? "" : "s", dim, dim == 1 ? "" : "s",
+                n == 3 && p->s[p->pos - 1] != ')' ? ", not more" : "");
+  return built(p, ex_table_call(p->d, index, ord, args));
+}
+
 static ex_id parse_name(parser *p) {
   size_t at = p->pos, i = at;
   while (is_name_char((unsigned char)p->s[i])) i++;
@@ -185,7 +215,12 @@ static ex_id parse_name(parser *p) {
   while (p->s[i] == '\'') i++, primes++;
   p->pos = i;
   skip_ws(p);
-  const func *f = find_func(name);
+  const ex_function *f = ex_function_find(name);
+  int table = f ? -1 : ex_dag_find_table(p->d, name);
+  if (table >= 0 && !primes && (p->s[p->pos] == '(' || (p->s[p->pos] == '.' && p->pos == i)))
+    return parse_table_call(p, table, name, at);
+  if (table >= 0)
+    return fail(p, at, "'%s' is a table: write %s(...)", name, name);
   if (p->s[p->pos] == '(' && !primes) {
     if (!f) return fail(p, at, "unknown function '%s'", name);
     return parse_call(p, f, at);

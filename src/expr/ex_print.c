@@ -62,7 +62,8 @@ static int plain_factor(const ex_dag *d, ex_id e) {
   const ex_node *nd = &d->nodes[e];
   if (nd->op == EX_POW) nd = &d->nodes[nd->a];
   return nd->op == EX_SLOT || (nd->op >= EX_SIN && nd->op <= EX_ABS) ||
-         nd->op == EX_ATAN2 || nd->op == EX_MIN || nd->op == EX_MAX || nd->op == EX_IF;
+         nd->op == EX_ATAN2 || nd->op == EX_MIN || nd->op == EX_MAX || nd->op == EX_IF ||
+         nd->op == EX_TABLE;
 }
 
 static void put(printer *o, const char *s, size_t n) {
@@ -163,6 +164,25 @@ static void emit(printer *o, ex_id e) {
     put(o, ")", 1);
     break;
   }
+  case EX_TABLE: { /* name(u, v) or name.K(u, v), K the axes differentiated (1-based) */
+    int index, ord[3], at = 0;
+    ex_table_decode(nd->v, &index, ord);
+    const char *name = ex_dag_table_name(d, index);
+    puts_(o, name ? name : "table?");
+    if (ord[0] + ord[1] + ord[2] > 0) {
+      tmp[at++] = '.';
+      for (int k = 0; k < 3; k++)
+        for (int r = 0; r < ord[k]; r++) tmp[at++] = (char)('1' + k);
+      tmp[at] = 0;
+      puts_(o, tmp);
+    }
+    put(o, "(", 1);
+    child(o, nd->a, 0);
+    if (nd->b >= 0) puts_(o, ", "), child(o, nd->b, 0);
+    if (nd->c >= 0) puts_(o, ", "), child(o, nd->c, 0);
+    put(o, ")", 1);
+    break;
+  }
   default: /* functions */
     puts_(o, ex_op_name(nd->op));
     put(o, "(", 1);
@@ -178,8 +198,8 @@ static void emit(printer *o, ex_id e) {
 size_t ex_print(const ex_dag *d, ex_id e, const char *const *names, char *buf, size_t len) {
   if (buf && len) buf[0] = 0;
   if (!d || e < 0 || e >= d->n) return 0;
-  unsigned char *mark = calloc((size_t)e + 1, 1);
-  size_t *lens = malloc(((size_t)e + 1) * sizeof *lens);
+  unsigned char *mark = cv_calloc((size_t)e + 1, 1);
+  size_t *lens = cv_malloc(((size_t)e + 1) * sizeof *lens);
   size_t total = 0;
   if (!mark || !lens) goto cleanup; /* returns 0: nothing could be printed */
   ex_mark_reachable(d, e, mark, 0);
@@ -199,7 +219,7 @@ size_t ex_print(const ex_dag *d, ex_id e, const char *const *names, char *buf, s
     buf[o.pos] = 0;
   }
 cleanup:
-  free(mark);
-  free(lens);
+  cv_free(mark);
+  cv_free(lens);
   return total;
 }

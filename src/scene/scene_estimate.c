@@ -32,7 +32,7 @@
 static int reference_mesh(const scene *s, int nn, const double *x, int degree, double **t)
 {
   int ne = degree == 1 ? 2 * (nn - 1) : nn - 1;
-  double *u = malloc((size_t)(ne + 1) * sizeof *u), L = s->b - s->a;
+  double *u = cv_malloc((size_t)(ne + 1) * sizeof *u), L = s->b - s->a;
   if (!u)
     return -1;
   for (int j = 0, k = 0; j < nn; j++) {
@@ -57,7 +57,7 @@ int cli_estimate_error(const scene *s, const cv_problem *p, int nn, int degree,
   cv_status why;
   double *t = NULL;
   cv_solver *f = cv_solver_new(&why);
-  double *yf = malloc((size_t)nn * n * sizeof *yf);
+  double *yf = cv_malloc((size_t)nn * n * sizeof *yf);
   int ne = reference_mesh(s, nn, x, degree, &t);
   if (!f || !yf || ne < 0)
     goto done;
@@ -84,8 +84,8 @@ int cli_estimate_error(const scene *s, const cv_problem *p, int nn, int degree,
   }
 done:
   cv_solver_free(f);
-  free(yf);
-  free(t);
+  cv_free(yf);
+  cv_free(t);
   return rc;
 }
 

@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 
+#include "core/cv_memory.h"
 #include "scene/scene.h"
 
 /* Where a piece of a (possibly continued) value came from: the value's characters from
@@ -29,7 +30,7 @@ typedef struct {
 
 typedef enum {
   SEC_SCENE, SEC_PARAMETERS, SEC_DEFINITIONS, SEC_BOUNDARY, SEC_GUESS, SEC_CONSTRAINTS,
-  SEC_INTEGRALS, SEC_EXACT, SEC_REPORT, SEC_MESH, SEC_SOLVER, SEC_PLOT, SEC_COUNT
+  SEC_INTEGRALS, SEC_EXACT, SEC_REPORT, SEC_MESH, SEC_SOLVER, SEC_TABLES, SEC_PLOT, SEC_COUNT
 } sc_section;
 
 /* A logical line: a section header or a key line (with its continuations). */
@@ -78,8 +79,7 @@ void sc_entry_free(sc_entry *e);
 /* Map a 0-based offset in an entry's value to a physical line and 1-based column. */
 void sc_entry_locate(const sc_entry *e, int off, int *line, int *col);
 
-/* scene_names.c: names and the resolver used while parsing expressions. */
-int sc_is_identifier(const char *s);
+/* scene_names.c: the names a scene may not define (the grammar's reserved names and free). */
 int sc_is_reserved(const char *s);
 
 /* The loader's state while it interprets the entries (scene_load.c and friends). */
@@ -94,21 +94,20 @@ typedef struct {
   int limit;     /* parameters (SC_R_PARAM) or definitions (SC_R_FULL) usable: index < limit */
 } sc_loader;
 
-/* A value split at commas outside parentheses; off[i] is item i's offset in the value. */
-typedef struct {
-  int n;
-  char **item;
-  int *off;
-} sc_list;
-
 /* scene_parse.c */
-int sc_list_split(const char *value, sc_list *list);
-void sc_list_free(sc_list *list);
 ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what);
 int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
                    const char *what, double *value);
 const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap);
 int sc_first_slot(const scene *s, ex_id e, int from, int to);
+
+/* scene_load.c: a new name (identifier, not reserved, not taken; `role` for the message). */
+int sc_check_new_name(sc_loader *L, int line, const char *name, const char *role);
+
+/* scene_table.c: the [tables] section, and one CSV grid read into a table (`shown` names
+ * the file in messages "FILE:LINE: ..."; NULL with the message in err). */
+int sc_load_tables(sc_loader *L);
+struct cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t errlen);
 
 /* scene_eval.c */
 int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const double *x,

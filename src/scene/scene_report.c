@@ -33,16 +33,16 @@ const char *cli_status_string(cv_status st)
 
 void cli_report_free(cli_report *r)
 {
-  free(r->has_mom);
-  free(r->mom_min);
-  free(r->mom_max);
-  free(r->has_rep);
-  free(r->rep);
-  free(r->x);
-  free(r->y);
-  free(r->lam);
-  free(r->has_mu);
-  free(r->mu);
+  cv_free(r->has_mom);
+  cv_free(r->mom_min);
+  cv_free(r->mom_max);
+  cv_free(r->has_rep);
+  cv_free(r->rep);
+  cv_free(r->x);
+  cv_free(r->y);
+  cv_free(r->lam);
+  cv_free(r->has_mu);
+  cv_free(r->mu);
   memset(r, 0, sizeof *r);
 }
 
@@ -69,9 +69,9 @@ static int nodal_error(cli_report *r, const scene *s)
     any |= s->exact[i] >= 0;
   if (!any)
     return 0;
-  double *ex = malloc((size_t)nn * n * sizeof *ex);
+  double *ex = cv_malloc((size_t)nn * n * sizeof *ex);
   if (!ex || scene_eval_exact(s, nn, r->x, ex) < 0) {
-    free(ex);
+    cv_free(ex);
     return -1;
   }
   double e = 0;
@@ -83,7 +83,7 @@ static int nodal_error(cli_report *r, const scene *s)
         finite &= isfinite(d);
         e = d > e ? d : e;
       }
-  free(ex);
+  cv_free(ex);
   if (finite) {
     r->has_err_nodal = 1;
     r->err_nodal = e;
@@ -131,18 +131,20 @@ static int constraints_depend_on(const scene *s, int slot)
   return 0;
 }
 
-/* Energy, momenta and report integrals at the quadrature points. */
-static int qpoint_quantities(cli_report *r, scene *s, cv_solver *sv)
+/* Energy, momenta and report integrals at the quadrature points. Energy and momenta come
+ * from the problem's compiled integrand (the partials the solver used). */
+static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv)
 {
   int n = s->n, nq = cv_solver_get_num_qpoints(sv), rc = -1;
   if (nq <= 0)
     return 0;
   size_t q = (size_t)nq;
-  double *x = malloc(q * sizeof *x), *w = malloc(q * sizeof *w);
-  double *y = malloc(q * n * sizeof *y), *dy = malloc(q * n * sizeof *dy);
+  double *x = cv_malloc(q * sizeof *x), *w = cv_malloc(q * sizeof *w);
+  double *y = cv_malloc(q * n * sizeof *y), *dy = cv_malloc(q * n * sizeof *dy);
   size_t nv = q * (size_t)(n > s->nreports ? n : s->nreports);
-  double *v = malloc((nv > q ? nv : q) * sizeof *v);
-  if (!x || !w || !y || !dy || !v)
+  double *v = cv_malloc((nv > q ? nv : q) * sizeof *v);
+  double *H = cv_malloc(q * sizeof *H), *mom = cv_malloc(q * n * sizeof *mom);
+  if (!x || !w || !y || !dy || !v || !H || !mom)
     goto done;
   if (cv_solver_get_qpoints(sv, x, w, y, dy) != CVAR_OK) {
     rc = 0; /* nothing to evaluate on: leave the keys out */
@@ -151,17 +153,18 @@ static int qpoint_quantities(cli_report *r, scene *s, cv_solver *sv)
   /* With constraints, H of F alone is conserved only when no constraint depends on the
    * variable and there is no integral constraint (whose multiplier enters the conserved
    * quantity); a momentum only when no constraint involves that unknown (docs/cli.md). */
-  if (!scene_F_depends_on_variable(s) && s->nints == 0 && !constraints_depend_on(s, 0)) {
-    if (scene_eval_energy(s, nq, x, y, dy, v) < 0)
-      goto done;
-    r->has_energy = elem_avg_range(v, w, nq, r->elements, &r->emin, &r->emax) == 0;
-  }
-  if (scene_eval_momenta(s, nq, x, y, dy, v) < 0)
+  cv_status st = cv_problem_eval_energy(p, nq, x, y, dy, H, mom);
+  if (st == CVAR_ENOMEM)
     goto done;
-  for (int i = 0; i < n; i++)
+  /* A callback that fails here leaves energy and momenta out, as non-finite values do. */
+  int have = st == CVAR_OK;
+  if (have && !scene_F_depends_on_variable(s) && s->nints == 0 &&
+      !constraints_depend_on(s, 0))
+    r->has_energy = elem_avg_range(H, w, nq, r->elements, &r->emin, &r->emax) == 0;
+  for (int i = 0; i < n && have; i++)
     if (!scene_F_depends_on_unknown(s, i) && !constraints_depend_on(s, 1 + i))
-      r->has_mom[i] = elem_avg_range(v + (size_t)i * q, w, nq, r->elements, &r->mom_min[i],
-                                     &r->mom_max[i]) == 0;
+      r->has_mom[i] = elem_avg_range(mom + (size_t)i * q, w, nq, r->elements,
+                                     &r->mom_min[i], &r->mom_max[i]) == 0;
   if (s->nreports > 0 && scene_eval_reports(s, nq, x, y, dy, v) < 0)
     goto done;
   for (int k = 0; k < s->nreports; k++) {
@@ -173,11 +176,13 @@ static int qpoint_quantities(cli_report *r, scene *s, cv_solver *sv)
   }
   rc = 0;
 done:
-  free(x);
-  free(w);
-  free(y);
-  free(dy);
-  free(v);
+  cv_free(x);
+  cv_free(w);
+  cv_free(y);
+  cv_free(dy);
+  cv_free(v);
+  cv_free(H);
+  cv_free(mom);
   return rc;
 }
 
@@ -212,7 +217,8 @@ static void compose_message(cli_report *r, cv_solver *sv)
 }
 
 /* Fill r after cv_solve returned st. Returns 0, or -1 on allocation failure. */
-int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_status st)
+int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv,
+                       cv_method m, cv_status st)
 {
   int n = s->n;
   memset(r, 0, sizeof *r);
@@ -232,14 +238,14 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
   r->time_s = cv_solver_get_time(sv);
   r->has_time = isfinite(r->time_s);
 
-  r->has_mom = calloc((size_t)n, sizeof *r->has_mom);
-  r->mom_min = calloc((size_t)n, sizeof *r->mom_min);
-  r->mom_max = calloc((size_t)n, sizeof *r->mom_max);
-  r->has_rep = calloc((size_t)s->nreports + 1, sizeof *r->has_rep);
-  r->rep = calloc((size_t)s->nreports + 1, sizeof *r->rep);
+  r->has_mom = cv_calloc((size_t)n, sizeof *r->has_mom);
+  r->mom_min = cv_calloc((size_t)n, sizeof *r->mom_min);
+  r->mom_max = cv_calloc((size_t)n, sizeof *r->mom_max);
+  r->has_rep = cv_calloc((size_t)s->nreports + 1, sizeof *r->has_rep);
+  r->rep = cv_calloc((size_t)s->nreports + 1, sizeof *r->rep);
   int nn = r->nodes > 0 ? r->nodes : 0;
-  r->x = calloc((size_t)nn + 1, sizeof *r->x);
-  r->y = calloc((size_t)nn * n + 1, sizeof *r->y);
+  r->x = cv_calloc((size_t)nn + 1, sizeof *r->x);
+  r->y = cv_calloc((size_t)nn * n + 1, sizeof *r->y);
   if (!r->has_mom || !r->mom_min || !r->mom_max || !r->has_rep || !r->rep || !r->x || !r->y)
     return -1;
   if (nn > 0 && (cv_solver_get_nodes(sv, r->x) != CVAR_OK ||
@@ -248,7 +254,7 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
 
   /* The Morse index describes a stationary point: reported only when Newton converged to
    * one (an unconverged iterate's inertia says nothing about the answer). */
-  if (m == SC_NEWTON && st == CVAR_OK) {
+  if (m == CVAR_METHOD_NEWTON && st == CVAR_OK) {
     int morse = cv_solver_get_morse_index(sv), nfree = cv_solver_get_num_free(sv);
     if (morse >= 0) {
       r->has_morse = 1;
@@ -267,7 +273,7 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
     return -1;
   /* Multiplier fields (CSV lambda_NAME) and integral multipliers (JSON multipliers). */
   if (nn > 0 && s->ncons > 0) {
-    r->lam = malloc((size_t)nn * s->ncons * sizeof *r->lam);
+    r->lam = cv_malloc((size_t)nn * s->ncons * sizeof *r->lam);
     if (!r->lam)
       return -1;
     for (int c = 0; c < s->ncons; c++)
@@ -275,8 +281,8 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
         for (int j = 0; j < nn; j++)
           r->lam[(size_t)c * nn + j] = NAN;
   }
-  r->has_mu = calloc((size_t)s->nints + 1, sizeof *r->has_mu);
-  r->mu = calloc((size_t)s->nints + 1, sizeof *r->mu);
+  r->has_mu = cv_calloc((size_t)s->nints + 1, sizeof *r->has_mu);
+  r->mu = cv_calloc((size_t)s->nints + 1, sizeof *r->mu);
   if (!r->has_mu || !r->mu)
     return -1;
   for (int k = 0; k < s->nints; k++)
@@ -285,7 +291,7 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
     r->has_err_action = 1;
     r->err_action = fabs(r->action - s->exact_action);
   }
-  if (nn > 0 && qpoint_quantities(r, s, sv) < 0)
+  if (nn > 0 && qpoint_quantities(r, s, p, sv) < 0)
     return -1;
   compose_message(r, sv);
   return 0;
@@ -294,7 +300,7 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
 int cli_report_build(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv, cv_status st,
                      int adaptive)
 {
-  if (cli_report_collect(r, s, sv, (sc_method)cv_solver_get_method(sv), st) < 0)
+  if (cli_report_collect(r, s, p, sv, cv_solver_get_method(sv), st) < 0)
     return -1;
   int any_exact = 0;
   for (int i = 0; i < s->n; i++)

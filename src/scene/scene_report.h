@@ -12,6 +12,7 @@
 #include <stdio.h>
 
 #include "calcvar.h"
+#include "core/cv_memory.h"
 #include "scene/scene.h"
 
 /* The version of the JSON report's layout, written as its "schema" key; raised when a key
@@ -22,7 +23,7 @@
  * apply are left out). report.c fills it from a solver and its scene. */
 typedef struct {
   const scene *sc;
-  sc_method method;
+  cv_method method;
   cv_status st;
   const char *status;
   char message[640];
@@ -48,7 +49,8 @@ typedef struct {
 } cli_report;
 
 const char *cli_status_string(cv_status st);
-int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_status st);
+int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv,
+                       cv_method m, cv_status st);
 /* estimate.c: the max nodal error of a solve without [exact], from a reference solve on
  * a mesh whose element boundaries include every node (docs/cli.md). cli_estimate_error
  * gives the max over all nodes and over the element boundaries (NaN when the reference

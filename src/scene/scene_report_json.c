@@ -41,7 +41,7 @@ json_t *cli_report_json_object(const cli_report *r)
   json_object_set_new(o, "title", json_string(s->title));
   json_object_set_new(o, "status", json_string(r->status));
   json_object_set_new(o, "message", json_string(r->message));
-  json_object_set_new(o, "method", json_string(scene_method_name(r->method)));
+  json_object_set_new(o, "method", json_string(cv_method_name(r->method)));
   if (r->nodes > 0) {
     json_object_set_new(o, "elements", json_integer(r->elements));
     json_object_set_new(o, "degree", json_integer(r->degree));
