@@ -85,6 +85,37 @@ def _free_all(solver, problem, scene):
         lib.cv_scene_free(scene)
 
 
+class _Handles:
+    """The scene, problem and solver behind one or more Solutions (the paths of one
+    all=True search share them); released when the last Solution goes."""
+
+    def __init__(self, scene, problem, solver):
+        self.h = (scene, problem, solver)
+        self.keep = []  # ctypes callbacks the library holds
+
+    def __del__(self):
+        h, self.h = self.h, None
+        if h:
+            try:
+                _free_all(h[2], h[1], h[0])
+            except (AttributeError, TypeError):  # the interpreter is shutting down
+                pass
+
+
+class Solutions(list):
+    """The paths of solve(..., all=True), by increasing action: a list of Solution, with
+    `search` (starts, failed, duplicates, found, stopped: how the search went) and
+    `message` (the plain solve's sentence when no path converged)."""
+    search = None
+    message = ""
+
+
+class _SearchInfo(ctypes.Structure):
+    _fields_ = [("starts", ctypes.c_int), ("failed", ctypes.c_int),
+                ("duplicates", ctypes.c_int), ("found", ctypes.c_int),
+                ("stop", ctypes.c_char * 200)]
+
+
 def _load(scene, set, err=None):
     if err is None:
         err = ctypes.create_string_buffer(_lib.ERRLEN)
@@ -145,8 +176,8 @@ def _progress_callback(user_fn, verbose, caught):
 
 
 def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
-          max_iterations=None, adapt=None, set=None, tol=None, all=False, progress=None,
-          verbose=False):
+          max_iterations=None, adapt=None, set=None, tol=None, all=False, max_paths=8,
+          work=None, progress=None, verbose=False):
     """Solve a scene as `calcvar solve` does and return a Solution.
 
     scene: a path (str or os.PathLike) or the text of a scene (any str with a newline or
@@ -157,6 +188,10 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
     residual, step, alpha, action, round, elements, estimate); returning True cancels.
     verbose=True prints those lines.
 
+    all=True searches for every stationary path with the same ends (`calcvar solve
+    --all`: deflated Newton, at most max_paths, work limit `work` like --work) and
+    returns a Solutions list, by increasing action.
+
     Bad input raises InputError (a ValueError) with the FILE:LINE sentence. A solve that
     does not converge is not an exception: look at Solution.status / .success.
     """
@@ -164,9 +199,10 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
         raise NotImplementedError("tol=: the accuracy target of `calcvar solve --tol` is not "
                                   "in this build of the library yet; adapt=TOL refines the "
                                   "mesh until the estimated max nodal error is below TOL")
-    if all:
-        raise NotImplementedError("all=True: several solutions per scene (`calcvar solve "
-                                  "--all`) are not in this build of the library yet")
+    if all and (isinstance(max_paths, bool) or not isinstance(max_paths, int)
+                or max_paths < 1):
+        raise InputError("CVAR_EINVAL", "max_paths=%r: a whole number >= 1 is needed"
+                         % (max_paths,))
     err = ctypes.create_string_buffer(_lib.ERRLEN)
     scene_h = _load(scene, set, err)
     problem = solver = None
@@ -202,7 +238,13 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
         if progress is not None or verbose:
             cb = _progress_callback(progress, verbose, caught)
             lib.cv_solver_set_progress(solver, cb, None)
-        st = lib.cv_solve(solver, problem)  # the GIL is released in here
+        if all:
+            if work is not None and lib.cv_solver_set_search_work(solver, float(work)) \
+                    != _lib.OK:
+                raise InputError("CVAR_EINVAL", "work=%r: a factor >= 1 is needed" % (work,))
+            st = lib.cv_solve_all(solver, problem, max_paths)  # the GIL is released
+        else:
+            st = lib.cv_solve(solver, problem)  # the GIL is released in here
         if cb is not None:
             lib.cv_solver_set_progress(solver, _lib.PROGRESS_FN(), None)
         if caught:
@@ -211,11 +253,43 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
             # input the core refused before solving, as the command reports it
             _fail(st, "%s: %s" % ("<string>" if "\n" in str(scene) else os.fspath(scene),
                                   lib.cv_solver_last_error(solver).decode()))
-        sol = Solution(scene_h, problem, solver)
-        scene_h = problem = solver = None  # the Solution owns them now
-        return sol
+        hold = _Handles(scene_h, problem, solver)
+        scene_h = problem = solver = None  # hold owns them now
+        if not all:
+            return Solution(hold)
+        return _paths(hold)
     finally:
         _free_all(solver, problem, scene_h)
+
+
+def _paths(hold):
+    scene, problem, solver = hold.h
+    out = Solutions()
+    info = _SearchInfo()
+    if lib.cv_solver_get_search(solver, ctypes.byref(info)) == _lib.OK:
+        out.search = {"starts": info.starts, "failed": info.failed,
+                      "duplicates": info.duplicates, "found": info.found,
+                      "stopped": info.stop.decode(errors="replace")}
+    out.message = lib.cv_solver_last_error(solver).decode(errors="replace")
+    n = lib.cv_solver_get_num_solutions(solver)
+    if n > 0:
+        # as the command does: the reference solve of each path's error estimate (its
+        # report) starts from that path, not from the scene's guess
+        a, b = ctypes.c_double(), ctypes.c_double()
+        lib.cv_problem_get_interval(problem, ctypes.byref(a), ctypes.byref(b))
+        lo, hi = a.value, b.value
+
+        def guess(m, x, y, _user):
+            xc = np.clip(np.ctypeslib.as_array(x, (m,)), lo, hi)
+            return 0 if lib.cv_solver_eval(solver, m, xc.ctypes.data, ctypes.cast(
+                y, ctypes.c_void_p), None) == _lib.OK else 1
+
+        cb = _lib.GUESS_FN(guess)
+        hold.keep.append(cb)
+        lib.cv_problem_set_guess(problem, cb, None)
+    for k in range(n):
+        out.append(Solution(hold, k))
+    return out
 
 
 class Solution:
@@ -235,10 +309,12 @@ class Solution:
                 without [exact] it makes the same reference solve the command does)
     """
 
-    def __init__(self, scene, problem, solver):
-        self._h = (scene, problem, solver)
+    def __init__(self, hold, path=None):
+        self._hold = hold
+        self._path = path  # index among the paths of an all=True search, else None
         self._report = None
         self._unknowns = None
+        scene, _, solver = self._h
         nn = lib.cv_solver_get_num_nodes(solver)
         n = lib.cv_scene_get_num_unknowns(scene)
         # numpy buffers filled by the library in place: node-major values (calcvar.h)
@@ -252,14 +328,13 @@ class Solution:
         self._code = lib.cv_solver_get_status(solver)
         self.success = self._code == _lib.OK
 
-    def __del__(self):
-        h = self.__dict__.get("_h")
-        if h:
-            self._h = None
-            try:
-                _free_all(h[2], h[1], h[0])
-            except (AttributeError, TypeError):  # the interpreter is shutting down
-                pass
+    @property
+    def _h(self):
+        """(scene, problem, solver), with this Solution's path selected."""
+        h = self._hold.h
+        if self._path is not None:
+            lib.cv_solver_select_solution(h[2], self._path)
+        return h
 
     # Everything else is read from the solver when asked for (the call stays cheap).
     unknowns = property(lambda self: self._names(), doc="the unknowns' names, in order")
@@ -309,7 +384,7 @@ class Solution:
 
     def __getattr__(self, name):
         # only called for names that are not attributes
-        if name.startswith("_") or "_h" not in self.__dict__ or not self._h:
+        if name.startswith("_") or "_hold" not in self.__dict__:
             raise AttributeError(name)
         if name in self.unknowns:
             return self[name]

@@ -45,6 +45,7 @@ class Progress(Structure):
 
 
 PROGRESS_FN = CFUNCTYPE(c_int, POINTER(Progress), c_void_p)
+GUESS_FN = CFUNCTYPE(c_int, c_int, POINTER(c_double), POINTER(c_double), c_void_p)
 
 
 def _sig(name, restype, *argtypes):
@@ -76,6 +77,12 @@ _sig("cv_report_json", c_char_p, c_void_p)
 _sig("cv_report_free", None, c_void_p)
 
 _sig("cv_problem_free", None, c_void_p)
+_sig("cv_problem_set_guess", c_int, c_void_p, GUESS_FN, c_void_p)
+_sig("cv_solve_all", c_int, c_void_p, c_void_p, c_int)
+_sig("cv_solver_set_search_work", c_int, c_void_p, c_double)
+_sig("cv_solver_get_num_solutions", c_int, c_void_p)
+_sig("cv_solver_select_solution", c_int, c_void_p, c_int)
+_sig("cv_solver_get_search", c_int, c_void_p, c_void_p)
 _sig("cv_problem_get_interval", None, c_void_p, dp, dp)
 _sig("cv_solver_new", c_void_p, POINTER(c_int))
 _sig("cv_solver_free", None, c_void_p)

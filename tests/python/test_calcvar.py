@@ -198,8 +198,47 @@ def test_versions():
 def test_not_yet_built_options_refuse():
     with pytest.raises(NotImplementedError, match="tol"):
         calcvar.solve(CATENARY, tol=1e-8)
-    with pytest.raises(NotImplementedError, match="all"):
-        calcvar.solve(CATENARY, all=True)
+
+
+BRATU = """[scene]
+title = Bratu
+interval = 0, 1
+unknowns = y
+integrand = y'^2/2 - exp(y)
+[boundary]
+y = 0, 0
+"""
+
+
+def _bisect(g, lo, hi):
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if g(lo) * g(mid) > 0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def test_all_paths_bratu():
+    """Bratu's problem, lambda = 1: two stationary paths y = -2 log(cosh((x - 1/2) t/2) /
+    cosh(t/4)) with t = sqrt(2) cosh(t/4) (two roots), a minimum and a saddle; 24 elements
+    of degree 8 reach 1e-10 (the command's test uses the same bound)."""
+    sols = calcvar.solve(BRATU, elements=24, degree=8, all=True)
+    assert isinstance(sols, calcvar.Solutions) and len(sols) == 2
+    assert sols.search["found"] == 2 and sols.search["starts"] >= 2
+    g = lambda t: t - math.sqrt(2.0) * math.cosh(t / 4)  # noqa: E731
+    for sol, theta, morse in zip(sols, (_bisect(g, 0.5, 4.0), _bisect(g, 4.0, 20.0)), (0, 1)):
+        x = np.linspace(0, 1, 101)
+        exact = -2 * np.log(np.cosh((x - 0.5) * theta / 2) / np.cosh(theta / 4))
+        assert np.max(np.abs(sol(x)[0] - exact)) < 1e-10    # between the nodes too
+        assert np.max(np.abs(sol.y - (-2 * np.log(np.cosh((sol.x - 0.5) * theta / 2)
+                                                  / np.cosh(theta / 4))))) < 1e-10
+        assert sol.morse_index == morse
+        assert sol.report["morse_index"] == morse
+    assert sols[0].action < sols[1].action
+    assert [s.report["stationary_kind"] for s in sols] == ["minimum", "saddle"]
+    with pytest.raises(ValueError, match="max_paths"):
+        calcvar.solve(BRATU, all=True, max_paths=0)
+    one = calcvar.solve(BRATU, elements=24, degree=8, all=True, max_paths=1)
+    assert len(one) == 1
 
 
 def test_progress_and_cancel():
