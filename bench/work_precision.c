@@ -215,7 +215,7 @@ static int draw(const char *dir, const char *name, const char *title, point pts[
                         .ylabel = "max nodal error", .logx = 1, .logy = 1, .nlines = nl,
                         .lines = lines};
   cli_outfile o;
-  if (cli_outfile_open(&o, path) < 0)
+  if (cli_outfile_open(&o, path, NULL) < 0)
     return -1;
   if (cli_plot_write(&o, 1, &pan) < 0) {
     cli_outfile_abandon(&o);

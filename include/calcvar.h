@@ -486,9 +486,10 @@ CVAR_API cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, do
 /** A loaded scene. Opaque; made by cv_scene_load_file or cv_scene_load_text, released by
  * cv_scene_free. */
 typedef struct cv_scene cv_scene;
-/** Load the scene file at path. set: nset strings "name=value" (value a constant
- * expression) overriding [parameters]; NULL when nset is 0. NULL on failure, with the
- * sentence in err. */
+/** Load the scene file at path: a regular file of at most 4 MiB, or "-" for standard
+ * input (read once per process; "<stdin>" in messages). set: nset strings "name=value"
+ * (value a constant expression) overriding [parameters]; NULL when nset is 0. NULL on
+ * failure, with the sentence in err. */
 CVAR_API cv_scene *cv_scene_load_file(const char *path, int nset, const char *const *set,
                                       char *err, size_t errlen);
 /** Load a scene from NUL-terminated text; name (NULL: "<text>") stands for the file in

@@ -83,7 +83,8 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
                strcmp(name, "--verbose") == 0 || strcmp(name, "-v") == 0;
     static const char *const valued[] = {
       "--elements", "--degree", "--method", "--tolerance", "--max-iterations", "--set",
-      "--adapt", "--continue", "--json", "--csv", "--plot", "--max", "--work", NULL};
+      "--adapt", "--continue", "--json", "--csv", "--plot", "--max", "--work",
+      "--max-elements", NULL};
     int known = flag;
     for (int k = 0; valued[k]; k++)
       known |= strcmp(name, valued[k]) == 0;
@@ -136,6 +137,9 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
           o->tolerance >= 1)
         return bad(cmd, "--tolerance needs a number from 2.2e-15 (10 eps) to below 1, "
                    "got '%s'", v);
+    } else if (strcmp(name, "--max-elements") == 0) {
+      if (parse_int(v, 1, INT_MAX / 9, &o->max_elements) < 0)
+        return bad(cmd, "--max-elements needs a whole number >= 1, got '%s'", v);
     } else if (strcmp(name, "--adapt") == 0) {
       if (parse_pos_double(v, &o->adapt) < 0)
         return bad(cmd, "--adapt needs a target error > 0, got '%s'", v);
@@ -194,7 +198,8 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
 int cli_only_scene_options(const char *cmd, const cli_opts *o)
 {
   if (o->csv || o->plot || o->adapt > 0 || o->cont || o->elements || o->degree ||
-      o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all || o->verbose) {
+      o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all || o->max_elements ||
+      o->verbose) {
     fprintf(stderr, "calcvar %s: only --set, --json and --quiet apply to %s\n", cmd, cmd);
     return EXIT_BADINPUT;
   }

@@ -9,8 +9,9 @@
 #include "scene/scene.h"
 #include "scene/scene_report.h"
 
-/* Exit statuses of SCENES.md. */
-enum { EXIT_SOLVED = 0, EXIT_UNSOLVED = 1, EXIT_BADINPUT = 2 };
+/* Exit statuses of SCENES.md, and (an addition, docs/cli.md) 3 when a report or the
+ * standard output could not be written. */
+enum { EXIT_SOLVED = 0, EXIT_UNSOLVED = 1, EXIT_BADINPUT = 2, EXIT_IOERROR = 3 };
 
 /* Options of `solve` (and later `converge`): zero / NULL / -1 mean "as the scene says". */
 typedef struct {
@@ -19,6 +20,7 @@ typedef struct {
   int method; /* cv_method or -1 */
   double tolerance;
   double adapt;
+  int max_elements; /* --max-elements: the adaptive cap (0: 2e6) */
   const char *cont; /* --continue name=from:to */
   int nset;
   sc_set *set;
@@ -48,14 +50,26 @@ int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver
 int cli_report_csv(FILE *f, const cli_report *r);
 void cli_report_text(FILE *f, const cli_report *r);
 
-/* outfile.c: all-or-nothing output files (a temporary file renamed at the end). */
+/* outfile.c: output files written completely or not at all (a temporary file renamed at
+ * the end), streamed into devices and FIFOs, links followed; a directory or the input scene
+ * `input` (may be NULL or "-") is refused. open and both commits return 0, or -1 after
+ * printing why (the file is then abandoned). */
 typedef struct {
-  const char *path; /* "-" is stdout */
-  char *tmp;
+  const char *path; /* as given, for messages; "-" is stdout */
+  char *dest;       /* path with symbolic links followed */
+  char *tmp;        /* the temporary file beside dest (regular files) */
+  char *scratch;    /* a rendering scratch file in $TMPDIR (streams) */
+  int stream;       /* dest is a device, FIFO or socket: written through */
   FILE *f;
 } cli_outfile;
-int cli_outfile_open(cli_outfile *o, const char *path);
+int cli_outfile_open(cli_outfile *o, const char *path, const char *input);
 int cli_outfile_commit(cli_outfile *o);
+/* Commit when the writer succeeded (wrote >= 0), else say why (a write error) and abandon. */
+int cli_outfile_finish(cli_outfile *o, int wrote);
+/* For a library that writes a file by name (PLplot): the name to write to, then
+ * commit_rendered moves or copies it into place. */
+int cli_outfile_render_name(cli_outfile *o, const char **name);
+int cli_outfile_commit_rendered(cli_outfile *o);
 void cli_outfile_abandon(cli_outfile *o);
 
 /* plot.c: curves on panels stacked top to bottom, written with PLplot to the temporary

@@ -232,17 +232,17 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, doubl
   for (int k = 0; k < np; k++)
     listed += keep[k];
   rc = listed > 0 ? EXIT_SOLVED : EXIT_UNSOLVED;
-  if (jf->f && (write_json(jf->f, r, keep, np, &in, listed) < 0 || cli_outfile_commit(jf) < 0)) {
+  if (jf->f && cli_outfile_finish(jf, write_json(jf->f, r, keep, np, &in, listed)) < 0) {
     fprintf(stderr, "calcvar solve: the JSON report could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   if (pf->f && write_plot(pf, r, keep, np, sv, s) < 0) {
     fprintf(stderr, "calcvar solve: the plot could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
-  if (cf->f && (write_csv(cf->f, r, keep, np, s) < 0 || cli_outfile_commit(cf) < 0)) {
+  if (cf->f && cli_outfile_finish(cf, write_csv(cf->f, r, keep, np, s)) < 0) {
     fprintf(stderr, "calcvar solve: the CSV table could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   int stdout_taken = (o->json && strcmp(o->json, "-") == 0) || (o->csv && strcmp(o->csv, "-") == 0);
   if (!o->quiet && !stdout_taken) {

@@ -38,7 +38,7 @@ static void usage(FILE *f)
         "  --quiet              no table on stdout\n"
         "  -v, --verbose        one line per Newton iteration on stderr\n"
         "Errors are against [exact]; without it they are estimates from a finer mesh.\n"
-        "exit status: 0 every mesh converged, 1 some did not, 2 bad input\n", f);
+        "exit status: 0 every mesh converged, 1 some did not, 2 bad input, 3 write error\n", f);
 }
 
 static int bad(const char *fmt, const char *v)
@@ -89,7 +89,7 @@ static int split_args(int argc, char **argv, conv_opts *c, char **rest, int *nre
 {
   static const char *const valued[] = {"--elements", "--method", "--tolerance",
                                        "--max-iterations", "--set", "--adapt", "--continue",
-                                       "--json", "--csv", "--plot", NULL};
+                                       "--json", "--csv", "--plot", "--max-elements", NULL};
   static const char *const mine[] = {"--levels", "--degree", "--svg"};
   c->levels = 6;
   *nrest = 0;
@@ -268,7 +268,7 @@ int cli_converge(int argc, char **argv)
   }
   cli_progress_setup(o.verbose);
   const char *notmine = o.csv ? "--csv" : o.plot ? "--plot" : o.adapt > 0 ? "--adapt"
-                        : o.cont ? "--continue" : NULL;
+                        : o.cont ? "--continue" : o.max_elements ? "--max-elements" : NULL;
   if (notmine) {
     rc = bad("%s is an option of solve, not of converge", notmine);
     goto done;
@@ -306,8 +306,8 @@ int cli_converge(int argc, char **argv)
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if ((o.json && cli_outfile_open(&jf, o.json) < 0) ||
-      (c.svg && cli_outfile_open(&gf, c.svg) < 0)) {
+  if ((o.json && cli_outfile_open(&jf, o.json, o.scene_path) < 0) ||
+      (c.svg && cli_outfile_open(&gf, c.svg, o.scene_path) < 0)) {
     rc = EXIT_BADINPUT;
     goto done;
   }
@@ -331,13 +331,13 @@ int cli_converge(int argc, char **argv)
     }
   s->elements = e0;
   rc = all_ok ? EXIT_SOLVED : EXIT_UNSOLVED;
-  if (jf.f && (cli_converge_json(jf.f, rows, nrows) < 0 || cli_outfile_commit(&jf) < 0)) {
+  if (jf.f && cli_outfile_finish(&jf, cli_converge_json(jf.f, rows, nrows)) < 0) {
     fprintf(stderr, "calcvar converge: the JSON report could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   if (gf.f && cli_plot_converge(&gf, rows, nrows) < 0) {
     fprintf(stderr, "calcvar converge: the SVG could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   if (!o.quiet && !(o.json && strcmp(o.json, "-") == 0))
     cli_converge_text(stdout, rows, nrows);

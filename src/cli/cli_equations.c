@@ -183,7 +183,7 @@ int cli_equations(int argc, char **argv)
     goto done;
   }
   /* Output files are opened before the work: an unwritable path is bad input. */
-  if (o.json && cli_outfile_open(&jf, o.json) < 0) {
+  if (o.json && cli_outfile_open(&jf, o.json, o.scene_path) < 0) {
     rc = EXIT_BADINPUT;
     goto done;
   }
@@ -193,9 +193,9 @@ int cli_equations(int argc, char **argv)
     goto done;
   }
   if (o.json) {
-    if (write_json(jf.f, s, &eq, &t) < 0 || cli_outfile_commit(&jf) < 0) {
+    if (cli_outfile_finish(&jf, write_json(jf.f, s, &eq, &t)) < 0) {
       fprintf(stderr, "calcvar equations: the JSON could not be written\n");
-      rc = EXIT_UNSOLVED;
+      rc = EXIT_IOERROR;
       goto done;
     }
   }

@@ -23,6 +23,7 @@ static void usage(FILE *f)
         "  --max-iterations K   iteration limit (default 50)\n"
         "  --set name=value     override a parameter (repeatable)\n"
         "  --adapt TOL          refine until the estimated max nodal error < TOL\n"
+        "  --max-elements N     cap of adaptive refinement (default 2000000)\n"
         "  --continue name=from:to   continuation in a parameter\n"
         "  --all                every stationary path that can be found (deflation)\n"
         "  --max K              at most K paths with --all (default 8)\n"
@@ -33,7 +34,7 @@ static void usage(FILE *f)
         "  --quiet              no summary on stdout\n"
         "  -v, --verbose        one line per Newton iteration and adaptive round on stderr\n"
         "  -h, --help           this text\n"
-        "exit status: 0 converged, 1 not solved, 2 bad input\n", f);
+        "exit status: 0 converged, 1 not solved, 2 bad input, 3 write error\n", f);
 }
 
 /* Combinations that cannot be honoured: refuse (exit 2, nothing written) rather than
@@ -43,6 +44,11 @@ static int unsupported(const cli_opts *o, const scene *s)
   if (o->cont && (o->adapt > 0 || s->adapt > 0)) {
     fprintf(stderr, "calcvar solve: --continue and adaptive refinement cannot be combined "
             "(continuation keeps one mesh)\n");
+    return EXIT_BADINPUT;
+  }
+  if (o->max_elements > 0 && !(o->adapt > 0 || s->adapt > 0)) {
+    fprintf(stderr, "calcvar solve: --max-elements applies to adaptive refinement only "
+            "(--adapt TOL or [mesh] adapt)\n");
     return EXIT_BADINPUT;
   }
   if (o->all && o->cont) {
@@ -109,16 +115,18 @@ int cli_solve(int argc, char **argv)
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if ((o.json && cli_outfile_open(&jf, o.json) < 0) ||
-      (o.csv && cli_outfile_open(&cf, o.csv) < 0) ||
-      (o.plot && cli_outfile_open(&pf, o.plot) < 0)) {
+  if ((o.json && cli_outfile_open(&jf, o.json, o.scene_path) < 0) ||
+      (o.csv && cli_outfile_open(&cf, o.csv, o.scene_path) < 0) ||
+      (o.plot && cli_outfile_open(&pf, o.plot, o.scene_path) < 0)) {
     rc = EXIT_BADINPUT;
     goto done;
   }
 
-  /* Adaptive refinement: [mesh] adapt or --adapt, capped at 2e6 elements (theory AD-1). */
+  /* Adaptive refinement: [mesh] adapt or --adapt, capped at --max-elements, default 2e6
+   * elements (theory AD-1). */
   double adapt = o.adapt > 0 ? o.adapt : s->adapt;
-  if (adapt > 0 && cv_solver_set_adapt(sv, adapt, 2000000) != CVAR_OK) {
+  int cap = o.max_elements > 0 ? o.max_elements : 2000000;
+  if (adapt > 0 && cv_solver_set_adapt(sv, adapt, cap) != CVAR_OK) {
     fprintf(stderr, "calcvar solve: invalid adaptive tolerance %g\n", adapt);
     rc = EXIT_BADINPUT;
     goto done;
@@ -167,17 +175,17 @@ int cli_solve(int argc, char **argv)
              cont_msg + 1);
   }
   rc = st == CVAR_OK ? EXIT_SOLVED : EXIT_UNSOLVED;
-  if (jf.f && (cli_report_json(jf.f, &r) < 0 || cli_outfile_commit(&jf) < 0)) {
+  if (jf.f && cli_outfile_finish(&jf, cli_report_json(jf.f, &r)) < 0) {
     fprintf(stderr, "calcvar solve: the JSON report could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   if (pf.f && cli_plot_solution(&pf, &r, sv) < 0) {
     fprintf(stderr, "calcvar solve: the plot could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
-  if (cf.f && (cli_report_csv(cf.f, &r) < 0 || cli_outfile_commit(&cf) < 0)) {
+  if (cf.f && cli_outfile_finish(&cf, cli_report_csv(cf.f, &r)) < 0) {
     fprintf(stderr, "calcvar solve: the CSV table could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   /* stdout carries the data when a report goes there; the summary would corrupt it. */
   int stdout_taken = (o.json && strcmp(o.json, "-") == 0) || (o.csv && strcmp(o.csv, "-") == 0);

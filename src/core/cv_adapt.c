@@ -54,6 +54,9 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   double *xe = NULL, *t = NULL, *xn = NULL, *yf = NULL, *eta = NULL;
   cv_meshspec spec0 = s->mesh;
   int E = 0, n = p->n;
+  /* Newton iterations summed over the rounds (working meshes; the reference solves apart):
+   * what the report gives, not the last round's count alone. */
+  int it_work = 0, it_ref = 0;
   double tol = s->adapt_tol;
   if (!f) return CVAR_ENOMEM;
   f->degree = s->degree;
@@ -79,6 +82,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     if (!st && s->rounds > 1) st = warm_start(s, p, f);
     if (st) goto cleanup;
     st = cv_solve_mesh(s, p);
+    it_work += s->iterations;
     cv_solver_set_start(s, 0, NULL);
     if (st) {
       char why[320];
@@ -107,6 +111,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     cv_free(xf);
     if (!st) st = warm_start(f, p, s);
     if (!st) st = cv_solve_mesh(f, p);
+    it_ref += f->iterations;
     cv_solver_set_start(f, 0, NULL);
     if (st) {
       cv_set_msg(s->msg, sizeof s->msg,
@@ -162,9 +167,10 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     }
     if (est <= tol) {
       cv_set_msg(s->msg, sizeof s->msg,
-                 "converged on an adapted mesh of %d elements after %d rounds (estimated max "
-                 "nodal error %.2g <= %.2g)",
-                 E, s->rounds, est, tol);
+                 "converged on an adapted mesh of %d elements after %d round%s, %d Newton "
+                 "iterations in all (and %d on the reference meshes); estimated max nodal "
+                 "error %.2g <= %.2g",
+                 E, s->rounds, s->rounds == 1 ? "" : "s", it_work, it_ref, est, tol);
       st = CVAR_OK;
       goto cleanup;
     }
@@ -173,9 +179,11 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     if (E + marked > s->adapt_max) {
       st = CVAR_EMAXITER;
       cv_set_msg(s->msg, sizeof s->msg,
-                 "adaptive refinement reached the cap of %d elements with an estimated max "
-                 "nodal error of %.2g > %.2g; raise the cap or the degree",
-                 s->adapt_max, est, tol);
+                 "adaptive refinement reached the cap of %d elements after %d rounds with an "
+                 "estimated max nodal error of %.2g > %.2g; use a higher degree or a looser "
+                 "tolerance (or raise the cap: --max-elements, or the max_elements argument "
+                 "of cv_solver_set_adapt)",
+                 s->adapt_max, s->rounds, est, tol);
       goto cleanup;
     }
     double *xn2 = cv_malloc((size_t)(E + marked + 1) * sizeof *xn2);
@@ -198,6 +206,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
              "adaptive refinement did not reach %.2g in %d rounds (estimated error %.2g)", tol,
              MAX_ROUNDS, s->err_est);
 cleanup:
+  if (it_work > 0) s->iterations = it_work; /* the total over the rounds */
   cv_free(s->mesh.t);
   s->mesh = spec0; /* the caller's mesh settings, for the next solve */
   cv_free(xe);

@@ -201,7 +201,20 @@ static ex_id parse_table_call(parser *p, int index, const char *name, size_t at)
     return fail(p, at, "table '%s' has %d coordinate%s, so it takes %d argument%s%s", name,
                 dim, dim == 1 ? "" : "s", dim, dim == 1 ? "" : "s",
                 n == 3 && p->s[p->pos - 1] != ')' ? ", not more" : "");
-  return built(p, ex_table_call(p->d, index, ord, args));
+  ex_id e = built(p, ex_table_call(p->d, index, ord, args));
+  /* a call at numbers folds inside the grid (ex_table_call), so one that stays a call at
+   * numbers lies outside: no extrapolation, say so now */
+  if (e >= 0 && ex_node_op(p->d, e) == EX_TABLE) {
+    for (int k = 0; k < dim; k++) {
+      double lo, hi, v = ex_node_value(p->d, args[k]);
+      cv_table_get_range(t, k, &lo, &hi);
+      if (ex_node_op(p->d, args[k]) == EX_NUM && !(v >= lo && v <= hi))
+        return fail(p, at, "table '%s' is called outside its grid: argument %d is %.15g, "
+                    "the grid spans [%.15g, %.15g] (tables are not extrapolated)", name,
+                    k + 1, v, lo, hi);
+    }
+  }
+  return e;
 }
 
 static ex_id parse_name(parser *p) {

@@ -48,6 +48,10 @@ int ex_is_const(const ex_dag *d, ex_id e);           /* depends on no slot */
 int ex_depends_on(const ex_dag *d, ex_id e, int slot);
 /* Value of a constant expression; returns 0 on success, -1 if it depends on a slot. */
 int ex_eval_const(const ex_dag *d, ex_id e, double *value);
+/* The innermost constant subexpression of e whose value is not finite (0/0, log(0), a
+ * formula on such a constant), which the folder keeps as a formula (theory (EX-1)); -1
+ * when there is none, -2 when out of memory. */
+ex_id ex_nonfinite_const(const ex_dag *d, ex_id e);
 
 /* The grammar's names (ex_names.c). An identifier is a letter or '_' followed by letters,
  * digits or '_' (a prime is not part of a name); the reserved names are pi and the

@@ -21,6 +21,9 @@
 #include "expr/expr.h"
 
 enum { SC_ERRLEN = 1024 };
+/* The largest scene file read (bytes): a scene is a page of text; the cap keeps
+ * `solve /dev/zero` or a wrong file from eating the memory (docs/scenes.md). */
+enum { SC_MAX_BYTES = 4 << 20 };
 
 /** One `--set name=value` override; value is a constant expression. */
 typedef struct {
@@ -86,7 +89,10 @@ typedef struct scene {
   int *plot_down;      /* [n + 1]: nonzero for a name drawn increasing downward */
 } scene;
 
-/** Load a scene file. `name` for messages is the path itself. nset overrides (may be 0). */
+/** Load a scene file. `name` for messages is the path itself; the path "-" reads standard
+ * input, named "<stdin>" in messages (read once; later loads of "-" in the process reuse
+ * its text). Only regular files (and "-") of at most SC_MAX_BYTES are read. nset overrides
+ * (may be 0). */
 scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
                        size_t errlen);
 /** Load a scene from memory: len bytes (NUL bytes inside are rejected), `name` is used in

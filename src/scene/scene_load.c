@@ -339,39 +339,3 @@ scene *scene_load_buffer(const char *text, size_t len, const char *name, int nse
   sc_raw_free(&L.raw);
   return s;
 }
-
-scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
-                       size_t errlen)
-{
-  if (err && errlen)
-    err[0] = '\0';
-  FILE *f = fopen(path, "rb");
-  if (!f) {
-    sc_err(err, errlen, path, 0, "cannot open: %s", strerror(errno));
-    return NULL;
-  }
-  size_t cap = 4096, len = 0;
-  char *buf = cv_malloc(cap);
-  while (buf) {
-    size_t k = fread(buf + len, 1, cap - len, f);
-    len += k;
-    if (len < cap)
-      break;
-    char *nb = cv_realloc(buf, cap *= 2);
-    if (!nb) {
-      cv_free(buf);
-      buf = NULL;
-    } else
-      buf = nb;
-  }
-  int bad = ferror(f);
-  fclose(f);
-  if (!buf || bad) {
-    cv_free(buf);
-    sc_err(err, errlen, path, 0, bad ? "read error" : "out of memory");
-    return NULL;
-  }
-  scene *s = scene_load_buffer(buf, len, path, nset, set, err, errlen);
-  cv_free(buf);
-  return s;
-}

@@ -122,8 +122,26 @@ ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const
     return -1;
   }
   ex_id r = ex_parse(L->s->dag, text, resolve, L, 0, msg, sizeof msg);
-  if (r >= 0)
-    return r;
+  if (r >= 0) {
+    /* A constant that is not finite (0/0, log(0), sqrt(-1)*0) is bad input, never a NaN
+     * carried into the solve (theory (EX-1)). */
+    ex_id bad = ex_nonfinite_const(L->s->dag, r);
+    if (bad == -1)
+      return r;
+    char sub[160] = "?";
+    double v = NAN;
+    if (bad >= 0) {
+      ex_print(L->s->dag, bad, NULL, sub, sizeof sub);
+      ex_eval_const(L->s->dag, bad, &v);
+    }
+    sc_entry_locate(e, off, &line, &col);
+    if (bad == -2)
+      sc_err(L->err, L->errlen, L->file, line, "%s: out of memory", what);
+    else
+      sc_err(L->err, L->errlen, L->file, line, "%s: the constant '%s' is not a finite number "
+             "(%s)", what, sub, isnan(v) ? "NaN" : v > 0 ? "+inf" : "-inf");
+    return -1;
+  }
   int c = 0, k = 0;
   if (sscanf(msg, "column %d: %n", &c, &k) >= 1 && k > 0 && c >= 1) {
     sc_entry_locate(e, off + c - 1, &line, &col);
@@ -154,8 +172,8 @@ int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
     return -1;
   }
   if (!isfinite(*value)) {
-    sc_err(L->err, L->errlen, L->file, line, "%s '%s' is not a finite number (%g)", what,
-           text, *value);
+    sc_err(L->err, L->errlen, L->file, line, "%s '%s' is not a finite number (%s)", what,
+           text, isnan(*value) ? "NaN" : *value > 0 ? "+inf" : "-inf");
     return -1;
   }
   return 0;

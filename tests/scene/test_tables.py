@@ -139,6 +139,8 @@ with tempfile.TemporaryDirectory() as tmp:
         ("too_many_args", "n(x, y, y)*sqrt(1 + y'^2)", "data/n.csv", 5, "takes 2 arguments"),
         ("bad_derivative", "n.3(x, y)*sqrt(1 + y'^2)", "data/n.csv", 5, "derivative index"),
         ("not_called", "n*sqrt(1 + y'^2)", "data/n.csv", 5, "'n' is a table"),
+        ("constant_outside", "n(x, 2)*sqrt(1 + y'^2)", "data/n.csv", 5,
+         "table 'n' is called outside its grid: argument 2 is 2"),
     ]
     for name, F, table, line, expect in scene_bad:
         write(scene, SCENE % (F, table, Y0, Y0))
