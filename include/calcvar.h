@@ -239,7 +239,8 @@ CVAR_API cv_status cv_table_get_range(const cv_table *t, int k, double *lo, doub
 CVAR_API int cv_table_eval(const cv_table *t, const double *u, const int *order, double *value);
 /** Make t callable as `name(u)`, `name(u, v)` or `name(u, v, w)` (and its derivatives
  * `name.1(...)`, `name.12(...)`, docs/expressions.md) in the formulas given afterwards to
- * cv_problem_set_integrand_expr. The problem takes its own reference. The name must be an
+ * cv_problem_set_integrand_expr, cv_problem_add_constraint_expr and
+ * cv_problem_add_integral_expr. The problem takes its own reference. The name must be an
  * identifier that is not a function, pi, or a table already added (CVAR_EINVAL). When a
  * solve fails after the path left a table's grid, cv_solver_last_error() names the table. */
 CVAR_API cv_status cv_problem_add_table(cv_problem *p, const char *name, cv_table *t);

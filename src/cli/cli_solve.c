@@ -167,6 +167,19 @@ int cli_solve(int argc, char **argv)
     rc = EXIT_UNSOLVED;
     goto done;
   }
+  double xs, alpha;
+  if (st == CVAR_OK && scene_interior_singularity(s, sv, &xs, &alpha) == 1) {
+    /* a finite discrete action of an infinite one: not a solution (theory (SG-1)) */
+    st = r.st = CVAR_ENONFINITE;
+    r.status = cli_status_string(st);
+    r.has_morse = 0;
+    r.kind = NULL;
+    snprintf(r.message, sizeof r.message,
+             "the integrand is singular at %s = %.6g inside the interval: along the path "
+             "|F| grows like |%s - %.6g|^(-%.2f), so the action is infinite and the discrete "
+             "answer (which changes with the mesh) is no stationary path; split the interval "
+             "there or remove the singularity", s->variable, xs, s->variable, xs, alpha);
+  }
   if (cont_msg[0]) {
     size_t used = st == CVAR_OK ? strlen(r.message) : 0;
     char c0 = cont_msg[0] >= 'a' && cont_msg[0] <= 'z' ? (char)(cont_msg[0] - 'a' + 'A')

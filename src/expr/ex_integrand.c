@@ -100,6 +100,12 @@ void ex_integrand_free(ex_integrand *g) {
 
 void ex_integrand_release(void *g) { ex_integrand_free(g); }
 
+int ex_integrand_has_tables(const ex_integrand *g) {
+  int any = 0;
+  for (int l = 0; g && l < 3; l++) any |= ex_tape_num_tables(g->tape[l]) > 0;
+  return any;
+}
+
 const char *ex_integrand_note(void *user, int reset) {
   ex_integrand *g = user;
   if (!g) return NULL;

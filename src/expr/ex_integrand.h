@@ -52,5 +52,7 @@ void ex_integrand_release(void *g);
 /* A cv_note_fn (core/cv_table_internal.h): the sentence of the last evaluation that failed
  * because a table was called outside its grid ("" if none); reset clears it. */
 const char *ex_integrand_note(void *user, int reset);
+/* Whether the expression calls a table (only then can ex_integrand_note say anything). */
+int ex_integrand_has_tables(const ex_integrand *g);
 
 #endif /* CV_EX_INTEGRAND_H */

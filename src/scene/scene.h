@@ -99,6 +99,10 @@ scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
  * messages (e.g. "gallery:catenary"). */
 scene *scene_load_buffer(const char *text, size_t len, const char *name, int nset,
                          const sc_set *set, char *err, size_t errlen);
+/** After a solve: a point x* strictly inside (a, b) where the integrand along the solution
+ * grows like |x - x*|^(-alpha) with alpha >= 0.85 (the action is then infinite, theory
+ * (SG-1)). Returns 1 with *xs and *alpha, 0 when there is none, -1 when out of memory. */
+int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double *alpha);
 /** Release a scene; NULL is a no-op. */
 void scene_free(scene *s);
 

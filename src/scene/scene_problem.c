@@ -30,8 +30,8 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
     goto fail;
   }
   why = cv_problem_set_integrand_owned(p, ex_integrand_eval, ig, ex_integrand_release);
-  if (why == CVAR_OK) /* names a table whose grid the path left, when a solve fails */
-    why = cv_problem_set_integrand_note(p, ex_integrand_note);
+  if (why == CVAR_OK && ex_integrand_has_tables(ig)) /* names a table whose grid was left */
+    why = cv_problem_add_note(p, ex_integrand_note, ig);
   if (why != CVAR_OK) {
     sc_err(err, errlen, s->file, s->F_line, "integrand: %s", cv_strerror(why));
     goto fail;
@@ -58,6 +58,8 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
     }
     why = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g,
                                           ex_integrand_release, NULL);
+    if (why == CVAR_OK && ex_integrand_has_tables(g))
+      why = cv_problem_add_note(p, ex_integrand_note, g);
     if (why != CVAR_OK) {
       sc_err(err, errlen, s->file, it->line, "[constraints] %s: %s", it->name, cv_strerror(why));
       goto fail;
@@ -73,6 +75,8 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
     }
     why = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release,
                                         it->value, NULL);
+    if (why == CVAR_OK && ex_integrand_has_tables(g))
+      why = cv_problem_add_note(p, ex_integrand_note, g);
     if (why != CVAR_OK) {
       sc_err(err, errlen, s->file, it->line, "[integrals] %s: %s", it->name, cv_strerror(why));
       goto fail;
