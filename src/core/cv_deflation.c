@@ -25,6 +25,8 @@
 #define MAX_BACKTRACK 12 /* deflated line search: a step cut below 2^-12 is no progress */
 #define TAU_BIG 10.0     /* |1 / (1 - r.delta0)| above this: deflation dominates (DF-3) */
 #define STALL_DROP 0.9   /* ... and |G| fell by less than 10% over two such steps: abandon */
+#define CRAWL_ALPHA 0.0625 /* a step cut to this or less is a crawl ... */
+#define CRAWL_RUN 8        /* ... and this many in a row that did not halve |G|: abandon */
 #define ARMIJO 1e-4
 #define SAME_FLOOR 1e-6 /* paths closer than this times their size are one (DF-5) */
 
@@ -248,7 +250,9 @@ static cv_status defl_run(defl *w, const cv_solver *s, double *Y, int maxit, int
   st = cv_kkt_eval(&w->kkt, Y, w->M, &S, w->g, Ax, w->dreg);
   if (st) return st;
   double Mv = deflation(w, Y, w->r), phi = merit(w, w->g, Mv), phi_big = phi;
-  int big = 0; /* consecutive iterations with |tau| > TAU_BIG */
+  int big = 0;                /* consecutive iterations with |tau| > TAU_BIG */
+  int crawl = 0;              /* consecutive steps cut to CRAWL_ALPHA or less */
+  double phi_crawl = phi;     /* the merit before the first of them */
   for (int it = 0; it < maxit; it++) {
     int neg;
     double dmin, dmax;
@@ -301,6 +305,13 @@ static cv_status defl_run(defl *w, const cv_solver *s, double *Y, int maxit, int
       }
     }
     if (!ok) return CVAR_ESTALL;
+    /* a crawl: CRAWL_RUN cut steps in a row that have not halved |G| (DF-3) */
+    if (alpha > CRAWL_ALPHA) {
+      crawl = 0;
+    } else {
+      if (crawl++ == 0) phi_crawl = phi;
+      if (crawl >= CRAWL_RUN && phit > 0.25 * phi_crawl) return CVAR_ESTALL;
+    }
     memcpy(Y, w->Yt, (size_t)d->ndof * sizeof *Y);
     memcpy(w->M, w->Mt, (w->nmult + 1) * sizeof *w->M);
     st = cv_kkt_eval(&w->kkt, Y, w->M, &St, w->g, Ax, w->dreg); /* and its Hessian */
@@ -447,9 +458,11 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
   /* 1. The plain solve from the guess (retries, continuation, adaptation as usual). */
   first = st = cv_solve(s, p);
   info->starts = 1;
-  /* Bounded work (DF-4): Newton iterations of the search, deflated and polishing, at most
-   * search_work times those of the first solve (counted as at least WORK_FLOOR). */
-  int work = 0, budget = (int)fmin(1e9, s->search_work * fmax(WORK_FLOOR, s->iterations));
+  /* Bounded work (DF-4): the search stops once its Newton iterations (deflated and
+   * polishing) since the last new path (or since it began) reach search_work times those
+   * of the first solve (counted as at least WORK_FLOOR): each path found renews it. */
+  int work = 0, found_at = 0;
+  int budget = (int)fmin(1e9, s->search_work * fmax(WORK_FLOOR, s->iterations));
   memcpy(msg0, s->msg, sizeof msg0);
   if (!s->have) goto finish; /* bad input: nothing to search around */
   /* 2. The search mesh: the mesh of that solve, frozen (DF-5); adaptation only polishes. */
@@ -508,7 +521,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
                  max == 1 ? "" : "s");
       break;
     }
-    if (work >= budget) {
+    if (work - found_at >= budget) {
       cv_set_msg(info->stop, sizeof info->stop,
                  "the work limit was reached (%d Newton iterations)", work);
       break;
@@ -563,7 +576,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
     }
     info->starts++;
     int it = 0;
-    int left = budget - work;
+    int left = budget - (work - found_at);
     st = w.nknown ? defl_run(&w, s, Y, left < DEFL_MAXIT ? left : DEFL_MAXIT, &it) : CVAR_OK;
     work += it;
     if (st) {
@@ -584,6 +597,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
     int added = keep_path(s, ps, &w, xs, ev, E, ests);
     if (added < 0) goto nomem;
     if (!added) info->duplicates++;
+    else found_at = work; /* a new path renews the allowance */
   }
   st = CVAR_OK;
   goto finish;
