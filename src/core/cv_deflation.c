@@ -576,8 +576,8 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
     }
     info->starts++;
     int it = 0;
-    int left = budget - (work - found_at);
-    st = w.nknown ? defl_run(&w, s, Y, left < DEFL_MAXIT ? left : DEFL_MAXIT, &it) : CVAR_OK;
+    /* a start that begins within the limit runs to its end (at most DEFL_MAXIT) */
+    st = w.nknown ? defl_run(&w, s, Y, DEFL_MAXIT, &it) : CVAR_OK;
     work += it;
     if (st) {
       info->failed++;
