@@ -10,6 +10,7 @@
  * scaled by 1 / (1 - r.delta0), r = grad M / M (DF-3): one LDL^T solve per iteration, the
  * same as plain Newton.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,6 +22,7 @@
 #define DEFL_MAXIT 25   /* deflated Newton iterations per start */
 #define WORK_FLOOR 8    /* the first solve counts as at least this many iterations */
 #define EIG_DIRS 3      /* lowest Hessian eigen-directions per path (DF-4) */
+#define MIN_TRIES 2 /* perturbations every path gets before the work limit may stop (DF-4) */
 #define EIG_STEPS 6     /* block inverse-iteration steps */
 #define MAX_BACKTRACK 12 /* deflated line search: a step cut below 2^-12 is no progress */
 #define TAU_BIG 10.0     /* |1 / (1 - r.delta0)| above this: deflation dominates (DF-3) */
@@ -521,7 +523,10 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
                  max == 1 ? "" : "s");
       break;
     }
-    if (work - found_at >= budget) {
+    int least = INT_MAX; /* the fewest perturbations tried on a path not yet exhausted */
+    for (int j = 0; j < w.nknown; j++)
+      if ((nmodes[j] < 0 || cursor[j] < namp * nmodes[j]) && cursor[j] < least) least = cursor[j];
+    if (work - found_at >= budget && least >= MIN_TRIES) {
       cv_set_msg(info->stop, sizeof info->stop,
                  "the work limit was reached (%d Newton iterations)", work);
       break;
