@@ -23,7 +23,7 @@
 #define WORK_FLOOR 8    /* the first solve counts as at least this many iterations */
 #define EIG_DIRS 3      /* lowest Hessian eigen-directions per path (DF-4) */
 #define MIN_TRIES 2 /* perturbations every path gets before the work limit may stop (DF-4) */
-#define EIG_STEPS 6     /* block inverse-iteration steps */
+#define EIG_STEPS 4     /* block inverse-iteration steps */
 #define MAX_BACKTRACK 12 /* deflated line search: a step cut below 2^-12 is no progress */
 #define TAU_BIG 10.0     /* |1 / (1 - r.delta0)| above this: deflation dominates (DF-3) */
 #define STALL_DROP 0.9   /* ... and |G| fell by less than 10% over two such steps: abandon */
