@@ -41,8 +41,12 @@ int cli_only_scene_options(const char *cmd, const cli_opts *o);
 void cli_apply_solver_options(const cli_opts *o, scene *s);
 
 /* cli_continue.c: `solve --continue name=from:to` (see there). */
-int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver **svp,
-                       cv_status *stp, char *cont_msg, size_t cmlen, char *err, size_t errlen);
+/* s0: the scene, loaded once with parameters as inputs (scene_load_file_inputs) and
+ * owned from here on; it is compiled once. *bp owns it and *sp is its instance at the
+ * reported value: free *pp and *svp, then cv_batch_free(*bp). */
+int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene **sp,
+                       cv_problem **pp, cv_solver **svp, cv_status *stp, char *cont_msg,
+                       size_t cmlen, char *err, size_t errlen);
 
 int cli_report_csv(FILE *f, const cli_report *r);
 void cli_report_text(FILE *f, const cli_report *r);
@@ -115,6 +119,7 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, doubl
 
 /* Subcommands. */
 int cli_converge(int argc, char **argv);
+int cli_batch(int argc, char **argv);     /* cli_batch.c */
 int cli_gallery(void);
 int cli_solve(int argc, char **argv);
 int cli_check(int argc, char **argv);

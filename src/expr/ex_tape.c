@@ -493,6 +493,8 @@ void ex_tape_eval(const ex_tape *t, int m, const double *const *in, double *cons
   }
 }
 
+int ex_tape_num_tables(const ex_tape *t) { return t ? t->ntab : 0; }
+
 int ex_tape_fault(const ex_tape *t, int m, const double *work, char *msg, size_t len) {
   if (!t || !t->ntab || m <= 0 || !work) return 0;
   const double *fault = work + (size_t)t->nregs * (size_t)m;

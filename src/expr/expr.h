@@ -116,6 +116,8 @@ int ex_tape_num_instructions(const ex_tape *t);
 /* After ex_tape_eval with the same m and work: 1 when a table call met a point outside its
  * grid (the outputs there are NaN), with a sentence naming the table in msg; else 0. */
 int ex_tape_fault(const ex_tape *t, int m, const double *work, char *msg, size_t len);
+/* Number of distinct tables the tape calls. */
+int ex_tape_num_tables(const ex_tape *t);
 
 /* The DAG node by node, and reference evaluation. */
 /* Number of nodes in d; valid ids are 0 .. ex_dag_num_nodes(d) - 1. */
