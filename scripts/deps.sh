@@ -11,4 +11,9 @@ $SUDO apt-get install -y -qq --no-install-recommends \
   libsuitesparse-dev libnlopt-dev libinih-dev libjansson-dev liblapack-dev \
   libplplot-dev plplot-driver-cairo \
   python3-numpy python3-pytest python3-matplotlib \
-  doxygen groff-base >/dev/null   # the API reference and the man page (tests 'docs')
+  doxygen groff-base \
+  libopenmpi-dev openmpi-bin \
+  g++ libgeographiclib-dev geographiclib-tools strace >/dev/null
+# doxygen, groff: the API reference and the man page (tests 'docs'); OpenMPI: calcvar batch
+# under mpirun (test batch_mpi); strace: --continue opens its scene once (test cli_batch);
+# g++ and GeographicLib: bench/bench_geodesic only.

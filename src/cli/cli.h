@@ -37,6 +37,8 @@ void cli_opts_free(cli_opts *o);
 /* For commands that only read a scene: EXIT_BADINPUT (after a message) if a solve-only
  * option was given, else 0. */
 int cli_only_scene_options(const char *cmd, const cli_opts *o);
+/* --method, --tolerance and --max-iterations, where given, override the scene's [solver]. */
+void cli_apply_solver_options(const cli_opts *o, scene *s);
 
 /* progress.c: --verbose lines and the terminal status line (see there). */
 void cli_progress_setup(int verbose);
@@ -44,8 +46,12 @@ void cli_progress_attach(cv_solver *sv);
 void cli_progress_end(void);
 
 /* cli_continue.c: `solve --continue name=from:to` (see there). */
-int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver **svp,
-                       cv_status *stp, char *cont_msg, size_t cmlen, char *err, size_t errlen);
+/* s0: the scene, loaded once with parameters as inputs (scene_load_file_inputs) and
+ * owned from here on; it is compiled once. *bp owns it and *sp is its instance at the
+ * reported value: free *pp and *svp, then cv_batch_free(*bp). */
+int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene **sp,
+                       cv_problem **pp, cv_solver **svp, cv_status *stp, char *cont_msg,
+                       size_t cmlen, char *err, size_t errlen);
 
 int cli_report_csv(FILE *f, const cli_report *r);
 void cli_report_text(FILE *f, const cli_report *r);
@@ -71,6 +77,12 @@ int cli_outfile_finish(cli_outfile *o, int wrote);
 int cli_outfile_render_name(cli_outfile *o, const char **name);
 int cli_outfile_commit_rendered(cli_outfile *o);
 void cli_outfile_abandon(cli_outfile *o);
+/* args.c: the start of a command that reads one scene (equations, modes): parse the
+ * arguments (--help prints usage), accept only the scene options, load the scene into *s
+ * and open --json's file in *jf. Returns -1 to go on, else the exit status (after a
+ * message); the caller releases o, *s and *jf in either case. */
+int cli_scene_command_start(const char *cmd, int argc, char **argv, void (*usage)(FILE *),
+                            cli_opts *o, scene **s, cli_outfile *jf);
 
 /* plot.c: curves on panels stacked top to bottom, written with PLplot to the temporary
  * file of an open cli_outfile (.svg or .png by its path) and renamed into place. */
@@ -120,6 +132,7 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, doubl
 
 /* Subcommands. */
 int cli_converge(int argc, char **argv);
+int cli_batch(int argc, char **argv);     /* cli_batch.c */
 int cli_gallery(void);
 int cli_solve(int argc, char **argv);
 int cli_check(int argc, char **argv);

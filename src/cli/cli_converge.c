@@ -286,12 +286,7 @@ int cli_converge(int argc, char **argv)
     s->elements = o.elements;
   if (c.ndeg == 0)
     c.deg[c.ndeg++] = s->degree;
-  if (o.method >= 0)
-    s->method = (cv_method)o.method;
-  if (o.tolerance > 0)
-    s->tolerance = o.tolerance;
-  if (o.max_iterations)
-    s->max_iterations = o.max_iterations;
+  cli_apply_solver_options(&o, s);
   s->adapt = 0; /* converge studies fixed meshes: a scene's adapt does not apply */
   /* The finest mesh, and the reference mesh of an estimate (p^2 times the nodes), must
    * keep every node count an int. */

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "cli/cli.h"
+#include "scene/scene_batch.h"
 
 static void usage(FILE *f)
 {
@@ -85,9 +86,12 @@ int cli_solve(int argc, char **argv)
     cli_opts_free(&o);
     return rc;
   }
-  scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
+  /* --continue: read once with the parameters as inputs, compiled once (issue 18) */
+  scene *s = o.cont ? scene_load_file_inputs(o.scene_path, o.nset, o.set, err, sizeof err)
+                    : scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
   cv_problem *p = NULL;
   cv_solver *sv = NULL;
+  cv_batch *cb = NULL; /* --continue: the compiled scene */
   cli_outfile jf = {0}, cf = {0}, pf = {0};
   cli_report r;
   memset(&r, 0, sizeof r);
@@ -100,16 +104,11 @@ int cli_solve(int argc, char **argv)
     s->elements = o.elements;
   if (o.degree)
     s->degree = o.degree;
-  if (o.method >= 0)
-    s->method = (cv_method)o.method;
-  if (o.tolerance > 0)
-    s->tolerance = o.tolerance;
-  if (o.max_iterations)
-    s->max_iterations = o.max_iterations;
+  cli_apply_solver_options(&o, s);
   if ((rc = unsupported(&o, s)) != 0)
     goto done;
   cv_status why;
-  if (!(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err)) ||
+  if ((!o.cont && !(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err))) ||
       !(sv = cv_solver_new(&why)) || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK) {
     fprintf(stderr, "%s\n", err[0] ? err : "calcvar solve: out of memory");
     rc = EXIT_BADINPUT;
@@ -143,15 +142,16 @@ int cli_solve(int argc, char **argv)
   if (o.cont) {
     /* continuation replaces scene, problem and solver by those of its last step */
     cv_solver_free(sv);
-    cv_problem_free(p);
-    scene_free(s);
-    s = NULL, p = NULL, sv = NULL;
-    if (cli_continue_solve(&o, &s, &p, &sv, &st, cont_msg, sizeof cont_msg, err,
+    scene *s0 = s;
+    s = NULL, sv = NULL;
+    const scene *si = NULL;
+    if (cli_continue_solve(&o, s0, &cb, &si, &p, &sv, &st, cont_msg, sizeof cont_msg, err,
                            sizeof err) < 0) {
       fprintf(stderr, "%s\n", err);
       rc = EXIT_BADINPUT;
       goto done;
     }
+    s = (scene *)si; /* the batch's instance: cb owns it (its DAG may grow for the report) */
   } else {
     st = cv_solve(sv, p);
   }
@@ -213,7 +213,9 @@ done:
   cli_report_free(&r);
   cv_solver_free(sv);
   cv_problem_free(p);
-  scene_free(s);
+  if (!cb)
+    scene_free(s);
+  cv_batch_free(cb);
   cli_opts_free(&o);
   return rc;
 }

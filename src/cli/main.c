@@ -17,6 +17,7 @@ static void usage(FILE *f)
         "  calcvar converge SCENE [opts]   error and run time over a sequence of meshes\n"
         "  calcvar equations SCENE         momenta, Euler-Lagrange equations, Hamiltonian\n"
         "  calcvar modes SCENE             equilibrium and small-oscillation frequencies\n"
+        "  calcvar batch SCENE TABLE.csv   one solve per table row (calcvar batch --help)\n"
         "  calcvar -h | --help             this text\n"
         "  calcvar -V | --version          versions of calcvar and the libraries linked\n"
         "Scene files: docs/scenes.md (\"-\" reads one from standard input).\n"
@@ -72,6 +73,8 @@ static int run(int argc, char **argv)
     return cli_equations(argc - 2, argv + 2);
   if (strcmp(cmd, "modes") == 0)
     return cli_modes(argc - 2, argv + 2);
+  if (strcmp(cmd, "batch") == 0)
+    return cli_batch(argc - 2, argv + 2);
   if (strcmp(cmd, "converge") == 0)
     return cli_converge(argc - 2, argv + 2);
   fprintf(stderr, "calcvar: unknown command '%s' (calcvar --help lists them)\n", cmd);
