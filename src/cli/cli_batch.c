@@ -293,7 +293,8 @@ static int own_args(int argc, char **argv, char **rest, int *nrest, const char *
     } else {
       rest[(*nrest)++] = argv[i];
       /* a valued solve option: keep its value with it */
-      if (!strchr(a, '=') && i + 1 < argc && strcmp(a, "--quiet") != 0)
+      if (!strchr(a, '=') && i + 1 < argc && strcmp(a, "--quiet") != 0 &&
+          strcmp(a, "--verbose") != 0 && strcmp(a, "-v") != 0)
         rest[(*nrest)++] = argv[++i];
     }
   }
@@ -325,6 +326,14 @@ int cli_batch(int argc, char **argv)
   if (!o.scene_path || !table_path) {
     fprintf(stderr, "calcvar batch: needs a scene and a table: calcvar batch SCENE "
             "TABLE.csv [options]\n");
+    cli_opts_free(&o);
+    cli_mpi_finish(&mpi);
+    return EXIT_BADINPUT;
+  }
+  if (o.verbose) {
+    /* rows are solved on several threads (and ranks): per-iteration lines would interleave */
+    fprintf(stderr, "calcvar batch: --verbose is not available for batch yet; run calcvar "
+            "solve --verbose --set ... on a row to see its iterations\n");
     cli_opts_free(&o);
     cli_mpi_finish(&mpi);
     return EXIT_BADINPUT;

@@ -52,6 +52,10 @@ check("no --verbose, not a terminal: stderr silent", r.returncode == 0 and r.std
       r.stderr)
 r = subprocess.run([exe, "equations", cat, "-v"], capture_output=True, text=True)
 check("equations refuses -v", r.returncode == 2, r.stderr)
+r = subprocess.run([exe, "batch", cat, os.devnull, "-v", "--threads", "1"],
+                   capture_output=True, text=True)
+check("batch refuses -v with a sentence", r.returncode == 2 and "--verbose" in r.stderr,
+      r.stderr)
 
 for flag in ("-V", "--version"):
     r = subprocess.run([exe, flag], capture_output=True, text=True)
