@@ -1,5 +1,5 @@
 /* src/expr/ex_integrand.c — partials of F(x, y, y') compiled to tapes, evaluated through
- * the core's integrand callback. SPDX-License-Identifier: MIT */
+ * the core's integrand callback (docs/theory.md (X-4)). SPDX-License-Identifier: MIT */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,7 +27,7 @@ static void set_err(char *err, size_t errlen, const char *msg) {
   if (err && errlen) snprintf(err, errlen, "%s", msg);
 }
 
-/* Upper-triangle index of (i, j), i <= j, in row-major order. */
+/* Upper-triangle index of (i, j), i <= j, in row-major order. */
 static int tri(int n, int i, int j) { return i * n - i * (i - 1) / 2 + (j - i); }
 
 /* Work buffers of g (tapes and sizes already set). 0, or -1 on allocation failure. */

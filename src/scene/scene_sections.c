@@ -187,7 +187,7 @@ int sc_load_guess_exact(sc_loader *L)
 static int load_named(sc_loader *L, int sec, sc_item **out, int *nout)
 {
   int ne = L->raw.ne[sec];
-  *out = calloc((size_t)ne + 1, sizeof **out);
+  *out = cv_calloc((size_t)ne + 1, sizeof **out);
   if (!*out)
     return nomem(L, 0);
   for (int i = 0; i < ne; i++) {
