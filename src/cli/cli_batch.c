@@ -294,7 +294,7 @@ static int own_args(int argc, char **argv, char **rest, int *nrest, const char *
       rest[(*nrest)++] = argv[i];
       /* a valued solve option: keep its value with it */
       if (!strchr(a, '=') && i + 1 < argc && strcmp(a, "--quiet") != 0 &&
-          strcmp(a, "--verbose") != 0 && strcmp(a, "-v") != 0)
+          strcmp(a, "--verbose") != 0 && strcmp(a, "-v") != 0 && strcmp(a, "--all") != 0)
         rest[(*nrest)++] = argv[++i];
     }
   }
@@ -338,9 +338,11 @@ int cli_batch(int argc, char **argv)
     cli_mpi_finish(&mpi);
     return EXIT_BADINPUT;
   }
-  if (o.cont || o.json || o.csv || o.plot) {
+  if (o.cont || o.json || o.csv || o.plot || o.all || o.max_paths || o.work > 0 ||
+      o.max_elements > 0) {
     fprintf(stderr, "calcvar batch: --%s is an option of calcvar solve, not of batch\n",
-            o.cont ? "continue" : o.json ? "json" : o.csv ? "csv" : "plot");
+            o.cont ? "continue" : o.json ? "json" : o.csv ? "csv" : o.plot ? "plot"
+            : o.all ? "all" : o.max_paths ? "max" : o.work > 0 ? "work" : "max-elements");
     cli_opts_free(&o);
     cli_mpi_finish(&mpi);
     return EXIT_BADINPUT;
