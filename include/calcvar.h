@@ -311,11 +311,12 @@ cv_status cv_solver_set_tol(cv_solver *s, double tol, int max_nodes);
 /** Estimated max nodal error of the last adaptive or --tol solve (NaN otherwise). */
 double cv_solver_get_error_estimate(const cv_solver *s);
 /** A-posteriori estimate of the max nodal error of the last (converged) solve on its own
- * mesh, from a warm-started solve on the p-enriched mesh (theory HP-2): CVAR_OK with *est,
- * or an error with a sentence (cv_solver_last_error is not changed; msg gets it) when the
- * enriched solve failed or landed on another stationary path (theory HP-3): no bound then. */
+ * mesh, from a warm-started solve on the p-enriched mesh (theory HP-2): CVAR_OK with *est
+ * and (if est_vertex is not NULL) the max over the element boundaries alone, or an error
+ * with a sentence in msg (cv_solver_last_error is not changed) when the enriched solve
+ * failed or landed on another stationary path (theory HP-3): no bound then, NaN. */
 cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p, double *est,
-                                   char *msg, size_t len);
+                                   double *est_vertex, char *msg, size_t len);
 /** Refinement rounds of the last adaptive solve. */
 int cv_solver_get_adapt_rounds(const cv_solver *s);
 

@@ -82,7 +82,7 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
                strcmp(name, "-h") == 0;
     static const char *const valued[] = {
       "--elements", "--degree", "--method", "--tolerance", "--max-iterations", "--set",
-      "--adapt", "--continue", "--json", "--csv", "--plot", NULL};
+      "--adapt", "--tol", "--continue", "--json", "--csv", "--plot", NULL};
     int known = flag;
     for (int k = 0; valued[k]; k++)
       known |= strcmp(name, valued[k]) == 0;
@@ -126,6 +126,9 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     } else if (strcmp(name, "--adapt") == 0) {
       if (parse_pos_double(v, &o->adapt) < 0)
         return bad(cmd, "--adapt needs a target error > 0, got '%s'", v);
+    } else if (strcmp(name, "--tol") == 0) {
+      if (parse_pos_double(v, &o->tol) < 0)
+        return bad(cmd, "--tol needs a target max nodal error > 0, got '%s'", v);
     } else if (strcmp(name, "--set") == 0) {
       const char *e = strchr(v, '=');
       if (!e || e == v || !e[1])
@@ -168,6 +171,9 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     return 0;
   if (!o->scene_path)
     return bad(cmd, "a scene file is missing: calcvar %s SCENE [options]", cmd);
+  if (o->tol > 0 && o->adapt > 0)
+    return bad(cmd, "--tol and --adapt cannot be combined (--tol chooses the mesh and the "
+               "degrees, --adapt the mesh at one degree)");
   if (o->json && o->csv && strcmp(o->json, "-") == 0 && strcmp(o->csv, "-") == 0)
     return bad(cmd, "--json - and --csv - cannot both write to stdout");
   if (o->json && o->csv && strcmp(o->json, o->csv) == 0 && strcmp(o->json, "-") != 0)
@@ -178,7 +184,7 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
 /* For commands that only read a scene (equations, modes): reject solve-only options. */
 int cli_only_scene_options(const char *cmd, const cli_opts *o)
 {
-  if (o->csv || o->plot || o->adapt > 0 || o->cont || o->elements || o->degree ||
+  if (o->csv || o->plot || o->adapt > 0 || o->tol > 0 || o->cont || o->elements || o->degree ||
       o->method >= 0 || o->tolerance > 0 || o->max_iterations) {
     fprintf(stderr, "calcvar %s: only --set, --json and --quiet apply to %s\n", cmd, cmd);
     return EXIT_BADINPUT;

@@ -87,7 +87,7 @@ static int parse_degrees(const char *v, conv_opts *c)
 static int split_args(int argc, char **argv, conv_opts *c, char **rest, int *nrest)
 {
   static const char *const valued[] = {"--elements", "--method", "--tolerance",
-                                       "--max-iterations", "--set", "--adapt", "--continue",
+                                       "--max-iterations", "--set", "--adapt", "--tol", "--continue",
                                        "--json", "--csv", "--plot", NULL};
   static const char *const mine[] = {"--levels", "--degree", "--svg"};
   c->levels = 6;
@@ -193,6 +193,10 @@ static int solve_row(scene *s, const cv_problem *p, int any_exact, cli_conv_row 
   if (!best)
     return -1;
   int rc = cli_report_collect(&row->r, s, best, s->method, st);
+  double ea = NAN, ev = NAN;
+  char why[400];
+  if (rc == 0 && !any_exact && row->r.nodes > 0 && st == CVAR_OK)
+    rc = cli_estimate_error(best, p, &ea, &ev, why, sizeof why);
   cv_solver_free(best);
   if (rc < 0)
     return -1;
@@ -208,9 +212,6 @@ static int solve_row(scene *s, const cv_problem *p, int any_exact, cli_conv_row 
     row->has_err_v = isfinite(ev);
     row->err_v = ev;
   } else {
-    double ea, ev;
-    if (cli_estimate_error(s, p, r->nodes, r->degree, r->x, r->y, &ea, &ev) < 0)
-      return -1;
     row->estimated = 1;
     row->has_err = isfinite(ea);
     row->err = ea;
@@ -264,7 +265,7 @@ int cli_converge(int argc, char **argv)
     goto done;
   }
   const char *notmine = o.csv ? "--csv" : o.plot ? "--plot" : o.adapt > 0 ? "--adapt"
-                        : o.cont ? "--continue" : NULL;
+                        : o.tol > 0 ? "--tol" : o.cont ? "--continue" : NULL;
   if (notmine) {
     rc = bad("%s is an option of solve, not of converge", notmine);
     goto done;
@@ -288,7 +289,8 @@ int cli_converge(int argc, char **argv)
     s->tolerance = o.tolerance;
   if (o.max_iterations)
     s->max_iterations = o.max_iterations;
-  s->adapt = 0; /* converge studies fixed meshes: a scene's adapt does not apply */
+  s->adapt = 0; /* converge studies fixed meshes: a scene's adapt or tol does not apply */
+  s->tol = 0;
   /* The finest mesh, and the reference mesh of an estimate (p^2 times the nodes), must
    * keep every node count an int. */
   if ((long long)s->elements << (c.levels - 1) > INT_MAX / 81) {

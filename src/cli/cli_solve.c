@@ -23,6 +23,8 @@ static void usage(FILE *f)
         "  --max-iterations K   iteration limit (default 50)\n"
         "  --set name=value     override a parameter (repeatable)\n"
         "  --adapt TOL          refine until the estimated max nodal error < TOL\n"
+        "  --tol T              choose mesh and degrees until the estimated max nodal\n"
+        "                       error <= T (elements/degree, if given, are the start)\n"
         "  --continue name=from:to   continuation in a parameter\n"
         "  --json FILE          JSON report ('-' for stdout)\n"
         "  --csv FILE           nodal table ('-' for stdout)\n"
@@ -35,7 +37,13 @@ static void usage(FILE *f)
  * ignore a request. */
 static int unsupported(const cli_opts *o, const scene *s)
 {
-  if (o->cont && (o->adapt > 0 || s->adapt > 0)) {
+  if ((o->tol > 0 && s->adapt > 0) || (o->adapt > 0 && s->tol > 0)) {
+    fprintf(stderr, "%s:%d: [mesh] %s cannot be combined with %s\n", s->file,
+            s->tol > 0 ? s->tol_line : s->adapt_line, s->tol > 0 ? "tol" : "adapt",
+            s->tol > 0 ? "--adapt" : "--tol");
+    return EXIT_BADINPUT;
+  }
+  if (o->cont && (o->adapt > 0 || s->adapt > 0 || o->tol > 0 || s->tol > 0)) {
     fprintf(stderr, "calcvar solve: --continue and adaptive refinement cannot be combined "
             "(continuation keeps one mesh)\n");
     return EXIT_BADINPUT;
@@ -87,6 +95,14 @@ int cli_solve(int argc, char **argv)
     s->max_iterations = o.max_iterations;
   if ((rc = unsupported(&o, s)) != 0)
     goto done;
+  double tol = o.tol > 0 ? o.tol : s->tol;
+  if (tol > 0) { /* automatic accuracy: the scene's or the flags' mesh is only the start */
+    s->tol = tol;
+    if (!o.elements && !s->elements_line && s->grading <= 0)
+      s->elements = SCENE_TOL_START_ELEMENTS;
+    if (!o.degree && !s->degree_line)
+      s->degree = SCENE_TOL_START_DEGREE;
+  }
   cv_status why;
   if (!(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err)) ||
       !(sv = cv_solver_new(&why)) || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK) {
@@ -146,12 +162,18 @@ int cli_solve(int argc, char **argv)
   int any_exact = 0;
   for (int i = 0; i < s->n; i++)
     any_exact |= s->exact[i] >= 0;
-  if (adapt > 0) {
-    /* the adaptive solve's own two-mesh estimate */
+  if (tol > 0) {
+    /* --tol: the rounds' own estimate, always (SCENES.md), and the degrees */
+    double est = cv_solver_get_error_estimate(sv);
+    r.has_err_est = isfinite(est);
+    r.err_est = est;
+    r.has_degrees = 1;
+  } else if (adapt > 0) {
+    /* the adaptive solve's own estimate */
     double est = cv_solver_get_error_estimate(sv);
     r.has_err_est = !any_exact && isfinite(est);
     r.err_est = est;
-  } else if (!any_exact && cli_report_estimate(&r, s, p) < 0) {
+  } else if (!any_exact && cli_report_estimate(&r, sv, p) < 0) {
     fprintf(stderr, "calcvar solve: out of memory while estimating the error\n");
     rc = EXIT_UNSOLVED;
     goto done;

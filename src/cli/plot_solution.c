@@ -59,8 +59,8 @@ int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv)
     }
   }
   char xl[256];
-  snprintf(xl, sizeof xl, "%s   (%d elements of degree %d, %s)", s->variable, r->elements,
-           r->degree, r->status);
+  snprintf(xl, sizeof xl, "%s   (%d elements of degree %s%d, %s)", s->variable, r->elements,
+           r->has_degrees ? "up to " : "", r->degree, r->status);
   cli_plot_panel pan[2];
   memset(pan, 0, sizeof pan);
   pan[0].title = s->title;

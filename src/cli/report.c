@@ -43,6 +43,7 @@ void cli_report_free(cli_report *r)
   free(r->lam);
   free(r->has_mu);
   free(r->mu);
+  free(r->degrees);
   memset(r, 0, sizeof *r);
 }
 
@@ -224,6 +225,12 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
   r->elements = cv_solver_get_num_elements(sv);
   r->degree = cv_solver_get_degree(sv);
   r->nodes = cv_solver_get_num_nodes(sv);
+  if (r->elements > 0) {
+    r->degrees = malloc((size_t)r->elements * sizeof *r->degrees);
+    if (!r->degrees)
+      return -1;
+    cv_solver_get_degrees(sv, r->degrees);
+  }
   r->iterations = cv_solver_get_num_iterations(sv);
   r->action = cv_solver_get_action(sv);
   r->has_action = isfinite(r->action);

@@ -154,7 +154,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     }
     double est;
     char why[400];
-    st = cv_estimate_enriched(s, p, f, &est, eta, sigma, where, why, sizeof why);
+    st = cv_estimate_enriched(s, p, f, &est, NULL, eta, sigma, where, why, sizeof why);
     if (st == CVAR_ENOMEM) goto cleanup;
     if (st) {
       /* HP-3: no bound from this mesh; halve every element and start the next round from

@@ -79,15 +79,18 @@ static cv_status indicators(const cv_disc *d, const cv_solver *f, double *eta, d
   int n = d->n;
   double xs[CV_MAX_DEGREE + 1], *ys = cv_malloc((size_t)n * (CV_MAX_DEGREE + 1) * sizeof *ys);
   double *yl = cv_malloc((size_t)n * (CV_MAX_DEGREE + 1) * sizeof *yl);
-  cv_status st = ys && yl ? CVAR_OK : CVAR_ENOMEM;
+  double *yg = cv_malloc((size_t)n * (CV_MAX_DEGREE + 3) * sizeof *yg);
+  cv_status st = ys && yl && yg ? CVAR_OK : CVAR_ENOMEM;
   for (long e = 0; e < d->E && !st; e++) {
     int pe = cv_disc_edeg(d, e), P = pe + 2 > CV_MAX_DEGREE ? CV_MAX_DEGREE : pe + 2;
-    if (P == pe) P = CV_MAX_DEGREE; /* p = 8: sampled at its own nodes, surplus from halves */
+    int G = pe + 3; /* Gauss points of the surplus: none is a node of I_p */
     cv_refelem R;
+    double tg[CV_MAX_DEGREE + 3], wg[CV_MAX_DEGREE + 3], xg[CV_MAX_DEGREE + 3];
     const cv_refelem *r = cv_disc_eref(d, e);
     cv_gauss_lobatto(P, R.xi, R.wl);
+    cv_gauss_legendre(G, tg, wg);
     double x0 = d->xe[e], h = d->xe[e + 1] - x0;
-    /* f at e's own nodes (for I_p f) and at the P + 1 sample points */
+    /* f at e's own nodes (for I_p f), at the P + 1 GLL points (Legendre coefficients) */
     for (int l = 0; l <= pe; l++) xs[l] = x0 + 0.5 * (r->xi[l] + 1.0) * h;
     st = cv_solver_eval(f, pe + 1, xs, yl, NULL);
     if (st) break;
@@ -95,16 +98,20 @@ static cv_status indicators(const cv_disc *d, const cv_solver *f, double *eta, d
     xs[0] = x0;
     xs[P] = d->xe[e + 1];
     st = cv_solver_eval(f, P + 1, xs, ys, NULL);
+    for (int l = 0; l < G; l++) xg[l] = x0 + 0.5 * (tg[l] + 1.0) * h;
+    if (!st) st = cv_solver_eval(f, G, xg, yg, NULL);
     if (st) break;
     double eta_e = 0.0, sig_e = INFINITY, at = 0.0;
     for (int i = 0; i < n; i++) {
       double phi[CV_MAX_DEGREE + 1], a[CV_MAX_DEGREE + 1] = {0}, Lg[CV_MAX_DEGREE + 1];
-      for (int l = 0; l <= P; l++) {
-        cv_lagrange(pe, r->xi, R.xi[l], phi, NULL);
+      for (int l = 0; l < G; l++) {
+        cv_lagrange(pe, r->xi, tg[l], phi, NULL);
         double ip = 0.0;
         for (int m = 0; m <= pe; m++) ip += phi[m] * yl[i * (pe + 1) + m];
-        double dlt = fabs(ys[i * (P + 1) + l] - ip);
-        if (!(dlt <= eta_e)) eta_e = dlt, at = R.xi[l]; /* NaN propagates */
+        double dlt = fabs(yg[i * G + l] - ip);
+        if (!(dlt <= eta_e)) eta_e = dlt, at = tg[l]; /* NaN propagates */
+      }
+      for (int l = 0; l <= P; l++) {
         legendre_all(P, R.xi[l], Lg);
         for (int k = 0; k <= P; k++) a[k] += R.wl[l] * ys[i * (P + 1) + l] * Lg[k];
       }
@@ -129,6 +136,7 @@ static cv_status indicators(const cv_disc *d, const cv_solver *f, double *eta, d
   }
   cv_free(ys);
   cv_free(yl);
+  cv_free(yg);
   return st;
 }
 
@@ -139,13 +147,14 @@ static cv_status indicators(const cv_disc *d, const cv_solver *f, double *eta, d
  * path (other Morse index, or moved by more than the distance Newton was asked to trust),
  * which is then no error bound. */
 cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solver *f,
-                               double *est, double *eta, double *sigma, double *where,
+                               double *est, double *est_vertex, double *eta, double *sigma, double *where,
                                char *msg, size_t len) {
   const cv_disc *d = &s->disc;
   int Ef = 0, *deg = NULL, n = p->n, N = d->nodes;
   double *t = NULL, *xn = NULL, *yf = NULL;
   cv_status st = enriched_mesh(d, &Ef, &t, &deg);
   *est = NAN;
+  if (est_vertex) *est_vertex = NAN;
   f->nq = 0;
   f->rtol = s->rtol;
   f->atol = s->atol;
@@ -184,13 +193,17 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
   cv_disc_fill_nodes(d, xn);
   st = cv_solver_eval(f, N, xn, yf, NULL);
   if (st) goto cleanup;
-  double e = 0.0, scale = 0.0;
-  for (int j = 0; j < N; j++)
+  double e = 0.0, ev = 0.0, scale = 0.0;
+  for (long el = 0, j = 0; j < N; j++) {
+    int vertex = j == N - 1 || j == cv_disc_enode(d, el);
+    if (vertex && j < N - 1) el++;
     for (int i = 0; i < n; i++) {
       double dl = fabs(s->y[(size_t)j * n + i] - yf[(size_t)i * N + j]);
       if (!(dl <= e)) e = dl;
+      if (vertex && !(dl <= ev)) ev = dl;
       scale = fmax(scale, fabs(yf[(size_t)i * N + j]));
     }
+  }
   if (!isfinite(e)) {
     st = CVAR_ENONFINITE;
     cv_set_msg(msg, len, "the error estimate is not finite");
@@ -207,6 +220,7 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
     goto cleanup;
   }
   *est = e;
+  if (est_vertex) *est_vertex = ev;
   if (eta && sigma && where) st = indicators(d, f, eta, sigma, where);
 cleanup:
   cv_free(t);
@@ -217,9 +231,10 @@ cleanup:
 }
 
 cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p, double *est,
-                                   char *msg, size_t len) {
+                                   double *est_vertex, char *msg, size_t len) {
   if (!s || !p || !est) return CVAR_EINVAL;
   *est = NAN;
+  if (est_vertex) *est_vertex = NAN;
   if (!s->have || s->status != CVAR_OK) {
     cv_set_msg(msg, len, "no converged solve to estimate the error of");
     return CVAR_ESTATE;
@@ -227,7 +242,7 @@ cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p, doub
   cv_status st;
   cv_solver *f = cv_solver_new(&st);
   if (!f) return st;
-  st = cv_estimate_enriched(s, p, f, est, NULL, NULL, NULL, msg, len);
+  st = cv_estimate_enriched(s, p, f, est, est_vertex, NULL, NULL, NULL, msg, len);
   cv_solver_free(f);
   return st;
 }

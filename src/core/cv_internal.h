@@ -272,7 +272,7 @@ cv_status cv_warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from
 /* HP-2, HP-3: the estimate of s's max nodal error from a warm-started solve into f on the
  * enriched mesh; with eta, sigma, where (E each, all or none) the indicators of HP-4. */
 cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solver *f,
-                               double *est, double *eta, double *sigma, double *where,
+                               double *est, double *est_vertex, double *eta, double *sigma, double *where,
                                char *msg, size_t len);
 /* HP-4, HP-5: the next mesh (on [0, 1], *t with *Enew + 1 entries, *deg with *Enew) from
  * d with the elements eta[e] >= thresh refined (hp = 0: bisected at their degree). */
