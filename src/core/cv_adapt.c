@@ -5,6 +5,8 @@
 #include <float.h>
 #include <math.h>
 #include <string.h>
+#include <stdio.h>
+#include <stdlib.h>
 
 #include "cv_internal.h"
 
@@ -14,8 +16,6 @@
  * estimate flat for as many rounds as the layer is halvings thin). */
 #define STALL_ROUNDS_FLOOR 3
 #define STALL_ROUNDS 40
-/* Estimates below this many units of round-off of the solution's size are at the floor. */
-#define FLOOR_ULPS 256.0
 
 cv_status cv_solver_set_tol(cv_solver *s, double tol, int max_nodes) {
   if (!s || !(tol >= 0) || !isfinite(tol) || max_nodes < 2) return CVAR_EINVAL;
@@ -63,16 +63,19 @@ static double value_scale(const cv_solver *s) {
 }
 
 /* HP-6: why the rounds must stop before reaching tol, as a sentence in s->msg, or 0 to go
- * on. best: smallest estimate so far; stalled: rounds since it last halved. */
-static int stop_rule(cv_solver *s, double est, double best, int stalled, int next_size) {
-  double tol = s->adapt_tol, floor_ = FLOOR_ULPS * DBL_EPSILON * value_scale(s);
+ * on. best: smallest estimate so far; floor_: the estimate's round-off part (HP-2);
+ * stalled: rounds since the best last halved. */
+static int stop_rule(cv_solver *s, double est, double best, double floor_, int stalled,
+                     int next_size) {
+  double tol = s->adapt_tol;
   const char *what = s->hp ? "nodes" : "elements";
   if ((best <= floor_ && tol < floor_) || (stalled >= STALL_ROUNDS_FLOOR && best <= 1e3 * floor_)) {
     cv_set_msg(s->msg, sizeof s->msg,
                "the error estimate reached %.2g > %.2g and can go no lower: that is the "
-               "round-off floor of double precision for values of size %.2g (about %.1g); ask "
-               "for a larger tolerance",
-               est, tol, value_scale(s), floor_);
+               "round-off floor of double precision for this solution (about %.1g, from "
+               "values of size %.2g and the slope times the spacing of doubles at the "
+               "nodes); ask for a larger tolerance",
+               est, tol, floor_, value_scale(s));
     return 1;
   }
   if (stalled >= STALL_ROUNDS) {
@@ -152,9 +155,9 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       st = CVAR_ENOMEM;
       goto cleanup;
     }
-    double est;
+    double est, floor_ = 0.0;
     char why[400];
-    st = cv_estimate_enriched(s, p, f, &est, NULL, eta, sigma, where, why, sizeof why);
+    st = cv_estimate_enriched(s, p, f, &est, NULL, &floor_, eta, sigma, where, why, sizeof why);
     if (st == CVAR_ENOMEM) goto cleanup;
     if (st) {
       /* HP-3: no bound from this mesh; halve every element and start the next round from
@@ -185,12 +188,13 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       else stalled++;
       if (est < best) best = est;
     }
+    if (getenv("CV_DEBUG_TOL")) fprintf(stderr, "round %d E %d nodes %d est %.3g\n", s->rounds, E, s->disc.nodes, est);
     double emax = 0.0;
     for (int e = 0; e < E; e++) emax = fmax(emax, eta[e]);
     /* mark: hp, the elements within a factor 4 of the largest surplus; --adapt, those above
      * tol / 4 (AD-1), and always the largest */
     double thresh = s->hp ? 0.25 * emax : fmin(0.25 * tol, emax);
-    if (stop_rule(s, est, best, stalled, next_size(&s->disc, eta, thresh, s->hp))) {
+    if (stop_rule(s, est, best, floor_, stalled, next_size(&s->disc, eta, thresh, s->hp))) {
       st = CVAR_EMAXITER;
       goto cleanup;
     }

@@ -2,6 +2,7 @@
  * p-enriched mesh (theory HP-2), checked to have stayed on the same path (HP-3), with the
  * per-element indicators the hp decisions use (HP-4).
  * SPDX-License-Identifier: MIT */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -12,6 +13,34 @@ static void legendre_all(int P, double s, double *L) {
   L[0] = 1.0;
   if (P >= 1) L[1] = s;
   for (int k = 2; k <= P; k++) L[k] = ((2.0 * k - 1.0) * s * L[k - 1] - (k - 1.0) * L[k - 2]) / k;
+}
+
+/* The enriched solution f on the element(s) made from one element of the judged mesh, at
+ * m reference coordinates tau in [-1, 1] of that element: fe is f's (first) element for
+ * it, split = 1 when it was halved (degree 8). Evaluated through the element's own basis,
+ * not through x: near an end x has an ulp of ~1e-16 and a layer's y' of 1e8 would turn
+ * that into 1e-8 (measured: a floor of the estimate at 4e-9 for eps = 1e-8).
+ * y[i*m + k] as cv_solver_eval. */
+static void f_eval(const cv_solver *f, long fe, int split, int m, const double *tau, double *y) {
+  const cv_disc *fd = &f->disc;
+  int n = fd->n;
+  double phi[CV_MAX_DEGREE + 1];
+  for (int k = 0; k < m; k++) {
+    long e = fe;
+    double t = tau[k];
+    if (split) {
+      if (t > 0) e++, t = 2.0 * t - 1.0;
+      else t = 2.0 * t + 1.0;
+    }
+    int pe = cv_disc_edeg(fd, e);
+    long j0 = cv_disc_enode(fd, e);
+    cv_lagrange(pe, cv_disc_eref(fd, e)->xi, t, phi, NULL);
+    for (int i = 0; i < n; i++) {
+      double v = 0.0;
+      for (int l = 0; l <= pe; l++) v += f->y[(j0 + l) * n + i] * phi[l];
+      y[i * m + k] = v;
+    }
+  }
 }
 
 /* Start solver s (its mesh set, about to be solved) from the solution held by `from`,
@@ -77,30 +106,25 @@ static cv_status enriched_mesh(const cv_disc *d, int *Ef, double **t, int **deg)
 static cv_status indicators(const cv_disc *d, const cv_solver *f, double *eta, double *sigma,
                             double *where) {
   int n = d->n;
-  double xs[CV_MAX_DEGREE + 1], *ys = cv_malloc((size_t)n * (CV_MAX_DEGREE + 1) * sizeof *ys);
+  double *ys = cv_malloc((size_t)n * (CV_MAX_DEGREE + 1) * sizeof *ys);
   double *yl = cv_malloc((size_t)n * (CV_MAX_DEGREE + 1) * sizeof *yl);
   double *yg = cv_malloc((size_t)n * (CV_MAX_DEGREE + 3) * sizeof *yg);
   cv_status st = ys && yl && yg ? CVAR_OK : CVAR_ENOMEM;
-  for (long e = 0; e < d->E && !st; e++) {
+  for (long e = 0, fe = 0; e < d->E && !st; e++) {
     int pe = cv_disc_edeg(d, e), P = pe + 2 > CV_MAX_DEGREE ? CV_MAX_DEGREE : pe + 2;
+    int split = pe == CV_MAX_DEGREE;
     int G = pe + 3; /* Gauss points of the surplus: none is a node of I_p */
     cv_refelem R;
-    double tg[CV_MAX_DEGREE + 3], wg[CV_MAX_DEGREE + 3], xg[CV_MAX_DEGREE + 3];
+    double tg[CV_MAX_DEGREE + 3], wg[CV_MAX_DEGREE + 3];
     const cv_refelem *r = cv_disc_eref(d, e);
     cv_gauss_lobatto(P, R.xi, R.wl);
     cv_gauss_legendre(G, tg, wg);
-    double x0 = d->xe[e], h = d->xe[e + 1] - x0;
-    /* f at e's own nodes (for I_p f), at the P + 1 GLL points (Legendre coefficients) */
-    for (int l = 0; l <= pe; l++) xs[l] = x0 + 0.5 * (r->xi[l] + 1.0) * h;
-    st = cv_solver_eval(f, pe + 1, xs, yl, NULL);
-    if (st) break;
-    for (int l = 0; l <= P; l++) xs[l] = x0 + 0.5 * (R.xi[l] + 1.0) * h;
-    xs[0] = x0;
-    xs[P] = d->xe[e + 1];
-    st = cv_solver_eval(f, P + 1, xs, ys, NULL);
-    for (int l = 0; l < G; l++) xg[l] = x0 + 0.5 * (tg[l] + 1.0) * h;
-    if (!st) st = cv_solver_eval(f, G, xg, yg, NULL);
-    if (st) break;
+    /* f at e's own nodes (for I_p f), at the P + 1 GLL points (Legendre coefficients),
+     * at the G Gauss points (surplus) */
+    f_eval(f, fe, split, pe + 1, r->xi, yl);
+    f_eval(f, fe, split, P + 1, R.xi, ys);
+    f_eval(f, fe, split, G, tg, yg);
+    fe += 1 + split;
     double eta_e = 0.0, sig_e = INFINITY, at = 0.0;
     for (int i = 0; i < n; i++) {
       double phi[CV_MAX_DEGREE + 1], a[CV_MAX_DEGREE + 1] = {0}, Lg[CV_MAX_DEGREE + 1];
@@ -147,14 +171,16 @@ static cv_status indicators(const cv_disc *d, const cv_solver *f, double *eta, d
  * path (other Morse index, or moved by more than the distance Newton was asked to trust),
  * which is then no error bound. */
 cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solver *f,
-                               double *est, double *est_vertex, double *eta, double *sigma, double *where,
+                               double *est, double *est_vertex, double *floor_out,
+                               double *eta, double *sigma, double *where,
                                char *msg, size_t len) {
   const cv_disc *d = &s->disc;
-  int Ef = 0, *deg = NULL, n = p->n, N = d->nodes;
-  double *t = NULL, *xn = NULL, *yf = NULL;
+  int Ef = 0, *deg = NULL, n = p->n;
+  double *t = NULL, *yf = NULL;
   cv_status st = enriched_mesh(d, &Ef, &t, &deg);
   *est = NAN;
   if (est_vertex) *est_vertex = NAN;
+  if (floor_out) *floor_out = NAN;
   f->nq = 0;
   f->rtol = s->rtol;
   f->atol = s->atol;
@@ -183,26 +209,38 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
                f->morse, s->morse);
     goto cleanup;
   }
-  xn = cv_malloc((size_t)N * sizeof *xn);
-  yf = cv_malloc((size_t)N * n * sizeof *yf);
-  if (!xn || !yf) {
+  yf = cv_malloc((size_t)(CV_MAX_DEGREE + 1) * n * sizeof *yf);
+  if (!yf) {
     st = CVAR_ENOMEM;
     cv_set_msg(msg, len, "out of memory for the error estimate");
     goto cleanup;
   }
-  cv_disc_fill_nodes(d, xn);
-  st = cv_solver_eval(f, N, xn, yf, NULL);
-  if (st) goto cleanup;
-  double e = 0.0, ev = 0.0, scale = 0.0;
-  for (long el = 0, j = 0; j < N; j++) {
-    int vertex = j == N - 1 || j == cv_disc_enode(d, el);
-    if (vertex && j < N - 1) el++;
-    for (int i = 0; i < n; i++) {
-      double dl = fabs(s->y[(size_t)j * n + i] - yf[(size_t)i * N + j]);
-      if (!(dl <= e)) e = dl;
-      if (vertex && !(dl <= ev)) ev = dl;
-      scale = fmax(scale, fabs(yf[(size_t)i * N + j]));
-    }
+  /* max over s's nodes of |y_s - y_f|, element by element through the reference
+   * coordinates (f_eval); the vertices alone too */
+  double e = 0.0, ev = 0.0, scale = 0.0, rox = 0.0;
+  for (long el = 0, fe = 0; el < d->E; el++) {
+    int pe = cv_disc_edeg(d, el), split = pe == CV_MAX_DEGREE, P1 = pe + 1;
+    long j0 = cv_disc_enode(d, el);
+    /* HP-2: a node's abscissa is a double, within half an ulp, eps |x| / 2, of the node:
+     * the value there carries |y'| times that (slopes between neighbouring nodes stand
+     * for y') */
+    const double *xi = cv_disc_eref(d, el)->xi;
+    double h = d->xe[el + 1] - d->xe[el];
+    double ulp = 0.5 * DBL_EPSILON * fmax(fabs(d->xe[el]), fabs(d->xe[el + 1]));
+    for (int l = 0; l < pe; l++)
+      for (int i = 0; i < n; i++) {
+        double dy = s->y[(size_t)(j0 + l + 1) * n + i] - s->y[(size_t)(j0 + l) * n + i];
+        rox = fmax(rox, fabs(dy) / (0.5 * h * (xi[l + 1] - xi[l])) * ulp);
+      }
+    f_eval(f, fe, split, P1, xi, yf);
+    fe += 1 + split;
+    for (int l = 0; l <= pe; l++)
+      for (int i = 0; i < n; i++) {
+        double dl = fabs(s->y[(size_t)(j0 + l) * n + i] - yf[(size_t)i * P1 + l]);
+        if (!(dl <= e)) e = dl;
+        if ((l == 0 || l == pe) && !(dl <= ev)) ev = dl;
+        scale = fmax(scale, fabs(yf[(size_t)i * P1 + l]));
+      }
   }
   if (!isfinite(e)) {
     st = CVAR_ENONFINITE;
@@ -219,13 +257,15 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
                e, scale);
     goto cleanup;
   }
-  *est = e;
-  if (est_vertex) *est_vertex = ev;
+  /* HP-2: never below the round-off of the values themselves (both solves carry it) */
+  double ro = CV_ROUNDOFF_ULPS * DBL_EPSILON * fmax(scale, 1.0);
+  *est = fmax(e, ro) + rox;
+  if (est_vertex) *est_vertex = fmax(ev, ro) + rox;
+  if (floor_out) *floor_out = ro + rox;
   if (eta && sigma && where) st = indicators(d, f, eta, sigma, where);
 cleanup:
   cv_free(t);
   cv_free(deg);
-  cv_free(xn);
   cv_free(yf);
   return st;
 }
@@ -242,7 +282,7 @@ cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p, doub
   cv_status st;
   cv_solver *f = cv_solver_new(&st);
   if (!f) return st;
-  st = cv_estimate_enriched(s, p, f, est, est_vertex, NULL, NULL, NULL, msg, len);
+  st = cv_estimate_enriched(s, p, f, est, est_vertex, NULL, NULL, NULL, NULL, msg, len);
   cv_solver_free(f);
   return st;
 }

@@ -12,6 +12,13 @@
 
 static int clamp_deg(int p) { return p > CV_MAX_DEGREE ? CV_MAX_DEGREE : p < 1 ? 1 : p; }
 
+/* A split point u of [x0, x1] on the reference interval, or -1 when round-off would
+ * leave one of the two parts empty (an element near an end of ~1e-16 relative size). */
+static double split_at(double x0, double x1, double u, double a, double L) {
+  double t0 = (x0 - a) / L, t1 = (x1 - a) / L, tu = (u - a) / L;
+  return tu > t0 && tu < t1 && a + L * tu > a + L * t0 && a + L * tu < a + L * t1 ? tu : -1.0;
+}
+
 cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
                        const double *where, double thresh, int hp, int *Enew, double **t,
                        int **deg) {
@@ -32,13 +39,16 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
     int pe = cv_disc_edeg(d, e);
     double x0 = d->xe[e], x1 = d->xe[e + 1];
     (*t)[k] = (x0 - a) / L;
-    if (!(eta[e] >= thresh)) {
-      (*deg)[k++] = pe;
+    double tm = split_at(x0, x1, 0.5 * (x0 + x1), a, L);
+    double tl = split_at(x0, x1, x0 + GEOM_RATIO * (x1 - x0), a, L);
+    double tr = split_at(x0, x1, x1 - GEOM_RATIO * (x1 - x0), a, L);
+    if (!(eta[e] >= thresh) || tm < 0 || tl < 0 || tr < 0) { /* unmarked, or too small */
+      (*deg)[k++] = eta[e] >= thresh ? clamp_deg(pe + 1) : pe;
       continue;
     }
     if (!hp) { /* fixed degree (--adapt): bisect */
       (*deg)[k++] = pe;
-      (*t)[k] = (0.5 * (x0 + x1) - a) / L;
+      (*t)[k] = tm;
       (*deg)[k++] = pe;
       continue;
     }
@@ -48,13 +58,13 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
                                                    sigma[e] < SMOOTH_RATE);
     if (sing_left && !sing_right) { /* small element at x0 keeps p, the rest p + 1 (HP-5) */
       (*deg)[k++] = pe;
-      (*t)[k] = (x0 + GEOM_RATIO * (x1 - x0) - a) / L;
+      (*t)[k] = tl;
       (*deg)[k++] = clamp_deg(pe + 1);
       continue;
     }
     if (sing_right && !sing_left) {
       (*deg)[k++] = clamp_deg(pe + 1);
-      (*t)[k] = (x1 - GEOM_RATIO * (x1 - x0) - a) / L;
+      (*t)[k] = tr;
       (*deg)[k++] = pe;
       continue;
     }
@@ -63,7 +73,7 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
       continue;
     }
     (*deg)[k++] = pe; /* not smooth, or degree 8 already: halve */
-    (*t)[k] = (0.5 * (x0 + x1) - a) / L;
+    (*t)[k] = tm;
     (*deg)[k++] = pe;
   }
   (*t)[0] = 0.0;

@@ -12,6 +12,8 @@
 #define CV_MAX_DEGREE 8
 #define CV_MAX_QUAD 32
 #define CV_PI 3.14159265358979323846
+/* The round-off floor of an error estimate, in units of eps times the values' size (HP-2). */
+#define CV_ROUNDOFF_ULPS 256.0
 
 /* ---- memory: the one allocator (tests may inject failures) ---- */
 void *cv_malloc(size_t n);
@@ -270,9 +272,11 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
 /* Start s (mesh set) from `from` interpolated at its nodes. */
 cv_status cv_warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from);
 /* HP-2, HP-3: the estimate of s's max nodal error from a warm-started solve into f on the
- * enriched mesh; with eta, sigma, where (E each, all or none) the indicators of HP-4. */
+ * enriched mesh (est_vertex: at the element boundaries; floor_out: its round-off part; both
+ * may be NULL); with eta, sigma, where (E each, all or none) the indicators of HP-4. */
 cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solver *f,
-                               double *est, double *est_vertex, double *eta, double *sigma, double *where,
+                               double *est, double *est_vertex, double *floor_out,
+                               double *eta, double *sigma, double *where,
                                char *msg, size_t len);
 /* HP-4, HP-5: the next mesh (on [0, 1], *t with *Enew + 1 entries, *deg with *Enew) from
  * d with the elements eta[e] >= thresh refined (hp = 0: bisected at their degree). */
