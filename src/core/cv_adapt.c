@@ -5,8 +5,6 @@
 #include <float.h>
 #include <math.h>
 #include <string.h>
-#include <stdio.h>
-#include <stdlib.h>
 
 #include "cv_internal.h"
 
@@ -188,7 +186,6 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       else stalled++;
       if (est < best) best = est;
     }
-    if (getenv("CV_DEBUG_TOL")) fprintf(stderr, "round %d E %d nodes %d est %.3g\n", s->rounds, E, s->disc.nodes, est);
     double emax = 0.0;
     for (int e = 0; e < E; e++) emax = fmax(emax, eta[e]);
     /* mark: hp, the elements within a factor 4 of the largest surplus; --adapt, those above
