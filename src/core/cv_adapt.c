@@ -197,7 +197,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     }
     cv_free(t);
     cv_free(deg);
-    st = cv_hp_refine(&s->disc, eta, sigma, where, thresh, s->hp, &E, &t, &deg);
+    st = cv_hp_refine(&s->disc, eta, sigma, where, thresh, tol, s->hp, &E, &t, &deg);
     if (st) goto cleanup;
   }
 cleanup:

@@ -2,6 +2,8 @@
  * marked element, raise its degree (smooth) or split it (not smooth, or degree 8),
  * geometrically towards a singular end.
  * SPDX-License-Identifier: MIT */
+#include <math.h>
+
 #include "cv_internal.h"
 
 /* Legendre coefficients decaying at least like e^(-sigma k) with sigma >= this count as
@@ -19,9 +21,18 @@ static double split_at(double x0, double x1, double u, double a, double L) {
   return tu > t0 && tu < t1 && a + L * tu > a + L * t0 && a + L * tu < a + L * t1 ? tu : -1.0;
 }
 
+/* HP-4: the degree at which a smooth element's surplus eta, falling like e^(-sigma k),
+ * would be below a tenth of the target: p + ceil(ln(eta / (target / 10)) / sigma), at
+ * least p + 1, at most 8. */
+static int predicted_degree(int p, double eta, double sigma, double target) {
+  double k = log(eta / (0.1 * target)) / sigma;
+  if (!(k >= 1)) return clamp_deg(p + 1);
+  return k > CV_MAX_DEGREE ? CV_MAX_DEGREE : clamp_deg(p + (int)ceil(k));
+}
+
 cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
-                       const double *where, double thresh, int hp, int *Enew, double **t,
-                       int **deg) {
+                       const double *where, double thresh, double target, int hp, int *Enew,
+                       double **t, int **deg) {
   int E = d->E, F = 0;
   for (int e = 0; e < E; e++) F += eta[e] >= thresh ? 2 : 1;
   *t = cv_malloc((size_t)(F + 1) * sizeof **t);
@@ -68,8 +79,8 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
       (*deg)[k++] = pe;
       continue;
     }
-    if (sigma[e] >= SMOOTH_RATE && pe < CV_MAX_DEGREE) { /* smooth: p + 1 (HP-4) */
-      (*deg)[k++] = pe + 1;
+    if (sigma[e] >= SMOOTH_RATE && pe < CV_MAX_DEGREE) { /* smooth: raise p (HP-4) */
+      (*deg)[k++] = predicted_degree(pe, eta[e], sigma[e], target);
       continue;
     }
     (*deg)[k++] = pe; /* not smooth, or degree 8 already: halve */
