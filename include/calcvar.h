@@ -295,11 +295,12 @@ cv_status cv_solver_set_continuation(cv_solver *s, int on);
 /** Continuation steps taken by the last solve (0 when Newton converged directly). */
 int cv_solver_get_continuation_steps(const cv_solver *s);
 
-/** Adaptive refinement (theory AD-1): solve, estimate the error of every element by a second
- * solve on the mesh with every element halved, bisect the elements whose estimate exceeds
- * tol / 4, and repeat until the estimated max nodal error is at most tol, or the mesh would
- * exceed max_elements (then CVAR_EMAXITER with a sentence). tol = 0 turns it off (default).
- * The starting mesh is the one set by the other mesh setters. */
+/** Adaptive refinement at a fixed degree (theory AD-1): solve, estimate the error with the
+ * enriched solve of cv_solver_estimate_error (HP-2), bisect the elements whose indicator
+ * exceeds tol / 4, and repeat until the estimated max nodal error is at most tol, or the
+ * mesh would exceed max_elements (then CVAR_EMAXITER with a sentence). tol = 0 turns it off
+ * (default). The starting mesh is the one set by the other mesh setters. Replaces a
+ * cv_solver_set_tol (the last one set wins). */
 cv_status cv_solver_set_adapt(cv_solver *s, double tol, int max_elements);
 /** Automatic accuracy (theory HP-1..HP-4): the solver chooses the mesh and the degree of
  * each element (1..8) until its estimate of the max nodal error is at most tol (> 0), or it
