@@ -47,6 +47,15 @@
 extern "C" {
 #endif
 
+/** Marks a declaration as part of the public ABI. The library is built with hidden
+ * visibility by default (meson.build), so only names marked CVAR_API are exported from
+ * libcalcvar.so; everything else stays internal. */
+#if defined(__GNUC__) || defined(__clang__)
+#define CVAR_API __attribute__((visibility("default")))
+#else
+#define CVAR_API
+#endif
+
 /** \name Version */
 /**@{*/
 #define CVAR_VERSION_MAJOR 0 /**< major version of this header */
@@ -57,7 +66,7 @@ extern "C" {
 /** This header's version, packed: compare with CVAR_VERSION_PACK(a, b, c) in `#if`. */
 #define CVAR_VERSION CVAR_VERSION_PACK(CVAR_VERSION_MAJOR, CVAR_VERSION_MINOR, CVAR_VERSION_PATCH)
 /** The library's version, to compare with the header's. Any pointer may be NULL. */
-void cv_version(int *major, int *minor, int *patch);
+CVAR_API void cv_version(int *major, int *minor, int *patch);
 /**@}*/
 
 /** \name Status codes
@@ -88,9 +97,9 @@ typedef enum { CVAR_STATUS_LIST(CVAR_ENUM_ITEM) CVAR_NUM_STATUS } cv_status;
 #undef CVAR_ENUM_ITEM
 
 /** A static sentence for a status; never NULL (unknown codes give "unknown status"). */
-const char *cv_strerror(cv_status s);
+CVAR_API const char *cv_strerror(cv_status s);
 /** The symbolic name of a status, e.g. "CVAR_EMAXITER"; never NULL. */
-const char *cv_status_name(cv_status s);
+CVAR_API const char *cv_status_name(cv_status s);
 /**@}*/
 
 /** \name Integrand callbacks */
@@ -148,25 +157,32 @@ typedef struct cv_problem cv_problem;
 /** A new problem with n >= 1 unknown functions on [a, b], a < b, both finite.
  * Returns NULL on failure and sets *why (may be NULL) to CVAR_EINVAL or CVAR_ENOMEM.
  * End values start as fixed at 0; no integrand is set. */
-cv_problem *cv_problem_new(int n, double a, double b, cv_status *why);
+CVAR_API cv_problem *cv_problem_new(int n, double a, double b, cv_status *why);
 /** Release a problem; NULL is a no-op. */
-void cv_problem_free(cv_problem *p);
+CVAR_API void cv_problem_free(cv_problem *p);
 /** The integrand (required before solving). `user` is passed through untouched. */
-cv_status cv_problem_set_integrand(cv_problem *p, cv_integrand_fn F, void *user);
+CVAR_API cv_status cv_problem_set_integrand(cv_problem *p, cv_integrand_fn F, void *user);
+/** Releases user data handed to the problem (see the `_owned` setters). */
+typedef void (*cv_release_fn)(void *user);
+/** Like cv_problem_set_integrand, but the problem owns `user`: cv_problem_free (or the next
+ * integrand set) calls release(user) when release is not NULL. On failure release(user) is
+ * called before returning, so the caller never has to. */
+CVAR_API cv_status cv_problem_set_integrand_owned(cv_problem *p, cv_integrand_fn F, void *user,
+                                         cv_release_fn release);
 /** Fix unknown k (0 <= k < n) to ya at a and yb at b. Values must be finite. */
-cv_status cv_problem_set_dirichlet(cv_problem *p, int k, double ya, double yb);
+CVAR_API cv_status cv_problem_set_dirichlet(cv_problem *p, int k, double ya, double yb);
 /** Fix unknown k at one end: end 0 is a, end 1 is b. */
-cv_status cv_problem_set_end_value(cv_problem *p, int k, int end, double value);
+CVAR_API cv_status cv_problem_set_end_value(cv_problem *p, int k, int end, double value);
 /** Leave unknown k free at one end (0 = a, 1 = b): the natural boundary condition
  * dF/dy'_k = 0 holds there at the solution. */
-cv_status cv_problem_set_free_end(cv_problem *p, int k, int end);
+CVAR_API cv_status cv_problem_set_free_end(cv_problem *p, int k, int end);
 /** Initial guess (default: the straight line between the end values; with a free end,
  * the constant fixed value; with both ends free, 0). NULL restores the default. */
-cv_status cv_problem_set_guess(cv_problem *p, cv_guess_fn g, void *user);
+CVAR_API cv_status cv_problem_set_guess(cv_problem *p, cv_guess_fn g, void *user);
 /** The number n of unknown functions. */
-int cv_problem_get_num_unknowns(const cv_problem *p);
+CVAR_API int cv_problem_get_num_unknowns(const cv_problem *p);
 /** The interval; a or b may be NULL. */
-void cv_problem_get_interval(const cv_problem *p, double *a, double *b);
+CVAR_API void cv_problem_get_interval(const cv_problem *p, double *a, double *b);
 
 /** The integrand as a formula string, with exact symbolic derivatives (no callback to
  * write). `variable` names the independent variable (NULL for "x"); `unknowns` is a comma
@@ -174,7 +190,7 @@ void cv_problem_get_interval(const cv_problem *p, double *a, double *b);
  * docs/scenes.md (y' is dy/dx). `parameters` is NULL or a comma separated list of
  * `name = constant expression`. On failure returns CVAR_EINVAL and writes a sentence to
  * err (errlen bytes, may be NULL/0). The problem owns the compiled integrand. */
-cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
+CVAR_API cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
                                         const char *unknowns, const char *F,
                                         const char *parameters, char *err, size_t errlen);
 
@@ -190,16 +206,44 @@ typedef int (*cv_constraint_fn)(int m, const double *x, const double *y, unsigne
  * lambda(x) of the Lagrangian F + lambda G (theory C-1). At an end where all unknowns are
  * fixed, the constraint must already hold (cv_solve returns CVAR_EINVAL otherwise).
  * *index (may be NULL) receives the constraint's number, 0, 1, ... */
-cv_status cv_problem_add_constraint(cv_problem *p, cv_constraint_fn G, void *user, int *index);
+CVAR_API cv_status cv_problem_add_constraint(cv_problem *p, cv_constraint_fn G, void *user, int *index);
 /** Add the integral constraint  int_a^b K(x, y, y') dx = c, with one scalar multiplier
  * mu (Lagrangian F + mu K, theory C-2). K has the integrand's signature and must supply
  * the partials asked for. *index (may be NULL) receives its number, 0, 1, ... */
-cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, void *user, double c,
+CVAR_API cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, void *user, double c,
                                   int *index);
+/** cv_problem_add_constraint whose `user` the problem owns and
+ * releases as in cv_problem_set_integrand_owned (also on failure). */
+CVAR_API cv_status cv_problem_add_constraint_owned(cv_problem *p, cv_constraint_fn G, void *user,
+                                          cv_release_fn release, int *index);
+/** cv_problem_add_integral whose `user` the problem owns (see above). */
+CVAR_API cv_status cv_problem_add_integral_owned(cv_problem *p, cv_integrand_fn K, void *user,
+                                        cv_release_fn release, double c, int *index);
+/** The pointwise constraint G(x, y) = 0 as a formula (no callback, exact partials): the
+ * arguments as cv_problem_set_integrand_expr's; G may not involve the derivatives y'.
+ * On failure CVAR_EINVAL with a sentence in err. *index as cv_problem_add_constraint. */
+CVAR_API cv_status cv_problem_add_constraint_expr(cv_problem *p, const char *variable,
+                                                  const char *unknowns, const char *G,
+                                                  const char *parameters, int *index,
+                                                  char *err, size_t errlen);
+/** The integral constraint int_a^b K(x, y, y') dx = c as a formula, as above. */
+CVAR_API cv_status cv_problem_add_integral_expr(cv_problem *p, const char *variable,
+                                                const char *unknowns, const char *K,
+                                                double c, const char *parameters, int *index,
+                                                char *err, size_t errlen);
 /** The number of pointwise constraints added so far. */
-int cv_problem_get_num_constraints(const cv_problem *p);
+CVAR_API int cv_problem_get_num_constraints(const cv_problem *p);
 /** The number of integral constraints added so far. */
-int cv_problem_get_num_integrals(const cv_problem *p);
+CVAR_API int cv_problem_get_num_integrals(const cv_problem *p);
+/** Energy H = sum_i y'_i dF/dy'_i - F and momenta P_i = dF/dy'_i at m >= 0 points, from
+ * the integrand's own partials (any m: the callback is called in batches), e.g. at the
+ * quadrature points of a solution (cv_solver_get_qpoints): x[k], y[i*m + k], dy[i*m + k]
+ * in; H[k] and P[i*m + k] out, either may be NULL. Returns CVAR_ECALLBACK or
+ * CVAR_ENONFINITE when the callback returns < 0 or > 0 at some point, CVAR_ENOMEM or
+ * CVAR_EINVAL; values are written as they come (the caller checks finiteness). */
+CVAR_API cv_status cv_problem_eval_energy(const cv_problem *p, int m, const double *x,
+                                          const double *y, const double *dy, double *H,
+                                          double *P);
 
 /** Outcome of cv_problem_check_derivatives. */
 typedef struct {
@@ -214,7 +258,7 @@ typedef struct {
  * of F (for the first partials) and of the first partials (for the second), at m points
  * (x[k], y[i*m+k], dy[i*m+k]); 1 <= m <= 256. Fills *report with the worst entry.
  * Returns CVAR_ECALLBACK/CVAR_ENONFINITE if the callback fails at a point. */
-cv_status cv_problem_check_derivatives(const cv_problem *p, int m, const double *x,
+CVAR_API cv_status cv_problem_check_derivatives(const cv_problem *p, int m, const double *x,
                                        const double *y, const double *dy,
                                        cv_derivcheck *report);
 /**@}*/
@@ -230,36 +274,36 @@ enum { CVAR_GRADE_A = 0, CVAR_GRADE_B = 1, CVAR_GRADE_BOTH = 2 };
 
 /** A new solver with defaults: 100 uniform elements of degree 1, p+1 Gauss points,
  * rtol = atol = 1e-10, 50 iterations. NULL on failure (*why set when why != NULL). */
-cv_solver *cv_solver_new(cv_status *why);
+CVAR_API cv_solver *cv_solver_new(cv_status *why);
 /** Release a solver and its results; NULL is a no-op. */
-void cv_solver_free(cv_solver *s);
+CVAR_API void cv_solver_free(cv_solver *s);
 
 /** Number of elements of a uniform mesh (>= 1). Replaces a user or graded mesh. */
-cv_status cv_solver_set_elements(cv_solver *s, int elements);
+CVAR_API cv_status cv_solver_set_elements(cv_solver *s, int elements);
 /** Polynomial degree 1..8 of every element. */
-cv_status cv_solver_set_degree(cv_solver *s, int degree);
+CVAR_API cv_status cv_solver_set_degree(cv_solver *s, int degree);
 /** Gauss-Legendre points per element, 0 for the default p+1, else 1..32. */
-cv_status cv_solver_set_quadrature_points(cv_solver *s, int q);
+CVAR_API cv_status cv_solver_set_quadrature_points(cv_solver *s, int q);
 /** Graded mesh: element boundaries a + (b-a) t_i^k with t_i = i/E towards end a
  * (CVAR_GRADE_A), mirrored towards b, or symmetric towards both; grading k >= 1. */
-cv_status cv_solver_set_mesh_graded(cv_solver *s, int elements, double grading, int end);
+CVAR_API cv_status cv_solver_set_mesh_graded(cv_solver *s, int elements, double grading, int end);
 /** A user mesh on the reference interval [0, 1]: t[0] = 0 < t[1] < ... < t[E] = 1, mapped
  * affinely onto the problem's [a, b]. The array is copied; E >= 1. */
-cv_status cv_solver_set_mesh(cv_solver *s, int elements, const double *t);
+CVAR_API cv_status cv_solver_set_mesh(cv_solver *s, int elements, const double *t);
 /** A user mesh as cv_solver_set_mesh with its own degree 1..8 for each element
  * (degrees[0 .. elements-1], copied; theory HP-1). Nodes: 1 + the sum of the degrees.
  * cv_solver_set_degree and the other mesh setters return to one degree for all. */
-cv_status cv_solver_set_mesh_hp(cv_solver *s, int elements, const double *t,
-                                const int *degrees);
+CVAR_API cv_status cv_solver_set_mesh_hp(cv_solver *s, int elements, const double *t,
+                                         const int *degrees);
 /** Points in (a, b) at which the mesh must have nodes (where the integrand may jump), in
  * the problem's variable. The nearest element boundary is moved onto each breakpoint (the
  * mesh is split there when moving would tangle it). nb = 0 clears. */
-cv_status cv_solver_set_breakpoints(cv_solver *s, int nb, const double *xb);
+CVAR_API cv_status cv_solver_set_breakpoints(cv_solver *s, int nb, const double *xb);
 /** Tolerances on the Newton step, weighted as 1/(rtol |y_i| + atol * scale), where scale
  * is the largest end value magnitude (or 1). Both >= 0, not both 0; rtol >= 10 eps. */
-cv_status cv_solver_set_tolerances(cv_solver *s, double rtol, double atol);
+CVAR_API cv_status cv_solver_set_tolerances(cv_solver *s, double rtol, double atol);
 /** Maximum Newton iterations (>= 1). */
-cv_status cv_solver_set_max_iterations(cv_solver *s, int maxit);
+CVAR_API cv_status cv_solver_set_max_iterations(cv_solver *s, int maxit);
 
 /** Engines. Newton finds any stationary point (minimum or saddle) and reports its Morse
  * index; the NLopt minimisers find minima only (docs/engines.md). */
@@ -273,27 +317,27 @@ typedef enum {
   CVAR_METHOD_AUGLAG      /**< NLopt augmented Lagrangian around L-BFGS (equality constraints) */
 } cv_method;
 /** "newton", "lbfgs", "tnewton", "mma", "ccsaq", "slsqp", "auglag"; NULL if out of range. */
-const char *cv_method_name(cv_method m);
+CVAR_API const char *cv_method_name(cv_method m);
 /** Parse a method name; CVAR_EINVAL if unknown. */
-cv_status cv_method_from_name(const char *name, cv_method *m);
+CVAR_API cv_status cv_method_from_name(const char *name, cv_method *m);
 /** The engine of the next solve (default CVAR_METHOD_NEWTON). */
-cv_status cv_solver_set_method(cv_solver *s, cv_method m);
+CVAR_API cv_status cv_solver_set_method(cv_solver *s, cv_method m);
 /** The engine of the next solve. */
-cv_method cv_solver_get_method(const cv_solver *s);
+CVAR_API cv_method cv_solver_get_method(const cv_solver *s);
 
 /** Make the discrete action of p stationary, starting from p's guess (or, after
  * cv_solver_set_start, from given nodal values). Results stay in s until the next solve.
  * Returns CVAR_OK only when converged; otherwise a failure status, with a sentence in
  * cv_solver_last_error(). On failure the results still describe the last iterate (for
  * diagnosis) but cv_solver_get_status() tells it did not converge. */
-cv_status cv_solve(cv_solver *s, const cv_problem *p);
+CVAR_API cv_status cv_solve(cv_solver *s, const cv_problem *p);
 
 /** Automatic continuation (on by default; theory HC-2): when Newton from the start fails to
  * converge on an unconstrained problem, follow the homotopy from the start to the problem
  * in small steps before giving up. The message then says so. */
-cv_status cv_solver_set_continuation(cv_solver *s, int on);
+CVAR_API cv_status cv_solver_set_continuation(cv_solver *s, int on);
 /** Continuation steps taken by the last solve (0 when Newton converged directly). */
-int cv_solver_get_continuation_steps(const cv_solver *s);
+CVAR_API int cv_solver_get_continuation_steps(const cv_solver *s);
 
 /** Adaptive refinement at a fixed degree (theory AD-1): solve, estimate the error with the
  * enriched solve of cv_solver_estimate_error (HP-2), bisect the elements whose indicator
@@ -301,83 +345,139 @@ int cv_solver_get_continuation_steps(const cv_solver *s);
  * mesh would exceed max_elements (then CVAR_EMAXITER with a sentence). tol = 0 turns it off
  * (default). The starting mesh is the one set by the other mesh setters. Replaces a
  * cv_solver_set_tol (the last one set wins). */
-cv_status cv_solver_set_adapt(cv_solver *s, double tol, int max_elements);
+CVAR_API cv_status cv_solver_set_adapt(cv_solver *s, double tol, int max_elements);
 /** Automatic accuracy (theory HP-1..HP-4): the solver chooses the mesh and the degree of
  * each element (1..8) until its estimate of the max nodal error is at most tol (> 0), or it
  * stops with CVAR_EMAXITER and a sentence saying why (the cap on unknowns, on rounds, or the
  * round-off floor) and the estimate reached. tol = 0 turns it off (default). The starting
  * mesh is the one set by the other setters. Cannot be combined with cv_solver_set_adapt
  * (the last one set wins). */
-cv_status cv_solver_set_tol(cv_solver *s, double tol, int max_nodes);
+CVAR_API cv_status cv_solver_set_tol(cv_solver *s, double tol, int max_nodes);
 /** Estimated max nodal error of the last adaptive or --tol solve (NaN otherwise). */
-double cv_solver_get_error_estimate(const cv_solver *s);
+CVAR_API double cv_solver_get_error_estimate(const cv_solver *s);
 /** A-posteriori estimate of the max nodal error of the last (converged) solve on its own
  * mesh, from a warm-started solve on the p-enriched mesh (theory HP-2): CVAR_OK with *est
  * and (if est_vertex is not NULL) the max over the element boundaries alone, or an error
  * with a sentence in msg (cv_solver_last_error is not changed) when the enriched solve
  * failed or landed on another stationary path (theory HP-3): no bound then, NaN. */
-cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p, double *est,
-                                   double *est_vertex, char *msg, size_t len);
+CVAR_API cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p,
+                                            double *est, double *est_vertex, char *msg,
+                                            size_t len);
 /** Refinement rounds of the last adaptive solve. */
-int cv_solver_get_adapt_rounds(const cv_solver *s);
+CVAR_API int cv_solver_get_adapt_rounds(const cv_solver *s);
 
 /** Start the next solve from nodal values y (node-major, length nodes*n as laid out by
  * the current mesh and degree); NULL returns to the problem's guess. Copied. */
-cv_status cv_solver_set_start(cv_solver *s, int len, const double *y);
+CVAR_API cv_status cv_solver_set_start(cv_solver *s, int len, const double *y);
 
 /** Status of the last solve (CVAR_ESTATE before any). */
-cv_status cv_solver_get_status(const cv_solver *s);
+CVAR_API cv_status cv_solver_get_status(const cv_solver *s);
 /** One sentence about the last failure or outcome; never NULL. */
-const char *cv_solver_last_error(const cv_solver *s);
+CVAR_API const char *cv_solver_last_error(const cv_solver *s);
 /** Nodes of the mesh of the last solve, including both ends (0 before any solve). */
-int cv_solver_get_num_nodes(const cv_solver *s);
+CVAR_API int cv_solver_get_num_nodes(const cv_solver *s);
 /** Elements of the mesh of the last solve (breakpoints may have added some; 0 before any). */
-int cv_solver_get_num_elements(const cv_solver *s);
+CVAR_API int cv_solver_get_num_elements(const cv_solver *s);
 /** Polynomial degree of the elements of the last solve, the largest with per-element
  * degrees (0 before any). */
-int cv_solver_get_degree(const cv_solver *s);
+CVAR_API int cv_solver_get_degree(const cv_solver *s);
 /** Number of elements of the last solve; with degrees != NULL also writes the degree of
  * each element (0 before any solve). */
-int cv_solver_get_degrees(const cv_solver *s, int *degrees);
+CVAR_API int cv_solver_get_degrees(const cv_solver *s, int *degrees);
 /** x[j] of node j, length cv_solver_get_num_nodes(). */
-cv_status cv_solver_get_nodes(const cv_solver *s, double *x);
+CVAR_API cv_status cv_solver_get_nodes(const cv_solver *s, double *x);
 /** Nodal values, node-major: y[j*n + i] is unknown i at node j; length nodes*n. */
-cv_status cv_solver_get_values(const cv_solver *s, double *y);
+CVAR_API cv_status cv_solver_get_values(const cv_solver *s, double *y);
 /** Discrete action S_h at the last iterate. */
-double cv_solver_get_action(const cv_solver *s);
+CVAR_API double cv_solver_get_action(const cv_solver *s);
 /** Max-norm of the discrete Euler-Lagrange residual scaled by the lumped nodal weights
  * (theory (N-3)); mesh independent. */
-double cv_solver_get_gradient_norm(const cv_solver *s);
+CVAR_API double cv_solver_get_gradient_norm(const cv_solver *s);
 /** Newton (or minimiser) iterations of the last solve. */
-int cv_solver_get_num_iterations(const cv_solver *s);
+CVAR_API int cv_solver_get_num_iterations(const cv_solver *s);
 /** Wall-clock seconds of the last cv_solve. */
-double cv_solver_get_time(const cv_solver *s);
+CVAR_API double cv_solver_get_time(const cv_solver *s);
 /** Number of negative pivots of the LDL^T factor of the Hessian at the last iterate (the
  * Morse index), or -1 when unknown. */
-int cv_solver_get_morse_index(const cv_solver *s);
+CVAR_API int cv_solver_get_morse_index(const cv_solver *s);
 /** Nonzero when the Hessian at the last iterate has a (numerically) zero pivot. */
-int cv_solver_get_degenerate(const cv_solver *s);
+CVAR_API int cv_solver_get_degenerate(const cv_solver *s);
 /** Dimension of the discrete problem: free scalar nodal values minus constraint rows (the
  * largest possible Morse index). */
-int cv_solver_get_num_free(const cv_solver *s);
+CVAR_API int cv_solver_get_num_free(const cv_solver *s);
 
 /** The multiplier field of pointwise constraint k at the nodes of the last solve,
  * lambda[j], j < cv_solver_get_num_nodes(). At an end node whose unknowns are all fixed
  * (no multiplier there) the value is extrapolated from the neighbouring nodes. */
-cv_status cv_solver_get_multiplier_field(const cv_solver *s, int k, double *lambda);
+CVAR_API cv_status cv_solver_get_multiplier_field(const cv_solver *s, int k, double *lambda);
 /** The scalar multiplier of integral constraint k of the last solve. */
-cv_status cv_solver_get_multiplier(const cv_solver *s, int k, double *mu);
+CVAR_API cv_status cv_solver_get_multiplier(const cv_solver *s, int k, double *mu);
 
 /** Number nq of quadrature points of the last solve's mesh (0 before any). */
-int cv_solver_get_num_qpoints(const cv_solver *s);
+CVAR_API int cv_solver_get_num_qpoints(const cv_solver *s);
 /** Quadrature points of the last solve's mesh with their weights and the solution there.
  * Each output may be NULL. x, w: length nq; y, dy: n*nq, laid out y[i*nq + k] (structure of
  * arrays). Sum_k w[k] g(x[k]) is the solver's integral of g. */
-cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double *y,
+CVAR_API cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double *y,
                                 double *dy);
 /** Evaluate the last solution (degree-p interpolant) at m abscissae in [a, b]:
  * y[i*m + k] and, if dy != NULL, y'[i*m + k]. */
-cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y, double *dy);
+CVAR_API cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y, double *dy);
+/**@}*/
+
+/** \name Scene files: a problem and its options from the scene format (docs/scenes.md)
+ * The loader the calcvar command uses. A scene is loaded from a file or from text, with
+ * optional `name=value` overrides of its [parameters]; every failure is one sentence
+ * "FILE:LINE: what is wrong" in the caller's err buffer (errlen bytes; 1024 is ample).
+ * A problem made from a scene refers to it: free the problem before the scene. */
+/**@{*/
+/** A loaded scene. Opaque; made by cv_scene_load_file or cv_scene_load_text, released by
+ * cv_scene_free. */
+typedef struct cv_scene cv_scene;
+/** Load the scene file at path. set: nset strings "name=value" (value a constant
+ * expression) overriding [parameters]; NULL when nset is 0. NULL on failure, with the
+ * sentence in err. */
+CVAR_API cv_scene *cv_scene_load_file(const char *path, int nset, const char *const *set,
+                                      char *err, size_t errlen);
+/** Load a scene from NUL-terminated text; name (NULL: "<text>") stands for the file in
+ * messages. Otherwise as cv_scene_load_file. */
+CVAR_API cv_scene *cv_scene_load_text(const char *text, const char *name, int nset,
+                                      const char *const *set, char *err, size_t errlen);
+/** Release a scene; NULL is a no-op. */
+CVAR_API void cv_scene_free(cv_scene *sc);
+/** The number of unknowns. */
+CVAR_API int cv_scene_get_num_unknowns(const cv_scene *sc);
+/** The name of unknown i (NULL when out of range); owned by the scene. */
+CVAR_API const char *cv_scene_get_unknown(const cv_scene *sc, int i);
+/** The scene's title and its variable's name; owned by the scene, never NULL. */
+CVAR_API const char *cv_scene_get_title(const cv_scene *sc);
+/** The name of the independent variable ("x" unless the scene says otherwise). */
+CVAR_API const char *cv_scene_get_variable(const cv_scene *sc);
+/** Override a [mesh] or [solver] setting before cv_scene_problem_new and
+ * cv_scene_configure_solver, as the command's options do: "elements", "degree",
+ * "tolerance", "max_iterations", "adapt" (a number), "method" (a cv_method value).
+ * CVAR_EINVAL for an unknown name or a value out of range, with a sentence in err. */
+CVAR_API cv_status cv_scene_set_option(cv_scene *sc, const char *name, double value,
+                                       char *err, size_t errlen);
+/** A problem for the scene: integrand, ends, guess, [constraints], [integrals]. NULL on
+ * failure (sentence in err). Free it (cv_problem_free) before the scene. */
+CVAR_API cv_problem *cv_scene_problem_new(const cv_scene *sc, char *err, size_t errlen);
+/** Apply the scene's [mesh] and [solver] (and cv_scene_set_option overrides) to a solver. */
+CVAR_API cv_status cv_scene_configure_solver(const cv_scene *sc, cv_solver *s, char *err,
+                                             size_t errlen);
+
+/** The report of a solve, as `calcvar solve --json` writes it (docs/cli.md): the same keys,
+ * built by the same code. Opaque; released by cv_report_free. */
+typedef struct cv_report cv_report;
+/** The report of the last cv_solve of s on p, a problem of sc (s is not modified). Without
+ * [exact] it estimates the nodal error by a reference solve (docs/cli.md), as the command
+ * does. NULL on failure (*why, may be NULL: CVAR_ESTATE before a solve, CVAR_ENOMEM). */
+CVAR_API cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *s,
+                                  cv_status *why);
+/** The report as JSON text (UTF-8, NUL-terminated), owned by the report. */
+CVAR_API const char *cv_report_json(const cv_report *r);
+/** Release a report; NULL is a no-op. */
+CVAR_API void cv_report_free(cv_report *r);
 /**@}*/
 
 #ifdef __cplusplus

@@ -115,9 +115,11 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
       if (parse_int(v, 1, INT_MAX, &o->max_iterations) < 0)
         return bad(cmd, "--max-iterations needs a whole number >= 1, got '%s'", v);
     } else if (strcmp(name, "--method") == 0) {
-      if ((o->method = scene_method_from_name(v)) < 0)
+      cv_method m;
+      if (cv_method_from_name(v, &m) != CVAR_OK)
         return bad(cmd, "unknown method '%s' (known: newton, lbfgs, tnewton, mma, ccsaq, "
                    "slsqp, auglag)", v);
+      o->method = (int)m;
     } else if (strcmp(name, "--tolerance") == 0) {
       if (parse_pos_double(v, &o->tolerance) < 0 || o->tolerance < 10 * DBL_EPSILON ||
           o->tolerance >= 1)

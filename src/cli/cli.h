@@ -7,6 +7,7 @@
 
 #include "calcvar.h"
 #include "scene/scene.h"
+#include "scene/scene_report.h"
 
 /* Exit statuses of SCENES.md. */
 enum { EXIT_SOLVED = 0, EXIT_UNSOLVED = 1, EXIT_BADINPUT = 2 };
@@ -15,7 +16,7 @@ enum { EXIT_SOLVED = 0, EXIT_UNSOLVED = 1, EXIT_BADINPUT = 2 };
 typedef struct {
   const char *scene_path;
   int elements, degree, max_iterations;
-  int method; /* sc_method or -1 */
+  int method; /* cv_method or -1 */
   double tolerance;
   double adapt;
   double tol; /* --tol: automatic accuracy (hp) */
@@ -38,50 +39,6 @@ int cli_only_scene_options(const char *cmd, const cli_opts *o);
 int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver **svp,
                        cv_status *stp, char *cont_msg, size_t cmlen, char *err, size_t errlen);
 
-/* What `solve` reports; has_* flags say which keys apply (SCENES.md: keys that do not
- * apply are left out). report.c fills it from a solver and its scene. */
-typedef struct {
-  const scene *sc;
-  sc_method method;
-  cv_status st;
-  const char *status;
-  char message[640];
-  int elements, degree, nodes, n;
-  int *degrees; /* degree of each element (--tol: reported), or NULL */
-  int has_degrees;
-  int has_action, has_gradient_norm, has_time;
-  double action, gradient_norm, time_s;
-  int iterations;
-  int has_morse;
-  int morse;
-  const char *kind;
-  int has_err_nodal, has_err_action, has_err_est;
-  double err_nodal, err_action, err_est;
-  int has_energy;
-  double emin, emax;
-  int *has_mom;
-  double *mom_min, *mom_max;
-  int *has_rep;
-  double *rep;
-  double *x, *y; /* nodes and node-major values y[j*n + i] */
-  double *lam;   /* multiplier fields lam[c*nodes + j] of [constraints], or NULL */
-  int *has_mu;   /* [integrals] multipliers */
-  double *mu;
-} cli_report;
-
-const char *cli_status_string(cv_status st);
-int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_status st);
-/* estimate.c: the max nodal error of the solver's last solve, from the core's estimator
- * (theory HP-2, HP-3; docs/cli.md). cli_estimate_error gives the max over all nodes and
- * over the element boundaries (NaN, and the reason in why, when there is no bound);
- * cli_report_estimate puts it into r (or the reason into its message). Both return 0, or
- * -1 on allocation failure. */
-int cli_report_estimate(cli_report *r, const cv_solver *sv, const cv_problem *p);
-int cli_estimate_error(const cv_solver *sv, const cv_problem *p, double *e_all,
-                       double *e_vertex, char *why, size_t len);
-void cli_report_free(cli_report *r);
-
-int cli_report_json(FILE *f, const cli_report *r);
 int cli_report_csv(FILE *f, const cli_report *r);
 void cli_report_text(FILE *f, const cli_report *r);
 
@@ -128,7 +85,6 @@ typedef struct {
 int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_converge_json(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_plot_converge(cli_outfile *o, const cli_conv_row *rows, int nrows);
-struct json_t *cli_report_json_object(const cli_report *r);
 
 /* Subcommands. */
 int cli_converge(int argc, char **argv);
@@ -139,7 +95,7 @@ int cli_equations(int argc, char **argv); /* cli_equations.c */
 int cli_modes(int argc, char **argv);     /* cli_modes.c */
 int cli_unsupported(const char *cmd);
 
-/* gallery_scenes.c */
+/* gallery_scenes.c, generated from examples/scenes by src/cli/embed_scenes.py */
 typedef struct {
   const char *name;
   const char *text;

@@ -49,7 +49,7 @@ int cli_check(int argc, char **argv)
     return EXIT_BADINPUT;
   }
   if (o.method >= 0)
-    s->method = (sc_method)o.method;
+    s->method = (cv_method)o.method;
   int n = s->n;
   printf("%s (%s)\n", s->title, s->file);
   printf("  variable     %s on [%.15g, %.15g]\n", s->variable, s->a, s->b);
@@ -81,7 +81,7 @@ int cli_check(int argc, char **argv)
     printf("               (these conservation laws hold for F alone: constraints that "
            "involve %s or the unknowns can break them)\n", s->variable);
   unsigned need = scene_method_need(s->method);
-  printf("  method       %s needs F, dF/dy, dF/dy'%s\n", scene_method_name(s->method),
+  printf("  method       %s needs F, dF/dy, dF/dy'%s\n", cv_method_name(s->method),
          need & CVAR_NEED_HESS ? " and the second partials (y,y), (y,y'), (y',y')" : "");
 
   if (!(p = scene_problem_new(s, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, err,

@@ -31,7 +31,7 @@ static int load_at(const cli_opts *o, const char *name, double value, scene **s,
   if (!*s) return -1;
   if (over->elements) (*s)->elements = over->elements;
   if (over->degree) (*s)->degree = over->degree;
-  if (over->method >= 0) (*s)->method = (sc_method)over->method;
+  if (over->method >= 0) (*s)->method = (cv_method)over->method;
   if (over->tolerance > 0) (*s)->tolerance = over->tolerance;
   if (over->max_iterations) (*s)->max_iterations = over->max_iterations;
   *p = scene_problem_new(*s, scene_method_need((*s)->method), err, errlen);

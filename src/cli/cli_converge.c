@@ -192,7 +192,7 @@ static int solve_row(scene *s, const cv_problem *p, int any_exact, cli_conv_row 
   }
   if (!best)
     return -1;
-  int rc = cli_report_collect(&row->r, s, best, s->method, st);
+  int rc = cli_report_collect(&row->r, s, p, best, s->method, st);
   double ea = NAN, ev = NAN;
   char why[400];
   if (rc == 0 && !any_exact && row->r.nodes > 0 && st == CVAR_OK)
@@ -284,7 +284,7 @@ int cli_converge(int argc, char **argv)
   if (c.ndeg == 0)
     c.deg[c.ndeg++] = s->degree;
   if (o.method >= 0)
-    s->method = (sc_method)o.method;
+    s->method = (cv_method)o.method;
   if (o.tolerance > 0)
     s->tolerance = o.tolerance;
   if (o.max_iterations)

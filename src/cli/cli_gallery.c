@@ -1,11 +1,15 @@
-/* src/cli/cli_gallery.c — `calcvar` with no arguments: solve the built-in scenes and print
- * one row each (title, status, action, error, Morse index, time).
+/* src/cli/cli_gallery.c — `calcvar` with no arguments: solve the scenes of examples/scenes
+ * (embedded at build time, src/cli/embed_scenes.py) and print one row each (title, status,
+ * action, error, Morse index, time).
  * SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "cli/cli.h"
+
+/* Width of the title column: the longest title of examples/scenes fits. */
+enum { TITLE_W = 60 };
 
 /* One gallery row; returns 0 when the scene converged. */
 static int run_one(const cli_gallery_scene *g)
@@ -19,13 +23,13 @@ static int run_one(const cli_gallery_scene *g)
   cv_solver *sv = p ? cv_solver_new(&why) : NULL;
   int rc = 1;
   if (!sv || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK) {
-    printf("%-40s  %s\n", s ? s->title : g->name, err[0] ? err : "out of memory");
+    printf("%-*s  %s\n", TITLE_W, s ? s->title : g->name, err[0] ? err : "out of memory");
     goto done;
   }
   cv_status st = cv_solve(sv, p);
   cli_report r;
-  if (cli_report_collect(&r, s, sv, s->method, st) < 0) {
-    printf("%-40s  out of memory\n", s->title);
+  if (cli_report_collect(&r, s, p, sv, s->method, st) < 0) {
+    printf("%-*s  out of memory\n", TITLE_W, s->title);
     cli_report_free(&r);
     goto done;
   }
@@ -33,7 +37,7 @@ static int run_one(const cli_gallery_scene *g)
   for (int i = 0; i < s->n; i++)
     any_exact |= s->exact[i] >= 0;
   if (!any_exact && !r.has_err_action && cli_report_estimate(&r, sv, p) < 0) {
-    printf("%-40s  out of memory\n", s->title);
+    printf("%-*s  out of memory\n", TITLE_W, s->title);
     cli_report_free(&r);
     goto done;
   }
@@ -50,7 +54,7 @@ static int run_one(const cli_gallery_scene *g)
     snprintf(morse, sizeof morse, "%d", r.morse);
   if (r.has_time)
     snprintf(tm, sizeof tm, "%.4f", r.time_s);
-  printf("%-40s %-14s %17s %16s %5s %9s\n", s->title, r.status, act, errs, morse, tm);
+  printf("%-*s %-14s %17s %16s %5s %9s\n", TITLE_W, s->title, r.status, act, errs, morse, tm);
   rc = st == CVAR_OK ? 0 : 1;
   cli_report_free(&r);
 done:
@@ -65,8 +69,8 @@ int cli_gallery(void)
   int failed = 0;
   printf("calcvar gallery: variational problems solved by direct discretisation\n"
          "(calcvar --help for the commands; calcvar solve SCENE for your own)\n\n");
-  printf("%-40s %-14s %17s %16s %5s %9s\n", "scene", "status", "action", "error", "Morse",
-         "time [s]");
+  printf("%-*s %-14s %17s %16s %5s %9s\n", TITLE_W, "scene", "status", "action", "error",
+         "Morse", "time [s]");
   for (int i = 0; i < cli_gallery_count; i++)
     failed += run_one(&cli_gallery_scenes[i]);
   if (failed)

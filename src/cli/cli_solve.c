@@ -48,14 +48,14 @@ static int unsupported(const cli_opts *o, const scene *s)
             "(continuation keeps one mesh)\n");
     return EXIT_BADINPUT;
   }
-  if ((s->method == SC_LBFGS || s->method == SC_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
+  if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
     /* an unconstrained minimiser cannot impose [constraints] or [integrals] */
     if (o->method >= 0)
       fprintf(stderr, "calcvar solve: --method %s cannot impose constraints; use mma, ccsaq, "
-              "slsqp, auglag or newton\n", scene_method_name(s->method));
+              "slsqp, auglag or newton\n", cv_method_name(s->method));
     else
       fprintf(stderr, "%s:%d: method %s cannot impose constraints; use mma, ccsaq, slsqp, "
-              "auglag or newton\n", s->file, s->method_line, scene_method_name(s->method));
+              "auglag or newton\n", s->file, s->method_line, cv_method_name(s->method));
     return EXIT_BADINPUT;
   }
   return 0;
@@ -88,7 +88,7 @@ int cli_solve(int argc, char **argv)
   if (o.degree)
     s->degree = o.degree;
   if (o.method >= 0)
-    s->method = (sc_method)o.method;
+    s->method = (cv_method)o.method;
   if (o.tolerance > 0)
     s->tolerance = o.tolerance;
   if (o.max_iterations)
@@ -147,7 +147,7 @@ int cli_solve(int argc, char **argv)
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if (cli_report_collect(&r, s, sv, s->method, st) < 0) {
+  if (cli_report_build(&r, s, p, sv, st, tol > 0 ? 2 : adapt > 0) < 0) {
     fprintf(stderr, "calcvar solve: out of memory while reporting\n");
     rc = EXIT_UNSOLVED;
     goto done;
@@ -158,25 +158,6 @@ int cli_solve(int argc, char **argv)
                                                       : cont_msg[0];
     snprintf(r.message + used, sizeof r.message - used, "%s%c%s.", used ? " " : "", c0,
              cont_msg + 1);
-  }
-  int any_exact = 0;
-  for (int i = 0; i < s->n; i++)
-    any_exact |= s->exact[i] >= 0;
-  if (tol > 0) {
-    /* --tol: the rounds' own estimate, always (SCENES.md), and the degrees */
-    double est = cv_solver_get_error_estimate(sv);
-    r.has_err_est = isfinite(est);
-    r.err_est = est;
-    r.has_degrees = 1;
-  } else if (adapt > 0) {
-    /* the adaptive solve's own estimate */
-    double est = cv_solver_get_error_estimate(sv);
-    r.has_err_est = !any_exact && isfinite(est);
-    r.err_est = est;
-  } else if (!any_exact && cli_report_estimate(&r, sv, p) < 0) {
-    fprintf(stderr, "calcvar solve: out of memory while estimating the error\n");
-    rc = EXIT_UNSOLVED;
-    goto done;
   }
   rc = st == CVAR_OK ? EXIT_SOLVED : EXIT_UNSOLVED;
   if (jf.f && (cli_report_json(jf.f, &r) < 0 || cli_outfile_commit(&jf) < 0)) {

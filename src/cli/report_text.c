@@ -7,7 +7,7 @@ void cli_report_text(FILE *f, const cli_report *r)
   const scene *s = r->sc;
   fprintf(f, "%s\n", s->title);
   fprintf(f, "  status      %s: %s\n", r->status, r->message);
-  fprintf(f, "  method      %s, %d iteration%s", scene_method_name(r->method), r->iterations,
+  fprintf(f, "  method      %s, %d iteration%s", cv_method_name(r->method), r->iterations,
           r->iterations == 1 ? "" : "s");
   if (r->has_time)
     fprintf(f, ", %.3g s", r->time_s);

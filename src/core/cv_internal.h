@@ -5,7 +5,7 @@
 
 #include <stddef.h>
 #include "calcvar.h"
-#include "cv_internal_owned.h"
+#include "cv_memory.h" /* the one allocator (tests may inject failures) */
 
 /* Largest batch handed to an integrand callback (documented in calcvar.h). */
 #define CV_BATCH 256
@@ -15,23 +15,17 @@
 /* The round-off floor of an error estimate, in units of eps times the values' size (HP-2). */
 #define CV_ROUNDOFF_ULPS 256.0
 
-/* ---- memory: the one allocator (tests may inject failures) ---- */
-void *cv_malloc(size_t n);
-void *cv_calloc(size_t count, size_t size);
-void cv_free(void *ptr);
-/* Fail the k-th allocation from now on (k >= 0); -1 disables. For tests only. */
-void cv_debug_fail_alloc_after(long k);
 
 typedef struct {
   cv_constraint_fn G;
   void *user;
-  void (*release)(void *);
+  cv_release_fn release;
 } cv_pconstraint;
 
 typedef struct {
   cv_integrand_fn K;
   void *user;
-  void (*release)(void *);
+  cv_release_fn release;
   double c;
 } cv_iconstraint;
 
@@ -43,7 +37,7 @@ struct cv_problem {
   double a, b;
   cv_integrand_fn F;
   void *user;
-  void (*release)(void *);
+  cv_release_fn release;
   int *fixed;      /* fixed[2*k + end]: 1 fixed, 0 free (natural condition) */
   double *endval;  /* endval[2*k + end] */
   cv_guess_fn guess;
@@ -265,8 +259,20 @@ struct cv_solver {
   int hp;                      /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
+  int near_sing[2];            /* ends found nearly singular after a solve */
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
+/* The start of a solve (cv_start.c): cv_start_setup discretises the current mesh spec,
+ * allocates the results and fills s->y with the starting values and flags singular ends;
+ * cv_start_values fills Y with the given start / guess, or (line = 1) the straight line. */
+cv_status cv_start_setup(cv_solver *s, const cv_problem *p);
+cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y,
+                          int line);
+/* After a solve: is the integrand at end `end` (0 = a, 1 = b) nearly singular, so that
+ * the end element's rule under-integrates it (theory Q-3)? *rel: the relative change of
+ * the action under the singular-end rule there. */
+int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
+                            double action, double *rel);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
 /* ---- error estimate and hp decisions (cv_estimate.c, cv_hp.c) ---- */
 /* Start s (mesh set) from `from` interpolated at its nodes. */

@@ -2,7 +2,7 @@
  * SPDX-License-Identifier: MIT */
 #include <stdlib.h>
 
-#include "cv_internal.h"
+#include "cv_memory.h"
 
 /* Countdown to an injected failure; -1 = never. Only tests set it (single-threaded). */
 static long fail_after = -1;
@@ -24,6 +24,11 @@ void *cv_malloc(size_t n) {
 void *cv_calloc(size_t count, size_t size) {
   if (should_fail()) return NULL;
   return calloc(count ? count : 1, size ? size : 1);
+}
+
+void *cv_realloc(void *ptr, size_t n) {
+  if (should_fail()) return NULL;
+  return realloc(ptr, n ? n : 1);
 }
 
 void cv_free(void *ptr) { free(ptr); }

@@ -1,5 +1,5 @@
 /* src/core/cv_newton.c — Newton's method on the discrete Euler-Lagrange (or, with
- * constraints, Lagrangian) system with a line search, theory (N-1)-(N-5), (C-4).
+ * constraints, Lagrangian) system with a line search, theory (N-1)-(N-6), (C-4).
  * SPDX-License-Identifier: MIT */
 #include <float.h>
 #include <math.h>
@@ -15,6 +15,10 @@
 #define MAX_BACKTRACK 40
 #define ARMIJO 1e-4
 #define REFINE_STEPS 2
+/* The shifted factorisations of (N-6): a pivot ratio below this is not trusted for the
+ * inertia, and the refinement stops after this many sweeps. */
+#define SHIFT_PIVOT 1e-13
+#define SHIFT_REFINE_MAX 100
 
 typedef struct {
   const cv_disc *d;
@@ -22,6 +26,8 @@ typedef struct {
   const int *colptr; /* the pattern, owned by L */
   cv_ldlt *L;
   double *g, *gt, *delta, *Yt, *Mt, *dreg, *corr;
+  double *dsave, *x0; /* diagonal of H and first solve of the shifted factor (N-6), lazily */
+  double tau;         /* shift of the factor in L (0: L is the factor of H itself) */
 } newton_ws;
 
 static void ws_free(newton_ws *w) {
@@ -34,6 +40,8 @@ static void ws_free(newton_ws *w) {
   cv_free(w->Mt);
   cv_free(w->dreg);
   cv_free(w->corr);
+  cv_free(w->dsave);
+  cv_free(w->x0);
 }
 
 /* Every array here is a fresh page range of a large solve, and faulting it in is a large
@@ -118,6 +126,108 @@ static cv_status solve_refined(newton_ws *w, int nf, int regularised) {
     for (int f = 0; f < nf && !st; f++) w->delta[f] += w->corr[f];
   }
   return st;
+}
+
+/* Set the diagonal of the y rows to dsave + tau m (the multiplier rows keep theirs). */
+static void set_shift(newton_ws *w, double *Ax, double tau) {
+  const cv_disc *d = w->d;
+  for (int f = 0; f < d->nfree; f++)
+    if (w->gof[f] >= 0) Ax[w->colptr[f + 1] - 1] = w->dsave[f] + tau * d->mass[f];
+}
+
+/* A tiny or zero pivot of H need not mean that H is singular: LDL^T without pivoting
+ * meets one whenever a leading block of H is singular, which happens when a conjugate
+ * point of the discrete path falls on a mesh node although H itself is regular (theory
+ * N-6). Factor H + sigma M and H - sigma M (M the lumped weights of the y rows, sigma far
+ * below the problem's own eigenvalues, far above round-off): by Sylvester's law their
+ * negative pivots count the eigenvalues of the pencil (H, M) below -sigma and below
+ * +sigma. Equal counts prove that no eigenvalue lies in [-sigma, sigma): H is regular and
+ * its inertia is that count. L then holds the factor of H + (sigma/4) M, from which
+ * solve_step refines the step of H itself. Returns CVAR_OK with *neg, or CVAR_ESINGULAR
+ * (the counts differ: H is (nearly) singular, or a shifted pivot is itself tiny). */
+static cv_status factor_shifted(newton_ws *w, double *Ax, int *neg, char *detail,
+                                size_t len) {
+  const cv_disc *d = w->d;
+  int nf = d->nfree, cnt[2] = {-1, -2};
+  double lam = 0.0;
+  if (!w->dsave) w->dsave = cv_malloc((size_t)nf * sizeof *w->dsave);
+  if (!w->x0) w->x0 = cv_malloc((size_t)nf * sizeof *w->x0);
+  if (!w->corr) w->corr = cv_malloc((size_t)nf * sizeof *w->corr);
+  if (!w->dsave || !w->x0 || !w->corr) return CVAR_ENOMEM;
+  for (int f = 0; f < nf; f++) {
+    w->dsave[f] = Ax[w->colptr[f + 1] - 1];
+    if (w->gof[f] >= 0) lam = fmax(lam, fabs(w->dsave[f]) * d->imass[f]);
+  }
+  /* lam ~ c F_y'y' (p^2 / h)^2 is the top of the spectrum; lam / (E p^2)^2 is the scale
+   * of its bottom (c F_y'y' / (b - a)^2); sigma is 10^-6 of that, and at least 10^3 eps
+   * lam so that the shift survives the round-off of the diagonal. */
+  double ep = (double)d->E * d->p * d->p;
+  double sigma = fmax(1e-6 * lam / (ep * ep), 1e3 * DBL_EPSILON * lam);
+  if (!(sigma > 0.0) || !isfinite(sigma)) return CVAR_ESINGULAR;
+  for (int k = 0; k < 2; k++) {
+    double dmin, dmax;
+    set_shift(w, Ax, k ? -sigma : sigma);
+    cv_status st = cv_ldlt_factor(w->L, &cnt[k], &dmin, &dmax, detail, len);
+    if (st == CVAR_ESINGULAR || (st == CVAR_OK && !(dmin > SHIFT_PIVOT))) cnt[k] = -1 - k;
+    else if (st) return st;
+  }
+  cv_status st = CVAR_ESINGULAR;
+  if (cnt[0] == cnt[1]) {
+    double dmin, dmax;
+    int nq;
+    w->tau = 0.25 * sigma;
+    set_shift(w, Ax, w->tau);
+    st = cv_ldlt_factor(w->L, &nq, &dmin, &dmax, detail, len);
+    if (st == CVAR_OK && !(dmin > SHIFT_PIVOT)) st = CVAR_ESINGULAR;
+    *neg = cnt[0];
+  }
+  if (st) w->tau = 0.0;
+  set_shift(w, Ax, 0.0); /* the factor stays in L; Ax is H again */
+  return st;
+}
+
+/* r <- b - K x, K the unregularised matrix: the upper triangle in Ax (column c holds rows
+ * c + 1 - length .. c) plus dreg on the multiplier rows. */
+static void residual_of(const newton_ws *w, const double *Ax, int constrained, const double *b,
+                        const double *x, double *r) {
+  int nf = w->d->nfree;
+  for (int f = 0; f < nf; f++) r[f] = b[f] - (constrained ? w->dreg[f] * x[f] : 0.0);
+  for (int c = 0; c < nf; c++) {
+    int k0 = w->colptr[c], len = w->colptr[c + 1] - k0, r0 = c + 1 - len;
+    double xc = x[c], acc = 0.0;
+    for (int k = 0; k < len - 1; k++) {
+      r[r0 + k] -= Ax[k0 + k] * xc;
+      acc += Ax[k0 + k] * x[r0 + k];
+    }
+    r[c] -= acc + Ax[k0 + len - 1] * xc;
+  }
+}
+
+/* delta <- K^{-1} delta with L the factor of the shifted matrix (N-6), by iterative
+ * refinement on the true residual: x_{k+1} = x_k + L^{-1} (b - K x_k). The shift and the
+ * element growth of the shifted factor (a leading block close to singular) both enter its
+ * rate, at most 1/3 from the shift for the pencil's eigenvalues outside [-4 tau, 4 tau).
+ * Stops when a correction is below 4 eps of the step, or stops shrinking. */
+static cv_status solve_shifted(newton_ws *w, const double *Ax, int constrained) {
+  int nf = w->d->nfree;
+  memcpy(w->x0, w->delta, (size_t)nf * sizeof *w->x0); /* b */
+  cv_status st = cv_ldlt_solve(w->L, w->delta);
+  double last = INFINITY;
+  for (int it = 0; it < SHIFT_REFINE_MAX && !st; it++) {
+    residual_of(w, Ax, constrained, w->x0, w->delta, w->corr);
+    st = cv_ldlt_solve(w->L, w->corr);
+    double change = 0.0, size = 0.0;
+    for (int f = 0; f < nf && !st; f++) {
+      w->delta[f] += w->corr[f];
+      change = fmax(change, fabs(w->corr[f]));
+      size = fmax(size, fabs(w->delta[f]));
+    }
+    if (!st && !isfinite(size)) st = CVAR_ENONFINITE;
+    if (!st && (!(change > 4 * DBL_EPSILON * size) || !(change < 0.5 * last)))
+      return change <= 1e-8 * size ? CVAR_OK : CVAR_ESINGULAR;
+    last = change;
+  }
+  return st ? st : CVAR_ESINGULAR;
 }
 
 /* Yt = Y + alpha delta on the free unknowns; the fixed values of Yt were set once. */
@@ -205,6 +315,13 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     double tf = timed ? cv_now() : 0.0;
     st = cv_ldlt_factor(w.L, &neg, &dmin, &dmax, detail, sizeof detail);
     if (st == CVAR_OK && !(dmin > DEGENERATE_PIVOT)) st = CVAR_ESINGULAR;
+    w.tau = 0.0;
+    if (st == CVAR_ESINGULAR) { /* a singular leading block, or H itself (N-6) */
+      int negs = neg;
+      cv_status sst = factor_shifted(&w, Ax, &negs, detail, sizeof detail);
+      if (sst == CVAR_OK) st = CVAR_OK, neg = negs;
+      else if (sst != CVAR_ESINGULAR) st = sst;
+    }
     if (st) {
       if (st == CVAR_ESINGULAR) {
         s->degenerate = 1;
@@ -227,10 +344,13 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     /* Each constraint row adds one negative pivot to a quasi-definite KKT matrix (N-1). */
     s->morse = neg - ncon;
     for (int f = 0; f < nf; f++) w.delta[f] = -w.g[f];
-    st = solve_refined(&w, nf, constrained);
+    st = w.tau != 0.0 ? solve_shifted(&w, Ax, constrained) : solve_refined(&w, nf, constrained);
     if (timed) s->t_factor += cv_now() - tf;
     if (st) {
-      cv_set_msg(s->msg, sizeof s->msg, "CHOLMOD solve failed");
+      cv_set_msg(s->msg, sizeof s->msg, "%s",
+                 st == CVAR_ESINGULAR ? "the Hessian is nearly singular: the refinement of "
+                                        "the step from its shifted factor did not converge"
+                                      : "CHOLMOD solve failed");
       goto cleanup;
     }
     s->iterations++;

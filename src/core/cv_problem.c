@@ -56,7 +56,7 @@ void cv_problem_free(cv_problem *p) {
 }
 
 cv_status cv_problem_set_integrand_owned(cv_problem *p, cv_integrand_fn F, void *user,
-                                         void (*release)(void *)) {
+                                         cv_release_fn release) {
   if (!p || !F) {
     if (release) release(user);
     return CVAR_EINVAL;
@@ -109,7 +109,7 @@ void cv_problem_get_interval(const cv_problem *p, double *a, double *b) {
 }
 
 cv_status cv_problem_add_constraint_owned(cv_problem *p, cv_constraint_fn G, void *user,
-                                          void (*release)(void *), int *index) {
+                                          cv_release_fn release, int *index) {
   cv_pconstraint *grown;
   if (!p || !G) {
     if (release) release(user);
@@ -134,7 +134,7 @@ cv_status cv_problem_add_constraint(cv_problem *p, cv_constraint_fn G, void *use
 }
 
 cv_status cv_problem_add_integral_owned(cv_problem *p, cv_integrand_fn K, void *user,
-                                        void (*release)(void *), double c, int *index) {
+                                        cv_release_fn release, double c, int *index) {
   cv_iconstraint *grown;
   if (!p || !K || !isfinite(c)) {
     if (release) release(user);

@@ -1,5 +1,6 @@
-/* src/expr/cv_integrand_expr.c — cv_problem_set_integrand_expr: an integrand given as a
- * formula string, compiled with exact symbolic partials. SPDX-License-Identifier: MIT */
+/* src/expr/cv_integrand_expr.c — cv_problem_set_integrand_expr and the formula constraints
+ * (cv_problem_add_constraint_expr, cv_problem_add_integral_expr): formula strings compiled
+ * with exact symbolic partials. SPDX-License-Identifier: MIT */
 #include <ctype.h>
 #include <math.h>
 #include <stdarg.h>
@@ -8,7 +9,6 @@
 #include <string.h>
 
 #include "calcvar.h"
-#include "core/cv_internal_owned.h"
 #include "expr/ex_integrand.h"
 
 /* Names known while parsing: the variable (slot 0), the unknowns (slots 1..n, primed
@@ -66,78 +66,35 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
   return e;
 }
 
-/* Split s at commas outside parentheses into a NULL-terminated array of trimmed copies,
- * released with free_list. Returns NULL on allocation failure. */
-static char **split(const char *s, int *count) {
-  size_t len = strlen(s);
-  int parts = 1, depth = 0;
-  for (size_t i = 0; i < len; i++) {
-    if (s[i] == '(') depth++;
-    else if (s[i] == ')') depth--;
-    else if (s[i] == ',' && depth == 0) parts++;
-  }
-  char **list = calloc((size_t)parts + 1, sizeof *list);
-  if (!list) return NULL;
-  size_t start = 0;
-  int k = 0;
-  depth = 0;
-  for (size_t i = 0; i <= len; i++) {
-    if (i < len && s[i] == '(') depth++;
-    else if (i < len && s[i] == ')') depth--;
-    if (i == len || (s[i] == ',' && depth == 0)) {
-      size_t a = start, b = i;
-      while (a < b && isspace((unsigned char)s[a])) a++;
-      while (b > a && isspace((unsigned char)s[b - 1])) b--;
-      list[k] = malloc(b - a + 1);
-      if (!list[k]) {
-        for (int j = 0; j < k; j++) free(list[j]);
-        free(list);
-        return NULL;
-      }
-      memcpy(list[k], s + a, b - a);
-      list[k][b - a] = 0;
-      k++;
-      start = i + 1;
-    }
-  }
-  *count = k;
-  return list;
-}
-
-static void free_list(char **list) {
-  if (!list) return;
-  for (int i = 0; list[i]; i++) free(list[i]);
-  free(list);
-}
-
-static const char *const reserved[] = {"pi", "sin", "cos", "tan", "asin", "acos", "atan",
-                                       "sinh", "cosh", "tanh", "asinh", "acosh", "atanh",
-                                       "exp", "log", "sqrt", "abs", "atan2", "pow", "min",
-                                       "max", "if"};
-
 /* A usable name: an identifier that is neither a function nor pi. Returns the reason
  * it is not, or NULL. */
 static const char *bad_name(const char *s) {
   if (!s[0]) return "is empty";
   if (!(isalpha((unsigned char)s[0]) || s[0] == '_')) return "does not start with a letter";
-  for (const char *q = s; *q; q++)
-    if (!(isalnum((unsigned char)*q) || *q == '_')) return "is not a name (letters, digits, _)";
-  for (size_t i = 0; i < sizeof reserved / sizeof reserved[0]; i++)
-    if (strcmp(s, reserved[i]) == 0) return "is reserved (a function or pi)";
+  if (!ex_is_identifier(s)) return "is not a name (letters, digits, _)";
+  if (ex_is_reserved(s)) return "is reserved (a function or pi)";
   return NULL;
 }
 
-cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
-                                        const char *unknowns, const char *F,
-                                        const char *parameters, char *err, size_t errlen) {
+/* The kinds of formula a problem takes: what the formula is called in messages. */
+typedef enum { FORMULA_INTEGRAND, FORMULA_CONSTRAINT, FORMULA_INTEGRAL } formula_kind;
+static const char *const formula_what[] = {"integrand", "constraint", "integral"};
+
+/* Parse F (with its variable, unknowns and parameters) and hand the compiled formula to
+ * the problem as the integrand, a pointwise constraint (no y' allowed) or an integral
+ * constraint int K = c. */
+static cv_status compile(cv_problem *p, const char *variable, const char *unknowns,
+                         const char *F, const char *parameters, formula_kind kind, double c_rhs,
+                         int *index, char *err, size_t errlen) {
+  const char *what = formula_what[kind];
   if (err && errlen) err[0] = 0;
   if (!p || !unknowns || !F) {
-    msg(err, errlen, "problem, unknowns and integrand must not be NULL");
+    msg(err, errlen, "problem, unknowns and %s must not be NULL", what);
     return CVAR_EINVAL;
   }
   cv_status st = CVAR_EINVAL;
   names c = {variable ? variable : "x", 0, NULL, 0, NULL, NULL, 0};
-  char **plist = NULL;
+  ex_list unk = {0, NULL, NULL}, plist = {0, NULL, NULL};
   ex_dag *d = NULL;
   int np = 0;
   const char *why;
@@ -147,8 +104,8 @@ cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
     msg(err, errlen, "variable: '%s' %s", c.var, why);
     goto cleanup;
   }
-  c.unk = split(unknowns, &c.n);
-  if (!c.unk) goto nomem;
+  if ((c.n = ex_list_split(unknowns, &unk)) < 0) goto nomem;
+  c.unk = unk.item;
   if (c.n != cv_problem_get_num_unknowns(p)) {
     msg(err, errlen, "unknowns: %d name%s given, but the problem has %d unknown%s", c.n,
         c.n == 1 ? "" : "s", cv_problem_get_num_unknowns(p),
@@ -173,18 +130,17 @@ cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
   d = ex_dag_new();
   if (!d) goto nomem;
   if (parameters && parameters[0]) {
-    plist = split(parameters, &np);
-    if (!plist) goto nomem;
-    c.pname = calloc((size_t)np, sizeof *c.pname);
-    c.pval = calloc((size_t)np, sizeof *c.pval);
+    if ((np = ex_list_split(parameters, &plist)) < 0) goto nomem;
+    c.pname = cv_calloc((size_t)np, sizeof *c.pname);
+    c.pval = cv_calloc((size_t)np, sizeof *c.pval);
     if (!c.pname || !c.pval) goto nomem;
     for (int i = 0; i < np; i++) {
-      char *eq = strchr(plist[i], '=');
+      char *eq = strchr(plist.item[i], '=');
       if (!eq) {
-        msg(err, errlen, "parameters: '%s' is not of the form name = value", plist[i]);
+        msg(err, errlen, "parameters: '%s' is not of the form name = value", plist.item[i]);
         goto cleanup;
       }
-      char *name = plist[i], *end = eq;
+      char *name = plist.item[i], *end = eq;
       *eq = 0;
       while (end > name && isspace((unsigned char)end[-1])) *--end = 0;
       if ((why = bad_name(name))) {
@@ -220,18 +176,36 @@ cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
   c.np = np;
   ex_id f = ex_parse(d, F, resolve, &c, 0, perr, sizeof perr);
   if (f < 0) {
-    msg(err, errlen, "integrand: %s", perr);
+    msg(err, errlen, "%s: %s", what, perr);
+    goto cleanup;
+  }
+  if (kind == FORMULA_CONSTRAINT)
+    for (int i = 0; i < c.n; i++)
+      if (ex_depends_on(d, f, 1 + c.n + i)) {
+        msg(err, errlen, "constraint: a pointwise constraint G(%s, y) may not involve %s'",
+            c.var, c.unk[i]);
+        goto cleanup;
+      }
+  if (kind == FORMULA_INTEGRAL && !isfinite(c_rhs)) {
+    msg(err, errlen, "integral: the constant is not a finite number");
     goto cleanup;
   }
   ex_integrand *g = ex_integrand_new(d, c.n, f, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS,
                                      perr, sizeof perr);
   if (!g) {
-    msg(err, errlen, "integrand: %s", perr);
+    msg(err, errlen, "%s: %s", what, perr);
     st = CVAR_ENOMEM;
     goto cleanup;
   }
   /* The problem owns g from here on, also when the call fails (it releases it). */
-  st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
+  if (kind == FORMULA_INTEGRAND)
+    st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
+  else if (kind == FORMULA_CONSTRAINT)
+    st = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g,
+                                         ex_integrand_release, index);
+  else
+    st = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release, c_rhs,
+                                       index);
   if (st != CVAR_OK) msg(err, errlen, "%s", cv_strerror(st));
   goto cleanup;
 nomem:
@@ -239,9 +213,32 @@ nomem:
   st = CVAR_ENOMEM;
 cleanup:
   ex_dag_free(d);
-  free_list(c.unk);
-  free_list(plist);
-  free(c.pname);
-  free(c.pval);
+  ex_list_free(&unk);
+  ex_list_free(&plist);
+  cv_free(c.pname);
+  cv_free(c.pval);
   return st;
+}
+
+cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
+                                        const char *unknowns, const char *F,
+                                        const char *parameters, char *err, size_t errlen) {
+  return compile(p, variable, unknowns, F, parameters, FORMULA_INTEGRAND, 0.0, NULL, err,
+                 errlen);
+}
+
+cv_status cv_problem_add_constraint_expr(cv_problem *p, const char *variable,
+                                         const char *unknowns, const char *G,
+                                         const char *parameters, int *index, char *err,
+                                         size_t errlen) {
+  return compile(p, variable, unknowns, G, parameters, FORMULA_CONSTRAINT, 0.0, index, err,
+                 errlen);
+}
+
+cv_status cv_problem_add_integral_expr(cv_problem *p, const char *variable,
+                                       const char *unknowns, const char *K, double c,
+                                       const char *parameters, int *index, char *err,
+                                       size_t errlen) {
+  return compile(p, variable, unknowns, K, parameters, FORMULA_INTEGRAL, c, index, err,
+                 errlen);
 }

@@ -47,8 +47,8 @@ typedef struct {
 } poly;
 
 static void poly_free(poly *P) {
-  for (int k = 0; k < P->n; k++) free(P->m[k].f);
-  free(P->m);
+  for (int k = 0; k < P->n; k++) cv_free(P->m[k].f);
+  cv_free(P->m);
   memset(P, 0, sizeof *P);
 }
 
@@ -68,7 +68,7 @@ static int add_mono(poly *P, const mono *m, double s) {
     }
   if (P->n == P->cap) {
     int nc = P->cap ? 2 * P->cap : 4;
-    mono *q = realloc(P->m, (size_t)nc * sizeof *q);
+    mono *q = cv_realloc(P->m, (size_t)nc * sizeof *q);
     if (!q) return -1;
     P->m = q;
     P->cap = nc;
@@ -78,7 +78,7 @@ static int add_mono(poly *P, const mono *m, double s) {
   d->nf = m->nf;
   d->f = NULL;
   if (m->nf) {
-    if (!(d->f = malloc((size_t)m->nf * sizeof *d->f))) return -1;
+    if (!(d->f = cv_malloc((size_t)m->nf * sizeof *d->f))) return -1;
     memcpy(d->f, m->f, (size_t)m->nf * sizeof *d->f);
   }
   P->n++;
@@ -93,18 +93,18 @@ static int add_poly(poly *P, const poly *A, double s) {
 
 /* The monomial c·Π f, exponents scaled by q (q = 1: as given; q = -1: reciprocal). */
 static int add_scaled(poly *P, double c, int nf, const factor *f, double q) {
-  factor *g = nf ? malloc((size_t)nf * sizeof *g) : NULL;
+  factor *g = nf ? cv_malloc((size_t)nf * sizeof *g) : NULL;
   if (nf && !g) return -1;
   for (int k = 0; k < nf; k++) g[k] = (factor){f[k].base, f[k].p * q};
   mono m = {c, nf, g};
   int rc = add_mono(P, &m, 1.0);
-  free(g);
+  cv_free(g);
   return rc;
 }
 
 /* a·b, factor lists merged (exponents of equal bases added, zero exponents dropped). */
 static int mul_mono(poly *P, const mono *a, const mono *b) {
-  factor *f = malloc(((size_t)a->nf + b->nf + 1) * sizeof *f);
+  factor *f = cv_malloc(((size_t)a->nf + b->nf + 1) * sizeof *f);
   int i = 0, j = 0, n = 0;
   if (!f) return -1;
   while (i < a->nf || j < b->nf) {
@@ -118,7 +118,7 @@ static int mul_mono(poly *P, const mono *a, const mono *b) {
   }
   mono m = {a->c * b->c, n, f};
   int rc = add_mono(P, &m, 1.0);
-  free(f);
+  cv_free(f);
   return rc;
 }
 
@@ -244,9 +244,9 @@ static int normal(ex_dag *d, ex_id id, poly *pl, const ex_id *map, poly *P) {
 
 ex_id ex_collect(ex_dag *d, ex_id e) {
   if (!d || e < 0 || e >= d->n) return -1;
-  unsigned char *mark = calloc((size_t)e + 1, 1);
-  ex_id *map = malloc(((size_t)e + 1) * sizeof *map);
-  poly *pl = calloc((size_t)e + 1, sizeof *pl);
+  unsigned char *mark = cv_calloc((size_t)e + 1, 1);
+  ex_id *map = cv_malloc(((size_t)e + 1) * sizeof *map);
+  poly *pl = cv_calloc((size_t)e + 1, sizeof *pl);
   ex_id result = -1;
   if (!mark || !map || !pl) goto cleanup;
   ex_mark_reachable(d, e, mark, 0);
@@ -259,8 +259,8 @@ ex_id ex_collect(ex_dag *d, ex_id e) {
 cleanup:
   if (pl)
     for (ex_id id = 0; id <= e; id++) poly_free(&pl[id]);
-  free(pl);
-  free(mark);
-  free(map);
+  cv_free(pl);
+  cv_free(mark);
+  cv_free(map);
   return result;
 }

@@ -7,12 +7,12 @@
 #include "expr/ex_internal.h"
 
 ex_dag *ex_dag_new(void) {
-  ex_dag *d = calloc(1, sizeof *d);
+  ex_dag *d = cv_calloc(1, sizeof *d);
   if (!d) return NULL;
   d->cap = 64;
   d->tcap = 128;
-  d->nodes = malloc((size_t)d->cap * sizeof *d->nodes);
-  d->table = malloc(d->tcap * sizeof *d->table);
+  d->nodes = cv_malloc((size_t)d->cap * sizeof *d->nodes);
+  d->table = cv_malloc(d->tcap * sizeof *d->table);
   if (!d->nodes || !d->table) {
     ex_dag_free(d);
     return NULL;
@@ -24,9 +24,9 @@ ex_dag *ex_dag_new(void) {
 
 void ex_dag_free(ex_dag *d) {
   if (!d) return;
-  free(d->nodes);
-  free(d->table);
-  free(d);
+  cv_free(d->nodes);
+  cv_free(d->table);
+  cv_free(d);
 }
 
 int ex_dag_num_nodes(const ex_dag *d) { return d->n; }
@@ -54,7 +54,7 @@ static int node_equal(const ex_node *nd, ex_op op, ex_id a, ex_id b, ex_id c, do
 
 static int grow_table(ex_dag *d) {
   size_t ncap = d->tcap * 2;
-  int *t = malloc(ncap * sizeof *t);
+  int *t = cv_malloc(ncap * sizeof *t);
   if (!t) return -1;
   memset(t, 0xff, ncap * sizeof *t);
   for (int id = 0; id < d->n; id++) {
@@ -63,7 +63,7 @@ static int grow_table(ex_dag *d) {
     while (t[h] >= 0) h = (h + 1) & (ncap - 1);
     t[h] = id;
   }
-  free(d->table);
+  cv_free(d->table);
   d->table = t;
   d->tcap = ncap;
   return 0;
@@ -78,7 +78,7 @@ ex_id ex_intern(ex_dag *d, ex_op op, ex_id a, ex_id b, ex_id c, double v) {
   }
   if (d->n == d->cap) {
     if (d->cap > (1 << 28)) return -1;
-    ex_node *nn = realloc(d->nodes, (size_t)d->cap * 2 * sizeof *nn);
+    ex_node *nn = cv_realloc(d->nodes, (size_t)d->cap * 2 * sizeof *nn);
     if (!nn) return -1;
     d->nodes = nn;
     d->cap *= 2;
@@ -138,13 +138,13 @@ int ex_depends_on(const ex_dag *d, ex_id e, int slot) {
   if (!(d->nodes[e].dep & ((uint64_t)1 << (slot & 63)))) return 0;
   if (d->max_slot < 64) return 1; /* the bit mask is exact */
   /* Slots alias modulo 64: walk the nodes below e (topological order) to decide. */
-  unsigned char *mark = calloc((size_t)e + 1, 1);
+  unsigned char *mark = cv_calloc((size_t)e + 1, 1);
   if (!mark) return 1; /* conservative answer: may depend */
   ex_mark_reachable(d, e, mark, 0);
   int found = 0;
   for (int id = 0; id <= e && !found; id++)
     if (mark[id] && d->nodes[id].op == EX_SLOT && d->nodes[id].a == slot) found = 1;
-  free(mark);
+  cv_free(mark);
   return found;
 }
 
@@ -156,17 +156,6 @@ int ex_op_arity(ex_op op) {
   case EX_IF: return 3;
   default: return 1;
   }
-}
-
-const char *ex_op_name(ex_op op) {
-  static const char *const names[EX_NUM_OPS] = {
-      [EX_SIN] = "sin",     [EX_COS] = "cos",     [EX_TAN] = "tan",     [EX_ASIN] = "asin",
-      [EX_ACOS] = "acos",   [EX_ATAN] = "atan",   [EX_SINH] = "sinh",   [EX_COSH] = "cosh",
-      [EX_TANH] = "tanh",   [EX_ASINH] = "asinh", [EX_ACOSH] = "acosh", [EX_ATANH] = "atanh",
-      [EX_EXP] = "exp",     [EX_LOG] = "log",     [EX_SQRT] = "sqrt",   [EX_ABS] = "abs",
-      [EX_ATAN2] = "atan2", [EX_MIN] = "min",     [EX_MAX] = "max",     [EX_IF] = "if",
-      [EX_POW] = "pow"};
-  return (unsigned)op < EX_NUM_OPS ? names[op] : NULL;
 }
 
 /* min/max pick the first operand on ties (the branch whose derivative ex_diff uses) and
@@ -222,11 +211,11 @@ void ex_mark_reachable(const ex_dag *d, ex_id e, unsigned char *mark, int skip_c
 
 int ex_eval(const ex_dag *d, ex_id e, const double *slots, double *value) {
   if (!valid(d, e)) return -1;
-  unsigned char *mark = calloc((size_t)e + 1, 1);
-  double *val = malloc(((size_t)e + 1) * sizeof *val);
+  unsigned char *mark = cv_calloc((size_t)e + 1, 1);
+  double *val = cv_malloc(((size_t)e + 1) * sizeof *val);
   if (!mark || !val) {
-    free(mark);
-    free(val);
+    cv_free(mark);
+    cv_free(val);
     return -1;
   }
   ex_mark_reachable(d, e, mark, 0);
@@ -242,8 +231,8 @@ int ex_eval(const ex_dag *d, ex_id e, const double *slots, double *value) {
     }
   }
   *value = val[e];
-  free(mark);
-  free(val);
+  cv_free(mark);
+  cv_free(val);
   return 0;
 }
 

@@ -63,8 +63,8 @@ ex_id ex_diff(ex_dag *d, ex_id e, int slot) {
   if (!d || e < 0 || e >= d->n || slot < 0) return -1;
   uint64_t bit = (uint64_t)1 << (slot & 63);
   if (!(d->nodes[e].dep & bit)) return ex_num(d, 0.0);
-  unsigned char *mark = calloc((size_t)e + 1, 1);
-  ex_id *dv = malloc(((size_t)e + 1) * sizeof *dv);
+  unsigned char *mark = cv_calloc((size_t)e + 1, 1);
+  ex_id *dv = cv_malloc(((size_t)e + 1) * sizeof *dv);
   ex_id zero = ex_num(d, 0.0), result = -1;
   if (!mark || !dv || zero < 0) goto cleanup;
   ex_mark_reachable(d, e, mark, 1);
@@ -84,7 +84,7 @@ ex_id ex_diff(ex_dag *d, ex_id e, int slot) {
   }
   result = dv[e];
 cleanup:
-  free(mark);
-  free(dv);
+  cv_free(mark);
+  cv_free(dv);
   return result;
 }

@@ -34,8 +34,8 @@ ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, cha
   int ntri = n * (n + 1) / 2;
   int level = max_need & CVAR_NEED_HESS ? 2 : max_need & CVAR_NEED_GRAD ? 1 : 0;
   int nout = level == 2 ? 1 + 2 * n + 2 * ntri + n * n : level == 1 ? 1 + 2 * n : 1;
-  ex_integrand *g = calloc(1, sizeof *g);
-  ex_id *outs = malloc((size_t)nout * sizeof *outs);
+  ex_integrand *g = cv_calloc(1, sizeof *g);
+  ex_id *outs = cv_malloc((size_t)nout * sizeof *outs);
   if (!g || !outs) goto nomem;
   g->n = n;
   g->max_need = max_need | CVAR_NEED_F;
@@ -73,16 +73,16 @@ ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, cha
     size_t w = ex_tape_work_size(g->tape[l], EX_INTEGRAND_BATCH);
     if (w > work) work = w;
   }
-  g->work = malloc((work ? work : 1) * sizeof *g->work);
-  g->scratch = malloc((size_t)nout * EX_INTEGRAND_BATCH * sizeof *g->scratch);
-  g->in = malloc((size_t)(2 * n + 1) * sizeof *g->in);
-  g->outp = malloc((size_t)nout * sizeof *g->outp);
+  g->work = cv_malloc((work ? work : 1) * sizeof *g->work);
+  g->scratch = cv_malloc((size_t)nout * EX_INTEGRAND_BATCH * sizeof *g->scratch);
+  g->in = cv_malloc((size_t)(2 * n + 1) * sizeof *g->in);
+  g->outp = cv_malloc((size_t)nout * sizeof *g->outp);
   if (!g->work || !g->scratch || !g->in || !g->outp) goto nomem;
-  free(outs);
+  cv_free(outs);
   return g;
 nomem:
   set_err(err, errlen, "out of memory while compiling the expression");
-  free(outs);
+  cv_free(outs);
   ex_integrand_free(g);
   return NULL;
 }
@@ -90,11 +90,11 @@ nomem:
 void ex_integrand_free(ex_integrand *g) {
   if (!g) return;
   for (int l = 0; l < 3; l++) ex_tape_free(g->tape[l]);
-  free(g->work);
-  free(g->scratch);
-  free(g->in);
-  free(g->outp);
-  free(g);
+  cv_free(g->work);
+  cv_free(g->scratch);
+  cv_free(g->in);
+  cv_free(g->outp);
+  cv_free(g);
 }
 
 void ex_integrand_release(void *g) { ex_integrand_free(g); }

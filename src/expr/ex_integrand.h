@@ -14,6 +14,7 @@
 #include <stddef.h>
 
 #include "calcvar.h"
+#include "core/cv_memory.h"
 #include "expr/expr.h"
 
 typedef struct ex_integrand ex_integrand;

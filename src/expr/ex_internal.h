@@ -5,6 +5,7 @@
 
 #include <stdint.h>
 
+#include "core/cv_memory.h"
 #include "expr/expr.h"
 
 /* pi to more digits than a double holds (M_PI is not ISO C). */
@@ -30,6 +31,14 @@ struct ex_dag {
 
 /* Number of operands of an operation (0..3). */
 int ex_op_arity(ex_op op);
+/* One function of the grammar: its name, operation and number of arguments (ex_names.c). */
+typedef struct {
+  const char *name;
+  ex_op op;
+  int nargs;
+} ex_function;
+/* The function called `name`, or NULL. */
+const ex_function *ex_function_find(const char *name);
 /* Name of a function as written in the grammar ("sin"), or NULL for operators. */
 const char *ex_op_name(ex_op op);
 /* Value of op applied to numbers (the pointwise semantics shared by constant folding and

@@ -103,27 +103,6 @@ static ex_id parse_number(parser *p) {
   return built(p, ex_num(p->d, v));
 }
 
-typedef struct {
-  const char *name;
-  ex_op op;
-  int nargs;
-} func;
-
-static const func funcs[] = {
-    {"sin", EX_SIN, 1},     {"cos", EX_COS, 1},     {"tan", EX_TAN, 1},
-    {"asin", EX_ASIN, 1},   {"acos", EX_ACOS, 1},   {"atan", EX_ATAN, 1},
-    {"sinh", EX_SINH, 1},   {"cosh", EX_COSH, 1},   {"tanh", EX_TANH, 1},
-    {"asinh", EX_ASINH, 1}, {"acosh", EX_ACOSH, 1}, {"atanh", EX_ATANH, 1},
-    {"exp", EX_EXP, 1},     {"log", EX_LOG, 1},     {"sqrt", EX_SQRT, 1},
-    {"abs", EX_ABS, 1},     {"atan2", EX_ATAN2, 2}, {"pow", EX_POW, 2},
-    {"min", EX_MIN, 2},     {"max", EX_MAX, 2},     {"if", EX_IF, 3}};
-
-static const func *find_func(const char *name) {
-  for (size_t i = 0; i < sizeof funcs / sizeof funcs[0]; i++)
-    if (strcmp(funcs[i].name, name) == 0) return &funcs[i];
-  return NULL;
-}
-
 /* sum [relop sum]: a condition's value is 1 or 0; a bare sum counts as true when != 0. */
 static ex_id parse_cond(parser *p) {
   ex_id a = parse_sum(p);
@@ -141,7 +120,7 @@ static ex_id parse_cond(parser *p) {
   return built(p, ex_binary(p->d, op, a, b));
 }
 
-static ex_id parse_call(parser *p, const func *f, size_t at) {
+static ex_id parse_call(parser *p, const ex_function *f, size_t at) {
   ex_id args[3];
   int n = 0;
   p->pos++; /* '(' */
@@ -185,7 +164,7 @@ static ex_id parse_name(parser *p) {
   while (p->s[i] == '\'') i++, primes++;
   p->pos = i;
   skip_ws(p);
-  const func *f = find_func(name);
+  const ex_function *f = ex_function_find(name);
   if (p->s[p->pos] == '(' && !primes) {
     if (!f) return fail(p, at, "unknown function '%s'", name);
     return parse_call(p, f, at);

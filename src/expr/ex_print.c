@@ -178,8 +178,8 @@ static void emit(printer *o, ex_id e) {
 size_t ex_print(const ex_dag *d, ex_id e, const char *const *names, char *buf, size_t len) {
   if (buf && len) buf[0] = 0;
   if (!d || e < 0 || e >= d->n) return 0;
-  unsigned char *mark = calloc((size_t)e + 1, 1);
-  size_t *lens = malloc(((size_t)e + 1) * sizeof *lens);
+  unsigned char *mark = cv_calloc((size_t)e + 1, 1);
+  size_t *lens = cv_malloc(((size_t)e + 1) * sizeof *lens);
   size_t total = 0;
   if (!mark || !lens) goto cleanup; /* returns 0: nothing could be printed */
   ex_mark_reachable(d, e, mark, 0);
@@ -199,7 +199,7 @@ size_t ex_print(const ex_dag *d, ex_id e, const char *const *names, char *buf, s
     buf[o.pos] = 0;
   }
 cleanup:
-  free(mark);
-  free(lens);
+  cv_free(mark);
+  cv_free(lens);
   return total;
 }

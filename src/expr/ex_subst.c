@@ -8,8 +8,8 @@ ex_id ex_subst(ex_dag *d, ex_id e, int slot, ex_id by) {
   if (!d || e < 0 || e >= d->n || slot < 0 || by < 0 || by >= d->n) return -1;
   uint64_t bit = (uint64_t)1 << (slot & 63);
   if (!(d->nodes[e].dep & bit)) return e;
-  unsigned char *mark = calloc((size_t)e + 1, 1);
-  ex_id *map = malloc(((size_t)e + 1) * sizeof *map);
+  unsigned char *mark = cv_calloc((size_t)e + 1, 1);
+  ex_id *map = cv_malloc(((size_t)e + 1) * sizeof *map);
   ex_id result = -1;
   if (!mark || !map) goto cleanup;
   ex_mark_reachable(d, e, mark, 0);
@@ -28,7 +28,7 @@ ex_id ex_subst(ex_dag *d, ex_id e, int slot, ex_id by) {
   }
   result = map[e];
 cleanup:
-  free(mark);
-  free(map);
+  cv_free(mark);
+  cv_free(map);
   return result;
 }

@@ -85,11 +85,11 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
     if (outs[o] > top) top = outs[o];
   }
   int nn = top + 1;
-  ex_tape *t = calloc(1, sizeof *t);
-  cnode *cn = calloc((size_t)(nn > 0 ? nn : 1), sizeof *cn);
+  ex_tape *t = cv_calloc(1, sizeof *t);
+  cnode *cn = cv_calloc((size_t)(nn > 0 ? nn : 1), sizeof *cn);
   int *freeregs = NULL, nfree = 0;
   /* At most one instruction per node plus one per output (copies and fills). */
-  instr *ins = malloc(((size_t)nn + (size_t)nout + 1) * sizeof *ins);
+  instr *ins = cv_malloc(((size_t)nn + (size_t)nout + 1) * sizeof *ins);
   if (!t || !cn || !ins) goto fail;
   t->nslots = nslots;
   t->nout = nout;
@@ -133,7 +133,7 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
     if (c->home.space < 0 && !c->konst && d->nodes[outs[o]].op != EX_SLOT)
       c->home = (loc){L_OUT, o};
   }
-  freeregs = malloc(((size_t)nn + 1) * sizeof *freeregs);
+  freeregs = cv_malloc(((size_t)nn + 1) * sizeof *freeregs);
   if (!freeregs) goto fail;
 
   int n = 0;
@@ -254,21 +254,21 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
   }
   t->ins = ins;
   t->nins = n;
-  free(cn);
-  free(freeregs);
+  cv_free(cn);
+  cv_free(freeregs);
   return t;
 fail:
-  free(cn);
-  free(freeregs);
-  free(ins);
-  free(t);
+  cv_free(cn);
+  cv_free(freeregs);
+  cv_free(ins);
+  cv_free(t);
   return NULL;
 }
 
 void ex_tape_free(ex_tape *t) {
   if (!t) return;
-  free(t->ins);
-  free(t);
+  cv_free(t->ins);
+  cv_free(t);
 }
 
 size_t ex_tape_work_size(const ex_tape *t, int m) {

@@ -48,6 +48,23 @@ int ex_depends_on(const ex_dag *d, ex_id e, int slot);
 /* Value of a constant expression; returns 0 on success, -1 if it depends on a slot. */
 int ex_eval_const(const ex_dag *d, ex_id e, double *value);
 
+/* The grammar's names (ex_names.c). An identifier is a letter or '_' followed by letters,
+ * digits or '_' (a prime is not part of a name); the reserved names are pi and the
+ * function names, which no parameter or unknown may take. */
+int ex_is_identifier(const char *s);
+int ex_is_reserved(const char *s);
+
+/* A value split at commas outside parentheses; off[i] is item i's offset in the value. */
+typedef struct {
+  int n;
+  char **item;
+  int *off;
+} ex_list;
+/* Split value into list (trimmed copies). Returns the item count, or -1 on allocation
+ * failure (list is then empty). ex_list_free releases the items and empties the list. */
+int ex_list_split(const char *value, ex_list *list);
+void ex_list_free(ex_list *list);
+
 /* Name resolution during parsing. `primes` is 0 for `name`, 1 for `name'` (2 for `name''`
  * only when the parse was started with allow_second = 1). Return a node id, or -1 with a
  * message in err (e.g. "unknown name 'q'", "a prime is only allowed on an unknown"). */

@@ -44,11 +44,6 @@ typedef struct {
   int line;
 } sc_boundary;
 
-/** Methods of SCENES.md "Method names". */
-typedef enum {
-  SC_NEWTON = 0, SC_LBFGS, SC_TNEWTON, SC_MMA, SC_CCSAQ, SC_SLSQP, SC_AUGLAG, SC_NUM_METHODS
-} sc_method;
-
 typedef struct scene {
   char *file;     /* the name used in messages */
   char *title;
@@ -87,7 +82,7 @@ typedef struct scene {
   int graded_end;      /* CVAR_GRADE_A, CVAR_GRADE_B or CVAR_GRADE_BOTH */
 
   /* [solver] */
-  sc_method method;
+  cv_method method;    /* the names are the core's: cv_method_name, cv_method_from_name */
   int method_line;     /* 0 when not given */
   double tolerance;    /* default 1e-10 */
   int max_iterations;  /* default 50 */
@@ -103,12 +98,9 @@ scene *scene_load_buffer(const char *text, size_t len, const char *name, int nse
 /** Release a scene; NULL is a no-op. */
 void scene_free(scene *s);
 
-/** The method's name ("newton", "lbfgs", ...) and the reverse look-up (-1 if unknown). */
-const char *scene_method_name(sc_method m);
-int scene_method_from_name(const char *name);
 /** Derivative groups a method asks the integrand for: newton F|GRAD|HESS, the NLopt
  * minimisers F|GRAD. */
-unsigned scene_method_need(sc_method m);
+unsigned scene_method_need(cv_method m);
 
 /** A problem for the scene's integrand, ends, guess, [constraints] and [integrals]. max_need:
  * CVAR_NEED_* bits the integrand and constraints compile. (A pointwise constraint that
@@ -130,12 +122,6 @@ int scene_F_depends_on_unknown(const scene *s, int i);
 int scene_eval_exact(const scene *s, int m, const double *x, double *exact);
 /** The guess (the [guess] expression or the default) at m abscissae: y[i*m + k]. */
 int scene_eval_guess(const scene *s, int m, const double *x, double *y);
-/** H = sum_i y'_i dF/dy'_i - F at m points. */
-int scene_eval_energy(scene *s, int m, const double *x, const double *y, const double *dy,
-                      double *H);
-/** p[i*m + k] = dF/dy'_i at m points, every unknown. */
-int scene_eval_momenta(scene *s, int m, const double *x, const double *y, const double *dy,
-                       double *p);
 /** K_r at m points: out[r*m + k] for each [report] entry r. */
 int scene_eval_reports(scene *s, int m, const double *x, const double *y, const double *dy,
                        double *out);

@@ -24,7 +24,7 @@ void sc_err(char *err, size_t errlen, const char *file, int line, const char *fm
 
 char *sc_strndup(const char *s, size_t n)
 {
-  char *r = malloc(n + 1);
+  char *r = cv_malloc(n + 1);
   if (r) {
     memcpy(r, s, n);
     r[n] = '\0';

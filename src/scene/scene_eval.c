@@ -1,5 +1,5 @@
 /* src/scene/scene_eval.c — evaluate scene expressions over batches of points: exact
- * solutions, guesses, energy, momenta and report integrands.
+ * solutions, guesses and report integrands.
  * SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <stdlib.h>
@@ -19,9 +19,9 @@ int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const doub
   if (nout == 0 || m == 0)
     return 0;
   ex_tape *t = ex_tape_new(s->dag, ns, nout, outs);
-  const double **in = malloc((size_t)ns * sizeof *in);
-  double **o = malloc((size_t)nout * sizeof *o);
-  double *work = t ? malloc((ex_tape_work_size(t, BATCH) + 1) * sizeof *work) : NULL;
+  const double **in = cv_malloc((size_t)ns * sizeof *in);
+  double **o = cv_malloc((size_t)nout * sizeof *o);
+  double *work = t ? cv_malloc((ex_tape_work_size(t, BATCH) + 1) * sizeof *work) : NULL;
   if (!t || !in || !o || !work)
     goto done;
   for (int k0 = 0; k0 < m; k0 += BATCH) {
@@ -37,9 +37,9 @@ int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const doub
   }
   rc = 0;
 done:
-  free(work);
-  free(o);
-  free(in);
+  cv_free(work);
+  cv_free(o);
+  cv_free(in);
   ex_tape_free(t);
   return rc;
 }
@@ -92,48 +92,16 @@ int scene_F_depends_on_unknown(const scene *s, int i)
   return ex_depends_on(s->dag, s->F, 1 + i);
 }
 
-/* H = sum_i y'_i dF/dy'_i - F, built symbolically so it is exact. */
-int scene_eval_energy(scene *s, int m, const double *x, const double *y, const double *dy,
-                      double *H)
-{
-  int n = s->n;
-  ex_id h = ex_unary(s->dag, EX_NEG, s->F);
-  for (int i = 0; i < n && h >= 0; i++) {
-    ex_id p = ex_diff(s->dag, s->F, 1 + n + i);
-    ex_id t = p >= 0 ? ex_binary(s->dag, EX_MUL, ex_slot(s->dag, 1 + n + i), p) : -1;
-    h = t >= 0 ? ex_binary(s->dag, EX_ADD, h, t) : -1;
-  }
-  if (h < 0)
-    return -1;
-  return sc_eval_exprs(s, 1, &h, m, x, y, dy, H);
-}
-
-int scene_eval_momenta(scene *s, int m, const double *x, const double *y, const double *dy,
-                       double *p)
-{
-  int n = s->n, rc = -1;
-  ex_id *outs = malloc((size_t)n * sizeof *outs);
-  if (!outs)
-    return -1;
-  for (int i = 0; i < n; i++)
-    if ((outs[i] = ex_diff(s->dag, s->F, 1 + n + i)) < 0)
-      goto done;
-  rc = sc_eval_exprs(s, n, outs, m, x, y, dy, p);
-done:
-  free(outs);
-  return rc;
-}
-
 int scene_eval_reports(scene *s, int m, const double *x, const double *y, const double *dy,
                        double *out)
 {
   int nr = s->nreports, rc;
-  ex_id *outs = malloc((size_t)(nr + 1) * sizeof *outs);
+  ex_id *outs = cv_malloc((size_t)(nr + 1) * sizeof *outs);
   if (!outs)
     return -1;
   for (int r = 0; r < nr; r++)
     outs[r] = s->reports[r].expr;
   rc = sc_eval_exprs(s, nr, outs, m, x, y, dy, out);
-  free(outs);
+  cv_free(outs);
   return rc;
 }

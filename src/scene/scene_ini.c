@@ -70,7 +70,7 @@ static int handler(void *user, const char *section, const char *name, const char
       f->failed = 1;
       return 0;
     }
-  sc_entry *e = realloc(raw->e[sec], (size_t)(raw->ne[sec] + 1) * sizeof *e);
+  sc_entry *e = cv_realloc(raw->e[sec], (size_t)(raw->ne[sec] + 1) * sizeof *e);
   if (!e) {
     sc_err(f->err, f->errlen, file, l->line, "out of memory");
     f->failed = 1;
@@ -87,7 +87,7 @@ void sc_raw_free(sc_raw *raw)
   for (int s = 0; s < SEC_COUNT; s++) {
     for (int i = 0; i < raw->ne[s]; i++)
       sc_entry_free(&raw->e[s][i]);
-    free(raw->e[s]);
+    cv_free(raw->e[s]);
     raw->e[s] = NULL;
     raw->ne[s] = 0;
   }

@@ -6,6 +6,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 
+#include "core/cv_memory.h"
 #include "scene/scene.h"
 
 /* Where a piece of a (possibly continued) value came from: the value's characters from
@@ -78,8 +79,7 @@ void sc_entry_free(sc_entry *e);
 /* Map a 0-based offset in an entry's value to a physical line and 1-based column. */
 void sc_entry_locate(const sc_entry *e, int off, int *line, int *col);
 
-/* scene_names.c: names and the resolver used while parsing expressions. */
-int sc_is_identifier(const char *s);
+/* scene_names.c: the names a scene may not define (the grammar's reserved names and free). */
 int sc_is_reserved(const char *s);
 
 /* The loader's state while it interprets the entries (scene_load.c and friends). */
@@ -94,16 +94,7 @@ typedef struct {
   int limit;     /* parameters (SC_R_PARAM) or definitions (SC_R_FULL) usable: index < limit */
 } sc_loader;
 
-/* A value split at commas outside parentheses; off[i] is item i's offset in the value. */
-typedef struct {
-  int n;
-  char **item;
-  int *off;
-} sc_list;
-
 /* scene_parse.c */
-int sc_list_split(const char *value, sc_list *list);
-void sc_list_free(sc_list *list);
 ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what);
 int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
                    const char *what, double *value);

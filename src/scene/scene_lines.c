@@ -40,9 +40,9 @@ static int is_ws(char c) { return c == ' ' || c == '\t'; }
 
 void sc_entry_free(sc_entry *e)
 {
-  free(e->key);
-  free(e->value);
-  free(e->pieces);
+  cv_free(e->key);
+  cv_free(e->value);
+  cv_free(e->pieces);
   memset(e, 0, sizeof *e);
 }
 
@@ -50,7 +50,7 @@ void sc_llines_free(sc_llines *ll)
 {
   for (int i = 0; i < ll->n; i++)
     sc_entry_free(&ll->l[i].entry);
-  free(ll->l);
+  cv_free(ll->l);
   ll->l = NULL;
   ll->n = 0;
 }
@@ -81,7 +81,7 @@ static sc_lline *push(sc_llines *ll, int *cap)
 {
   if (ll->n == *cap) {
     int nc = *cap ? 2 * *cap : 16;
-    sc_lline *l = realloc(ll->l, (size_t)nc * sizeof *l);
+    sc_lline *l = cv_realloc(ll->l, (size_t)nc * sizeof *l);
     if (!l)
       return NULL;
     ll->l = l;
@@ -96,8 +96,8 @@ static sc_lline *push(sc_llines *ll, int *cap)
 static int append_piece(sc_entry *e, const char *t, size_t n, int line, int col)
 {
   size_t old = strlen(e->value);
-  char *v = realloc(e->value, old + n + 2);
-  sc_piece *p = realloc(e->pieces, (size_t)(e->npieces + 1) * sizeof *p);
+  char *v = cv_realloc(e->value, old + n + 2);
+  sc_piece *p = cv_realloc(e->pieces, (size_t)(e->npieces + 1) * sizeof *p);
   if (v)
     e->value = v;
   if (p)

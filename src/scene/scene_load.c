@@ -20,31 +20,31 @@ int sc_load_solver(sc_loader *L);
 static void items_free(sc_item *it, int n)
 {
   for (int i = 0; i < n; i++)
-    free(it[i].name);
-  free(it);
+    cv_free(it[i].name);
+  cv_free(it);
 }
 
 void scene_free(scene *s)
 {
   if (!s)
     return;
-  free(s->file);
-  free(s->title);
-  free(s->variable);
+  cv_free(s->file);
+  cv_free(s->title);
+  cv_free(s->variable);
   for (int i = 0; i < s->n; i++)
-    free(s->unknowns[i]);
-  free(s->unknowns);
-  free(s->bc);
-  free(s->guess);
-  free(s->exact);
+    cv_free(s->unknowns[i]);
+  cv_free(s->unknowns);
+  cv_free(s->bc);
+  cv_free(s->guess);
+  cv_free(s->exact);
   items_free(s->params, s->nparams);
   items_free(s->defs, s->ndefs);
   items_free(s->cons, s->ncons);
   items_free(s->ints, s->nints);
   items_free(s->reports, s->nreports);
-  free(s->breakpoints);
+  cv_free(s->breakpoints);
   ex_dag_free(s->dag);
-  free(s);
+  cv_free(s);
 }
 
 static const sc_entry *find_entry(const sc_loader *L, int sec, const char *key)
@@ -93,7 +93,7 @@ static const char *taken(const scene *s, const char *name)
 static int check_new_name(sc_loader *L, int line, const char *name, const char *role)
 {
   const char *t;
-  if (!sc_is_identifier(name)) {
+  if (!ex_is_identifier(name)) {
     sc_err(L->err, L->errlen, L->file, line,
            "'%s' is not a valid %s name (letters, digits and '_', starting with a letter)",
            name, role);
@@ -137,25 +137,25 @@ static int load_scene_section(sc_loader *L)
     sc_err(L->err, L->errlen, L->file, hl, "[scene] needs 'unknowns = name, ...'");
     return -1;
   }
-  sc_list list;
-  if (sc_list_split(e->value, &list) < 0)
+  ex_list list;
+  if (ex_list_split(e->value, &list) < 0)
     goto nomem;
-  s->unknowns = calloc((size_t)list.n, sizeof *s->unknowns);
+  s->unknowns = cv_calloc((size_t)list.n, sizeof *s->unknowns);
   if (!s->unknowns) {
-    sc_list_free(&list);
+    ex_list_free(&list);
     goto nomem;
   }
   for (int i = 0; i < list.n; i++) {
     int line, col;
     sc_entry_locate(e, list.off[i], &line, &col);
     if (check_new_name(L, line, list.item[i], "unknown") < 0) {
-      sc_list_free(&list);
+      ex_list_free(&list);
       return -1;
     }
     s->unknowns[s->n++] = list.item[i];
     list.item[i] = NULL;
   }
-  sc_list_free(&list);
+  ex_list_free(&list);
   if (!find_entry(L, SEC_SCENE, "interval")) {
     sc_err(L->err, L->errlen, L->file, hl, "[scene] needs 'interval = a, b'");
     return -1;
@@ -177,7 +177,7 @@ static int load_parameters(sc_loader *L, int nset, const sc_set *set)
 {
   scene *s = L->s;
   int ne = L->raw.ne[SEC_PARAMETERS];
-  s->params = calloc((size_t)ne + 1, sizeof *s->params);
+  s->params = cv_calloc((size_t)ne + 1, sizeof *s->params);
   if (!s->params) {
     sc_err(L->err, L->errlen, L->file, 0, "out of memory");
     return -1;
@@ -235,7 +235,7 @@ static int load_definitions(sc_loader *L)
 {
   scene *s = L->s;
   int ne = L->raw.ne[SEC_DEFINITIONS];
-  s->defs = calloc((size_t)ne + 1, sizeof *s->defs);
+  s->defs = cv_calloc((size_t)ne + 1, sizeof *s->defs);
   if (!s->defs) {
     sc_err(L->err, L->errlen, L->file, 0, "out of memory");
     return -1;
@@ -271,8 +271,8 @@ static int load_interval_integrand(sc_loader *L)
 {
   scene *s = L->s;
   const sc_entry *e = find_entry(L, SEC_SCENE, "interval");
-  sc_list list;
-  if (sc_list_split(e->value, &list) < 0) {
+  ex_list list;
+  if (ex_list_split(e->value, &list) < 0) {
     sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
     return -1;
   }
@@ -296,7 +296,7 @@ static int load_interval_integrand(sc_loader *L)
     goto done;
   rc = 0;
 done:
-  sc_list_free(&list);
+  ex_list_free(&list);
   return rc;
 }
 
@@ -307,7 +307,7 @@ scene *scene_load_buffer(const char *text, size_t len, const char *name, int nse
   memset(&L, 0, sizeof L);
   if (err && errlen)
     err[0] = '\0';
-  scene *s = calloc(1, sizeof *s);
+  scene *s = cv_calloc(1, sizeof *s);
   if (!s || !(s->file = sc_strdup(name ? name : "scene")) || !(s->dag = ex_dag_new())) {
     scene_free(s);
     sc_err(err, errlen, name ? name : "scene", 0, "out of memory");
@@ -346,15 +346,15 @@ scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
     return NULL;
   }
   size_t cap = 4096, len = 0;
-  char *buf = malloc(cap);
+  char *buf = cv_malloc(cap);
   while (buf) {
     size_t k = fread(buf + len, 1, cap - len, f);
     len += k;
     if (len < cap)
       break;
-    char *nb = realloc(buf, cap *= 2);
+    char *nb = cv_realloc(buf, cap *= 2);
     if (!nb) {
-      free(buf);
+      cv_free(buf);
       buf = NULL;
     } else
       buf = nb;
@@ -362,11 +362,11 @@ scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
   int bad = ferror(f);
   fclose(f);
   if (!buf || bad) {
-    free(buf);
+    cv_free(buf);
     sc_err(err, errlen, path, 0, bad ? "read error" : "out of memory");
     return NULL;
   }
   scene *s = scene_load_buffer(buf, len, path, nset, set, err, errlen);
-  free(buf);
+  cv_free(buf);
   return s;
 }

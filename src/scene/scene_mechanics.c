@@ -37,7 +37,7 @@ static ex_id total_derivative(ex_dag *d, ex_id G, int n)
 static char *cat(const char *a, const char *b)
 {
   size_t la = strlen(a), lb = strlen(b);
-  char *s = malloc(la + lb + 1);
+  char *s = cv_malloc(la + lb + 1);
   if (s) {
     memcpy(s, a, la);
     memcpy(s + la, b, lb + 1);
@@ -49,7 +49,7 @@ static int make_names(const scene *s, sc_equations *eq)
 {
   int n = s->n;
   eq->nslots = 1 + 3 * n + s->ncons + s->nints;
-  if (!(eq->names = calloc((size_t)eq->nslots, sizeof *eq->names)))
+  if (!(eq->names = cv_calloc((size_t)eq->nslots, sizeof *eq->names)))
     return -1;
   eq->names[0] = cat(s->variable, "");
   for (int i = 0; i < n; i++) {
@@ -84,9 +84,9 @@ int scene_equations_new(scene *s, sc_equations *eq, char *err, size_t errlen)
   memset(eq, 0, sizeof *eq);
   eq->n = n;
   eq->hamiltonian = -1;
-  if (make_names(s, eq) < 0 || !(eq->momentum = malloc((size_t)n * sizeof *eq->momentum)) ||
-      !(eq->el = malloc((size_t)n * sizeof *eq->el)) ||
-      !(eq->cyclic = malloc((size_t)n * sizeof *eq->cyclic)))
+  if (make_names(s, eq) < 0 || !(eq->momentum = cv_malloc((size_t)n * sizeof *eq->momentum)) ||
+      !(eq->el = cv_malloc((size_t)n * sizeof *eq->el)) ||
+      !(eq->cyclic = cv_malloc((size_t)n * sizeof *eq->cyclic)))
     goto nomem;
   eq->autonomous = !scene_F_depends_on_variable(s);
   ex_id H = ex_unary(d, EX_NEG, s->F);
@@ -131,11 +131,11 @@ void scene_equations_free(sc_equations *eq)
     return;
   if (eq->names)
     for (int k = 0; k < eq->nslots; k++)
-      free(eq->names[k]);
-  free(eq->names);
-  free(eq->momentum);
-  free(eq->el);
-  free(eq->cyclic);
+      cv_free(eq->names[k]);
+  cv_free(eq->names);
+  cv_free(eq->momentum);
+  cv_free(eq->el);
+  cv_free(eq->cyclic);
   memset(eq, 0, sizeof *eq);
   eq->hamiltonian = -1;
 }

@@ -59,11 +59,11 @@ static int eval_partials(const scene *s, int nout, const ex_id *outs, const doub
 {
   int n = s->n;
   double x = s->a;
-  double *dy = calloc((size_t)n, sizeof *dy);
+  double *dy = cv_calloc((size_t)n, sizeof *dy);
   if (!dy)
     return -1;
   int rc = sc_eval_exprs(s, nout, outs, 1, &x, y, dy, out);
-  free(dy);
+  cv_free(dy);
   return rc;
 }
 
@@ -104,7 +104,7 @@ static int gyro_modes(sc_modes *md, int n, const double *M, const double *K, con
 {
   int N = 2 * n, info = 0, lw = -1;
   double q = 0;
-  double *A = calloc((size_t)N * N * 2 + 3 * (size_t)N, sizeof *A);
+  double *A = cv_calloc((size_t)N * N * 2 + 3 * (size_t)N, sizeof *A);
   if (!A)
     return -2;
   double *B = A + (size_t)N * N, *ar = B + (size_t)N * N, *ai = ar + N, *be = ai + N;
@@ -119,15 +119,15 @@ static int gyro_modes(sc_modes *md, int n, const double *M, const double *K, con
   }
   dggev_("N", "N", &N, A, &N, B, &N, ar, ai, be, NULL, &N, NULL, &N, &q, &lw, &info);
   lw = (int)fmax(q, 8.0 * N);
-  double *work = malloc((size_t)lw * sizeof *work);
+  double *work = cv_malloc((size_t)lw * sizeof *work);
   if (!work) {
-    free(A);
+    cv_free(A);
     return -2;
   }
   dggev_("N", "N", &N, A, &N, B, &N, ar, ai, be, NULL, &N, NULL, &N, work, &lw, &info);
-  free(work);
+  cv_free(work);
   if (info != 0) {
-    free(A);
+    cv_free(A);
     return -1;
   }
   double big = 0;
@@ -174,7 +174,7 @@ static int gyro_modes(sc_modes *md, int n, const double *M, const double *K, con
       md->gyro_kind[b] = md->gyro_kind[b - 1], md->gyro_kind[b - 1] = kk;
     }
   md->ngyro = m;
-  free(A);
+  cv_free(A);
   return 0;
 }
 
@@ -192,7 +192,7 @@ static int tangent_basis(int n, int nc, const double *A, double *T)
 {
   int info = 0, lw = -1;
   double q = 0;
-  double *Q = malloc(((size_t)n * n + n) * sizeof *Q);
+  double *Q = cv_malloc(((size_t)n * n + n) * sizeof *Q);
   if (!Q)
     return -2;
   double *tau = Q + (size_t)n * n;
@@ -200,9 +200,9 @@ static int tangent_basis(int n, int nc, const double *A, double *T)
   memcpy(Q, A, (size_t)n * nc * sizeof *Q);
   dgeqrf_(&n, &nc, Q, &n, tau, &q, &lw, &info);
   lw = (int)fmax(q, (double)n);
-  double *work = malloc((size_t)lw * sizeof *work);
+  double *work = cv_malloc((size_t)lw * sizeof *work);
   if (!work) {
-    free(Q);
+    cv_free(Q);
     return -2;
   }
   dgeqrf_(&n, &nc, Q, &n, tau, work, &lw, &info);
@@ -217,10 +217,10 @@ static int tangent_basis(int n, int nc, const double *A, double *T)
     int lw2 = -1;
     dorgqr_(&n, &n, &nc, Q, &n, tau, &q, &lw2, &info);
     if ((int)q > lw) {
-      free(work);
+      cv_free(work);
       lw = (int)q;
-      if (!(work = malloc((size_t)lw * sizeof *work))) {
-        free(Q);
+      if (!(work = cv_malloc((size_t)lw * sizeof *work))) {
+        cv_free(Q);
         return -2;
       }
     }
@@ -230,8 +230,8 @@ static int tangent_basis(int n, int nc, const double *A, double *T)
     else
       memcpy(T, Q + (size_t)n * nc, (size_t)n * (n - nc) * sizeof *T);
   }
-  free(work);
-  free(Q);
+  cv_free(work);
+  cv_free(Q);
   return rc;
 }
 
@@ -285,22 +285,22 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
   /* Outputs: L_y (n), L_yy, L_y'y', L_y'y (n*n each), then per constraint G, G_y (n),
    * G_yy (n*n) (P-9, P-10, P-13). */
   int per = 1 + n + nn, nout = n + 3 * nn + nc * per, m = n - nc;
-  outs = malloc((size_t)nout * sizeof *outs);
-  val = malloc((size_t)nout * sizeof *val);
-  md->equilibrium = malloc((size_t)n * sizeof *md->equilibrium);
-  md->multipliers = malloc((size_t)(nc ? nc : 1) * sizeof *md->multipliers);
-  md->omega2 = malloc((size_t)n * sizeof *md->omega2);
-  md->kind = malloc((size_t)n * sizeof *md->kind);
-  md->shape = malloc((size_t)nn * sizeof *md->shape);
-  md->mass = malloc((size_t)nn * sizeof *md->mass);
-  md->stiffness = malloc((size_t)nn * sizeof *md->stiffness);
-  md->gyro_omega = malloc((size_t)n * sizeof *md->gyro_omega);
-  md->gyro_growth = malloc((size_t)n * sizeof *md->gyro_growth);
-  md->gyro_kind = malloc((size_t)n * sizeof *md->gyro_kind);
-  A = malloc((size_t)(2 * N * N + 2 * N) * sizeof *A);
-  Jk = malloc((size_t)(N * N + N) * sizeof *Jk);
-  T = malloc((size_t)(nn + 3 * nn) * sizeof *T);
-  Ag = malloc((size_t)nn * sizeof *Ag); /* constraint gradients, n x nc column-major */
+  outs = cv_malloc((size_t)nout * sizeof *outs);
+  val = cv_malloc((size_t)nout * sizeof *val);
+  md->equilibrium = cv_malloc((size_t)n * sizeof *md->equilibrium);
+  md->multipliers = cv_malloc((size_t)(nc ? nc : 1) * sizeof *md->multipliers);
+  md->omega2 = cv_malloc((size_t)n * sizeof *md->omega2);
+  md->kind = cv_malloc((size_t)n * sizeof *md->kind);
+  md->shape = cv_malloc((size_t)nn * sizeof *md->shape);
+  md->mass = cv_malloc((size_t)nn * sizeof *md->mass);
+  md->stiffness = cv_malloc((size_t)nn * sizeof *md->stiffness);
+  md->gyro_omega = cv_malloc((size_t)n * sizeof *md->gyro_omega);
+  md->gyro_growth = cv_malloc((size_t)n * sizeof *md->gyro_growth);
+  md->gyro_kind = cv_malloc((size_t)n * sizeof *md->gyro_kind);
+  A = cv_malloc((size_t)(2 * N * N + 2 * N) * sizeof *A);
+  Jk = cv_malloc((size_t)(N * N + N) * sizeof *Jk);
+  T = cv_malloc((size_t)(nn + 3 * nn) * sizeof *T);
+  Ag = cv_malloc((size_t)nn * sizeof *Ag); /* constraint gradients, n x nc column-major */
   if (!outs || !val || !md->equilibrium || !md->multipliers || !md->omega2 || !md->kind ||
       !md->shape || !md->mass || !md->stiffness || !A || !md->gyro_omega ||
       !md->gyro_growth || !md->gyro_kind || !Jk || !T || !Ag)
@@ -339,7 +339,7 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
   dsyev_("V", "U", &N, A, &N, &dummy, &q1, &lw, &info);
   dsygv_(&one, "V", "U", &n, A, &n, A + nn, &n, &dummy, &q2, &lw2, &info);
   lw = (int)fmax(fmax(q1, q2), 3.0 * N);
-  if (!(work = malloc(((size_t)N * N + N + (size_t)lw) * sizeof *work)))
+  if (!(work = cv_malloc(((size_t)N * N + N + (size_t)lw) * sizeof *work)))
     goto cleanup;
 
   /* Equilibrium: Newton on the stationarity of L + lambda.G at y' = 0 (with G = 0) from
@@ -510,13 +510,13 @@ int scene_modes_new(scene *s, sc_modes *md, char *err, size_t errlen)
 cleanup:
   if (rc == SC_MODES_NOMEM)
     sc_err(err, errlen, s->file, 0, "out of memory while computing the modes");
-  free(outs);
-  free(val);
-  free(work);
-  free(A);
-  free(Jk);
-  free(T);
-  free(Ag);
+  cv_free(outs);
+  cv_free(val);
+  cv_free(work);
+  cv_free(A);
+  cv_free(Jk);
+  cv_free(T);
+  cv_free(Ag);
   if (rc != SC_MODES_OK)
     scene_modes_free(md);
   return rc;
@@ -526,15 +526,15 @@ void scene_modes_free(sc_modes *md)
 {
   if (!md)
     return;
-  free(md->equilibrium);
-  free(md->omega2);
-  free(md->kind);
-  free(md->shape);
-  free(md->mass);
-  free(md->stiffness);
-  free(md->gyro_omega);
-  free(md->gyro_growth);
-  free(md->gyro_kind);
-  free(md->multipliers);
+  cv_free(md->equilibrium);
+  cv_free(md->omega2);
+  cv_free(md->kind);
+  cv_free(md->shape);
+  cv_free(md->mass);
+  cv_free(md->stiffness);
+  cv_free(md->gyro_omega);
+  cv_free(md->gyro_growth);
+  cv_free(md->gyro_kind);
+  cv_free(md->multipliers);
   memset(md, 0, sizeof *md);
 }

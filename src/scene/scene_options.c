@@ -11,25 +11,9 @@
 int sc_load_mesh(sc_loader *L);
 int sc_load_solver(sc_loader *L);
 
-static const char *const method_names[SC_NUM_METHODS] = {
-  "newton", "lbfgs", "tnewton", "mma", "ccsaq", "slsqp", "auglag"};
-
-const char *scene_method_name(sc_method m)
+unsigned scene_method_need(cv_method m)
 {
-  return m >= 0 && m < SC_NUM_METHODS ? method_names[m] : "?";
-}
-
-int scene_method_from_name(const char *name)
-{
-  for (int i = 0; i < SC_NUM_METHODS; i++)
-    if (strcmp(name, method_names[i]) == 0)
-      return i;
-  return -1;
-}
-
-unsigned scene_method_need(sc_method m)
-{
-  return m == SC_NEWTON ? CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS
+  return m == CVAR_METHOD_NEWTON ? CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS
                         : CVAR_NEED_F | CVAR_NEED_GRAD;
 }
 
@@ -59,28 +43,28 @@ static int cmp_double(const void *a, const void *b)
 static int load_breakpoints(sc_loader *L, const sc_entry *e)
 {
   scene *s = L->s;
-  sc_list list;
-  if (sc_list_split(e->value, &list) < 0 ||
-      !(s->breakpoints = malloc((size_t)list.n * sizeof *s->breakpoints))) {
-    sc_list_free(&list);
+  ex_list list;
+  if (ex_list_split(e->value, &list) < 0 ||
+      !(s->breakpoints = cv_malloc((size_t)list.n * sizeof *s->breakpoints))) {
+    ex_list_free(&list);
     sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
     return -1;
   }
   for (int i = 0; i < list.n; i++) {
     double v;
     if (sc_parse_const(L, e, list.off[i], list.item[i], "breakpoint", &v) < 0) {
-      sc_list_free(&list);
+      ex_list_free(&list);
       return -1;
     }
     if (!(v > s->a && v < s->b)) {
       sc_err(L->err, L->errlen, L->file, e->line,
              "breakpoint %.17g is not inside the interval (%.17g, %.17g)", v, s->a, s->b);
-      sc_list_free(&list);
+      ex_list_free(&list);
       return -1;
     }
     s->breakpoints[s->nbreak++] = v;
   }
-  sc_list_free(&list);
+  ex_list_free(&list);
   qsort(s->breakpoints, (size_t)s->nbreak, sizeof *s->breakpoints, cmp_double);
   for (int i = 1; i < s->nbreak; i++)
     if (s->breakpoints[i] == s->breakpoints[i - 1]) {
@@ -171,7 +155,7 @@ int sc_load_solver(sc_loader *L)
 {
   static const char *const keys[] = {"method", "tolerance", "max_iterations", NULL};
   scene *s = L->s;
-  s->method = SC_NEWTON;
+  s->method = CVAR_METHOD_NEWTON;
   s->tolerance = 1e-10;
   s->max_iterations = 50;
   if (sc_check_keys(L, SEC_SOLVER, keys, "method, tolerance, max_iterations") < 0)
@@ -179,13 +163,11 @@ int sc_load_solver(sc_loader *L)
   for (int i = 0; i < L->raw.ne[SEC_SOLVER]; i++) {
     const sc_entry *e = &L->raw.e[SEC_SOLVER][i];
     if (strcmp(e->key, "method") == 0) {
-      int m = scene_method_from_name(e->value);
-      if (m < 0) {
+      if (cv_method_from_name(e->value, &s->method) != CVAR_OK) {
         sc_err(L->err, L->errlen, L->file, e->line, "unknown method '%s' (known: newton, "
                "lbfgs, tnewton, mma, ccsaq, slsqp, auglag)", e->value);
         return -1;
       }
-      s->method = (sc_method)m;
       s->method_line = e->line;
     } else if (strcmp(e->key, "tolerance") == 0) {
       if (sc_parse_const(L, e, 0, e->value, "tolerance", &s->tolerance) < 0)

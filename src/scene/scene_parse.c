@@ -11,59 +11,6 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-void sc_list_free(sc_list *list)
-{
-  for (int i = 0; i < list->n; i++)
-    free(list->item[i]);
-  free(list->item);
-  free(list->off);
-  memset(list, 0, sizeof *list);
-}
-
-/* Split at commas outside parentheses (SCENES.md: `atan2(1, 2), 0` is two values); each
- * item is trimmed. Returns the item count, or -1 on allocation failure. */
-int sc_list_split(const char *value, sc_list *list)
-{
-  int depth = 0, cap = 0;
-  const char *start = value;
-  memset(list, 0, sizeof *list);
-  for (const char *p = value;; p++) {
-    if (*p == '(')
-      depth++;
-    else if (*p == ')' && depth > 0)
-      depth--;
-    if (*p == '\0' || (*p == ',' && depth == 0)) {
-      const char *a = start, *b = p;
-      while (a < b && (*a == ' ' || *a == '\t'))
-        a++;
-      while (b > a && (b[-1] == ' ' || b[-1] == '\t'))
-        b--;
-      if (list->n == cap) {
-        cap = cap ? 2 * cap : 4;
-        char **it = realloc(list->item, (size_t)cap * sizeof *it);
-        if (it)
-          list->item = it;
-        int *off = realloc(list->off, (size_t)cap * sizeof *off);
-        if (off)
-          list->off = off;
-        if (!it || !off)
-          goto nomem;
-      }
-      list->item[list->n] = sc_strndup(a, (size_t)(b - a));
-      if (!list->item[list->n])
-        goto nomem;
-      list->off[list->n++] = (int)(a - value);
-      if (*p == '\0')
-        break;
-      start = p + 1;
-    }
-  }
-  return list->n;
-nomem:
-  sc_list_free(list);
-  return -1;
-}
-
 /* The name of a slot for messages: the variable, y or y'. */
 const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap)
 {

@@ -3,7 +3,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "core/cv_internal_owned.h"
 #include "expr/ex_integrand.h"
 #include "scene/scene_internal.h"
 
@@ -124,7 +123,7 @@ cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_
   }
   if (st == CVAR_OK) {
     what = "method";
-    st = cv_solver_set_method(sv, (cv_method)s->method); /* same order as cv_method */
+    st = cv_solver_set_method(sv, s->method);
   }
   if (st != CVAR_OK)
     sc_err(err, errlen, s->file, 0, "%s: %s (%s)", what, cv_solver_last_error(sv),

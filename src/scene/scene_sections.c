@@ -52,7 +52,7 @@ static int distance(const char *a, const char *b)
  * names of the scene qualify, so a parameter called `fee` still works. */
 static int looks_like_free(const scene *s, const char *t)
 {
-  if (!sc_is_identifier(t) || strcmp(t, "free") == 0 || distance(t, "free") > 1)
+  if (!ex_is_identifier(t) || strcmp(t, "free") == 0 || distance(t, "free") > 1)
     return 0;
   if (unknown_index(s, t) >= 0 || strcmp(t, s->variable) == 0)
     return 0;
@@ -68,7 +68,7 @@ static int looks_like_free(const scene *s, const char *t)
 int sc_load_boundary(sc_loader *L)
 {
   scene *s = L->s;
-  s->bc = calloc((size_t)s->n, sizeof *s->bc);
+  s->bc = cv_calloc((size_t)s->n, sizeof *s->bc);
   if (!s->bc)
     return nomem(L, 0);
   for (int i = 0; i < L->raw.ne[SEC_BOUNDARY]; i++) {
@@ -79,14 +79,14 @@ int sc_load_boundary(sc_loader *L)
              e->key);
       return -1;
     }
-    sc_list list;
-    if (sc_list_split(e->value, &list) < 0)
+    ex_list list;
+    if (ex_list_split(e->value, &list) < 0)
       return nomem(L, e->line);
     if (list.n != 2) {
       sc_err(L->err, L->errlen, L->file, e->line,
              "[boundary] %s needs two values 'value_at_a, value_at_b', got %d", e->key,
              list.n);
-      sc_list_free(&list);
+      ex_list_free(&list);
       return -1;
     }
     s->bc[k].line = e->line;
@@ -101,16 +101,16 @@ int sc_load_boundary(sc_loader *L)
         sc_err(L->err, L->errlen, L->file, e->line,
                "[boundary] %s: '%s' is not a value; did you mean 'free' (lower case)?",
                e->key, t);
-        sc_list_free(&list);
+        ex_list_free(&list);
         return -1;
       }
       snprintf(what, sizeof what, "[boundary] %s at %s", e->key, end ? "b" : "a");
       if (sc_parse_const(L, e, list.off[end], t, what, &s->bc[k].value[end]) < 0) {
-        sc_list_free(&list);
+        ex_list_free(&list);
         return -1;
       }
     }
-    sc_list_free(&list);
+    ex_list_free(&list);
   }
   for (int k = 0; k < s->n; k++)
     if (!s->bc[k].line) {
@@ -147,8 +147,8 @@ static ex_id parse_of_variable(sc_loader *L, const sc_entry *e, const char *what
 int sc_load_guess_exact(sc_loader *L)
 {
   scene *s = L->s;
-  s->guess = malloc((size_t)s->n * sizeof *s->guess);
-  s->exact = malloc((size_t)s->n * sizeof *s->exact);
+  s->guess = cv_malloc((size_t)s->n * sizeof *s->guess);
+  s->exact = cv_malloc((size_t)s->n * sizeof *s->exact);
   if (!s->guess || !s->exact)
     return nomem(L, 0);
   for (int i = 0; i < s->n; i++)
@@ -190,7 +190,7 @@ static int load_named(sc_loader *L, int sec, sc_item **out, int *nout)
     const sc_entry *e = &L->raw.e[sec][i];
     sc_item *it = &(*out)[i];
     char what[160];
-    if (!sc_is_identifier(e->key)) {
+    if (!ex_is_identifier(e->key)) {
       sc_err(L->err, L->errlen, L->file, e->line, "'%s' is not a valid name in [%s]",
              e->key, sc_section_name(sec));
       return -1;
@@ -207,8 +207,8 @@ static int load_named(sc_loader *L, int sec, sc_item **out, int *nout)
         return -1;
       continue;
     }
-    sc_list list;
-    if (sc_list_split(e->value, &list) < 0)
+    ex_list list;
+    if (ex_list_split(e->value, &list) < 0)
       return nomem(L, e->line);
     int rc = -1;
     if (list.n != 2)
@@ -221,7 +221,7 @@ static int load_named(sc_loader *L, int sec, sc_item **out, int *nout)
       it->expr2 = ex_num(L->s->dag, it->value);
       rc = 0;
     }
-    sc_list_free(&list);
+    ex_list_free(&list);
     if (rc < 0)
       return -1;
   }
@@ -243,12 +243,12 @@ static int check_constraint_ends(sc_loader *L, const sc_item *c)
     if (!fixed)
       continue;
     int ns = 1 + 2 * n;
-    ex_id *outs = malloc((size_t)(n + 1) * sizeof *outs);
-    double x = end ? s->b : s->a, *y = calloc((size_t)(ns + n + 1), sizeof *y);
+    ex_id *outs = cv_malloc((size_t)(n + 1) * sizeof *outs);
+    double x = end ? s->b : s->a, *y = cv_calloc((size_t)(ns + n + 1), sizeof *y);
     double *v = y ? y + ns : NULL;
     if (!outs || !y) {
-      free(outs);
-      free(y);
+      cv_free(outs);
+      cv_free(y);
       return nomem(L, c->line);
     }
     outs[0] = c->expr;
@@ -263,8 +263,8 @@ static int check_constraint_ends(sc_loader *L, const sc_item *c)
     double scale = 1.0, g = v[0];
     for (int i = 0; i < n; i++)
       scale += fabs(y[i] * v[1 + i]);
-    free(outs);
-    free(y);
+    cv_free(outs);
+    cv_free(y);
     if (rc < 0)
       return nomem(L, c->line);
     if (!(fabs(g) <= 1e-8 * scale)) {

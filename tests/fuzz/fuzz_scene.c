@@ -34,8 +34,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
       x[k] = s->a + (s->b - s->a) * (k + 0.5) / m;
     scene_eval_guess(s, m, x, y);
     scene_eval_exact(s, m, x, dy);
-    scene_eval_energy(s, m, x, y, dy, out);
-    scene_eval_momenta(s, m, x, y, dy, out);
+    if (p)
+      cv_problem_eval_energy(p, m, x, y, dy, out, out + m);
     if (s->nreports <= 2 * n + 3)
       scene_eval_reports(s, m, x, y, dy, out);
     free(y);

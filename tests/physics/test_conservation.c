@@ -79,9 +79,9 @@ static spread measure(const char *dir, const char *name, int what, int degree, i
   double *x = buf, *w = x + nq, *y = w + nq, *dy = y + (size_t)n * nq, *q = dy + (size_t)n * nq;
   cv_solver_get_qpoints(sv, x, w, y, dy);
   if (what == MOMENTUM)
-    scene_eval_momenta(s, nq, x, y, dy, q); /* unknown 0 */
+    cv_problem_eval_energy(p, nq, x, y, dy, NULL, q); /* unknown 0 */
   else
-    scene_eval_energy(s, nq, x, y, dy, q);
+    cv_problem_eval_energy(p, nq, x, y, dy, q, NULL);
   int per = nq / ne;
   double lo = INFINITY, hi = -INFINITY, mlo = INFINITY, mhi = -INFINITY, terr = 0;
   for (int e = 0; e < ne; e++) {

@@ -23,7 +23,7 @@ calcvar, data = [os.path.abspath(a) for a in sys.argv[1:3]]
 failures = 0
 checks = 0
 
-BASE = {"title", "status", "message", "method", "elements", "degree", "nodes", "unknowns",
+BASE = {"schema", "title", "status", "message", "method", "elements", "degree", "nodes", "unknowns",
         "action", "gradient_norm", "iterations", "time_s", "morse_index", "stationary_kind"}
 
 

@@ -1,4 +1,4 @@
-/* src/cli/report_json.c — the JSON report of SCENES.md ("--json"), with jansson.
+/* src/scene/scene_report_json.c — the JSON report of SCENES.md ("--json"), with jansson.
  * SPDX-License-Identifier: MIT
  *
  * Keys that do not apply are left out (never placeholders); so is any number that came
@@ -8,7 +8,7 @@
 #include <jansson.h>
 #include <math.h>
 
-#include "cli/cli.h"
+#include "scene/scene_report.h"
 
 /* Set key to a real only when it is finite (json_real refuses NaN and infinities). */
 static int set_real(json_t *o, const char *key, double v)
@@ -37,10 +37,11 @@ json_t *cli_report_json_object(const cli_report *r)
   json_t *o = json_object(), *a;
   if (!o)
     return NULL;
+  json_object_set_new(o, "schema", json_integer(CVAR_REPORT_SCHEMA)); /* an addition */
   json_object_set_new(o, "title", json_string(s->title));
   json_object_set_new(o, "status", json_string(r->status));
   json_object_set_new(o, "message", json_string(r->message));
-  json_object_set_new(o, "method", json_string(scene_method_name(r->method)));
+  json_object_set_new(o, "method", json_string(cv_method_name(r->method)));
   if (r->nodes > 0) {
     json_object_set_new(o, "elements", json_integer(r->elements));
     json_object_set_new(o, "degree", json_integer(r->degree));
@@ -117,4 +118,14 @@ int cli_report_json(FILE *f, const cli_report *r)
     rc = -1;
   json_decref(o);
   return rc;
+}
+
+char *cli_report_json_text(const cli_report *r)
+{
+  json_t *o = cli_report_json_object(r);
+  if (!o)
+    return NULL;
+  char *text = json_dumps(o, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
+  json_decref(o);
+  return text;
 }

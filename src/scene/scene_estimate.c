@@ -1,4 +1,4 @@
-/* src/cli/estimate.c — the error estimate of a report without [exact]: the core's one
+/* src/scene/scene_estimate.c — the error estimate of a report without [exact]: the core's one
  * estimator (cv_solver_estimate_error, theory HP-2 and HP-3), and what to say when it gives
  * no bound. docs/cli.md and docs/performance.md give its measured accuracy.
  * SPDX-License-Identifier: MIT */
@@ -6,7 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "cli/cli.h"
+#include "scene/scene_report.h"
 
 int cli_estimate_error(const cv_solver *sv, const cv_problem *p, double *e_all,
                        double *e_vertex, char *why, size_t len)

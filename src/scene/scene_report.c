@@ -1,4 +1,4 @@
-/* src/cli/report.c — gather what `solve` reports from a solver and its scene.
+/* src/scene/scene_report.c — gather what `solve` reports from a solver and its scene.
  * SPDX-License-Identifier: MIT
  *
  * Energy, momenta and [report] integrals are evaluated at the solver's quadrature points
@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "cli/cli.h"
+#include "scene/scene_report.h"
 
 const char *cli_status_string(cv_status st)
 {
@@ -132,8 +132,9 @@ static int constraints_depend_on(const scene *s, int slot)
   return 0;
 }
 
-/* Energy, momenta and report integrals at the quadrature points. */
-static int qpoint_quantities(cli_report *r, scene *s, cv_solver *sv)
+/* Energy, momenta and report integrals at the quadrature points. Energy and momenta come
+ * from the problem's compiled integrand (the partials the solver used). */
+static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv)
 {
   int n = s->n, nq = cv_solver_get_num_qpoints(sv), rc = -1;
   if (nq <= 0)
@@ -143,7 +144,8 @@ static int qpoint_quantities(cli_report *r, scene *s, cv_solver *sv)
   double *y = malloc(q * n * sizeof *y), *dy = malloc(q * n * sizeof *dy);
   size_t nv = q * (size_t)(n > s->nreports ? n : s->nreports);
   double *v = malloc((nv > q ? nv : q) * sizeof *v);
-  if (!x || !w || !y || !dy || !v)
+  double *H = malloc(q * sizeof *H), *mom = malloc(q * n * sizeof *mom);
+  if (!x || !w || !y || !dy || !v || !H || !mom)
     goto done;
   if (cv_solver_get_qpoints(sv, x, w, y, dy) != CVAR_OK) {
     rc = 0; /* nothing to evaluate on: leave the keys out */
@@ -152,17 +154,18 @@ static int qpoint_quantities(cli_report *r, scene *s, cv_solver *sv)
   /* With constraints, H of F alone is conserved only when no constraint depends on the
    * variable and there is no integral constraint (whose multiplier enters the conserved
    * quantity); a momentum only when no constraint involves that unknown (docs/cli.md). */
-  if (!scene_F_depends_on_variable(s) && s->nints == 0 && !constraints_depend_on(s, 0)) {
-    if (scene_eval_energy(s, nq, x, y, dy, v) < 0)
-      goto done;
-    r->has_energy = elem_avg_range(v, w, nq, r->elements, &r->emin, &r->emax) == 0;
-  }
-  if (scene_eval_momenta(s, nq, x, y, dy, v) < 0)
+  cv_status st = cv_problem_eval_energy(p, nq, x, y, dy, H, mom);
+  if (st == CVAR_ENOMEM)
     goto done;
-  for (int i = 0; i < n; i++)
+  /* A callback that fails here leaves energy and momenta out, as non-finite values do. */
+  int have = st == CVAR_OK;
+  if (have && !scene_F_depends_on_variable(s) && s->nints == 0 &&
+      !constraints_depend_on(s, 0))
+    r->has_energy = elem_avg_range(H, w, nq, r->elements, &r->emin, &r->emax) == 0;
+  for (int i = 0; i < n && have; i++)
     if (!scene_F_depends_on_unknown(s, i) && !constraints_depend_on(s, 1 + i))
-      r->has_mom[i] = elem_avg_range(v + (size_t)i * q, w, nq, r->elements, &r->mom_min[i],
-                                     &r->mom_max[i]) == 0;
+      r->has_mom[i] = elem_avg_range(mom + (size_t)i * q, w, nq, r->elements,
+                                     &r->mom_min[i], &r->mom_max[i]) == 0;
   if (s->nreports > 0 && scene_eval_reports(s, nq, x, y, dy, v) < 0)
     goto done;
   for (int k = 0; k < s->nreports; k++) {
@@ -179,6 +182,8 @@ done:
   free(y);
   free(dy);
   free(v);
+  free(H);
+  free(mom);
   return rc;
 }
 
@@ -213,7 +218,8 @@ static void compose_message(cli_report *r, cv_solver *sv)
 }
 
 /* Fill r after cv_solve returned st. Returns 0, or -1 on allocation failure. */
-int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_status st)
+int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv,
+                       cv_method m, cv_status st)
 {
   int n = s->n;
   memset(r, 0, sizeof *r);
@@ -255,7 +261,7 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
 
   /* The Morse index describes a stationary point: reported only when Newton converged to
    * one (an unconverged iterate's inertia says nothing about the answer). */
-  if (m == SC_NEWTON && st == CVAR_OK) {
+  if (m == CVAR_METHOD_NEWTON && st == CVAR_OK) {
     int morse = cv_solver_get_morse_index(sv), nfree = cv_solver_get_num_free(sv);
     if (morse >= 0) {
       r->has_morse = 1;
@@ -292,8 +298,27 @@ int cli_report_collect(cli_report *r, scene *s, cv_solver *sv, sc_method m, cv_s
     r->has_err_action = 1;
     r->err_action = fabs(r->action - s->exact_action);
   }
-  if (nn > 0 && qpoint_quantities(r, s, sv) < 0)
+  if (nn > 0 && qpoint_quantities(r, s, p, sv) < 0)
     return -1;
   compose_message(r, sv);
   return 0;
+}
+
+int cli_report_build(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv, cv_status st,
+                     int adaptive)
+{
+  if (cli_report_collect(r, s, p, sv, cv_solver_get_method(sv), st) < 0)
+    return -1;
+  int any_exact = 0;
+  for (int i = 0; i < s->n; i++)
+    any_exact |= s->exact[i] >= 0;
+  if (adaptive) {
+    /* the rounds' own estimate (theory HP-2); with --tol always, and the degrees */
+    double est = cv_solver_get_error_estimate(sv);
+    r->has_err_est = (adaptive == 2 || !any_exact) && isfinite(est);
+    r->err_est = est;
+    r->has_degrees = adaptive == 2;
+    return 0;
+  }
+  return any_exact ? 0 : cli_report_estimate(r, sv, p);
 }

@@ -1,0 +1,228 @@
+/* src/core/cv_start.c — the start of a solve: discretisation of the current mesh spec,
+ * starting values (given, guessed or the straight line) and singular-end detection.
+ * SPDX-License-Identifier: MIT */
+#include <float.h>
+#include <math.h>
+#include <string.h>
+
+#include "cv_internal.h"
+
+/* The default start at fraction t of the interval: the straight line between the end
+ * values (a free end takes the other end's value; both free: 0). */
+static void straight_line(const cv_problem *p, double t, double *y) {
+  for (int i = 0; i < p->n; i++) {
+    int fa = p->fixed[2 * i], fb = p->fixed[2 * i + 1];
+    double ya = p->endval[2 * i], yb = p->endval[2 * i + 1];
+    if (!fa) ya = fb ? yb : 0.0;
+    if (!fb) yb = ya;
+    y[i] = ya + (yb - ya) * t;
+  }
+}
+
+/* Initial nodal values: user start, guess callback, or (always with line = 1) the
+ * straight line. Fixed ends always win. */
+cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y,
+                          int line) {
+  int n = p->n;
+  if (s->start && !line) {
+    if (s->start_len != d->ndof) {
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "start vector has %d values but the mesh has %d nodes x %d unknowns",
+                 s->start_len, d->nodes, n);
+      return CVAR_EINVAL;
+    }
+    memcpy(Y, s->start, (size_t)d->ndof * sizeof *Y);
+  } else if (p->guess && !line) {
+    double xb[CV_BATCH], *yb = cv_malloc((size_t)n * CV_BATCH * sizeof *yb);
+    if (!yb) return CVAR_ENOMEM;
+    for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
+      int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
+      for (int k = 0; k < m; k++) xb[k] = cv_disc_node_x(d, j0 + k);
+      int rc = p->guess(m, xb, yb, p->guess_user);
+      for (int k = 0; k < m && rc == 0; k++)
+        for (int i = 0; i < n; i++) {
+          if (!isfinite(yb[i * m + k])) rc = 1;
+          Y[(j0 + k) * n + i] = yb[i * m + k];
+        }
+      if (rc) {
+        cv_free(yb);
+        cv_set_msg(s->msg, sizeof s->msg,
+                   "the initial guess is not finite (or its callback failed) near x = %g",
+                   xb[0]);
+        return CVAR_ECALLBACK;
+      }
+    }
+    cv_free(yb);
+  } else {
+    /* node by node, element by element: no array of abscissae (a large solve faults in
+     * every page it allocates, docs/performance.md) */
+    double rl = 1.0 / (d->b - d->a);
+    for (long e = 0; e < d->E; e++) {
+      double x0 = d->xe[e], h = d->xe[e + 1] - x0;
+      const double *xi = cv_disc_eref(d, e)->xi;
+      for (int l = 0, pe = cv_disc_edeg(d, e); l < pe; l++) {
+        double x = l ? x0 + 0.5 * (xi[l] + 1.0) * h : x0;
+        straight_line(p, (x - d->a) * rl, Y + (cv_disc_enode(d, e) + l) * n);
+      }
+    }
+    straight_line(p, 1.0, Y + (d->nodes - 1) * n);
+    for (int i = 0; i < n; i++) { /* exactly, so that no blend below is needed */
+      if (p->fixed[2 * i]) Y[i] = p->endval[2 * i];
+      if (p->fixed[2 * i + 1]) Y[(d->nodes - 1) * n + i] = p->endval[2 * i + 1];
+    }
+  }
+  /* A start or guess that misses the fixed end values is shifted onto them by a linear
+   * blend, da (1 - t) + db t, rather than having its end nodes overwritten: a kink in the
+   * end elements makes a poor Newton start (measured: a catenary warm-started from its
+   * neighbour in a continuation diverged with the end nodes overwritten). */
+  long last = d->nodes - 1;
+  for (int i = 0; i < n; i++) {
+    double da = p->fixed[2 * i] ? p->endval[2 * i] - Y[i] : 0.0;
+    double db = p->fixed[2 * i + 1] ? p->endval[2 * i + 1] - Y[last * n + i] : 0.0;
+    if (da == 0.0 && db == 0.0) continue;
+    for (long j = 0; j <= last; j++) {
+      double t = (cv_disc_node_x(d, j) - d->a) / (d->b - d->a);
+      Y[j * n + i] += da * (1.0 - t) + db * t;
+    }
+    if (p->fixed[2 * i]) Y[i] = p->endval[2 * i];
+    if (p->fixed[2 * i + 1]) Y[last * n + i] = p->endval[2 * i + 1];
+  }
+  return CVAR_OK;
+}
+
+/* An end where F itself is not finite at the end value (the brachistochrone's 1/sqrt(y) at
+ * y = 0) gets the singular-end rule (Q-2) on its element; Gauss points avoid the end, but a
+ * fixed Gauss rule under-integrates there and the discrete minimiser exploits it. */
+static void detect_singular_ends(const cv_problem *p, cv_disc *d, const double *Y) {
+  int n = p->n;
+  double x, *buf = cv_malloc((2 * (size_t)n + 1) * sizeof *buf);
+  if (!buf) return;
+  for (int end = 0; end < 2; end++) {
+    long node = end ? d->nodes - 1 : 0;
+    long e = end ? d->E - 1 : 0;
+    double h = d->xe[e + 1] - d->xe[e], phi[CV_MAX_DEGREE + 1], dphi[CV_MAX_DEGREE + 1];
+    int pe = cv_disc_edeg(d, e);
+    cv_lagrange(pe, cv_disc_eref(d, e)->xi, end ? 1.0 : -1.0, phi, dphi);
+    for (int i = 0; i < n; i++) {
+      double dv = 0.0;
+      for (int l = 0; l <= pe; l++) dv += Y[(cv_disc_enode(d, e) + l) * n + i] * dphi[l];
+      buf[i] = Y[node * n + i];
+      buf[n + i] = dv * 2.0 / h;
+    }
+    x = end ? d->b : d->a;
+    cv_partials o = {buf + 2 * n, NULL, NULL, NULL, NULL, NULL};
+    int rc = p->F(1, &x, buf, buf + n, CVAR_NEED_F, &o, p->user);
+    /* infinite (or "cannot evaluate here"), not NaN: a NaN end is undefined, not singular */
+    int singular = rc > 0 || (rc == 0 && isinf(o.F[0]));
+    if (end) d->sing_b = singular;
+    else d->sing_a = singular;
+  }
+  cv_free(buf);
+}
+
+/* Discretisation, starting values and singular-end detection for the current mesh spec. */
+cv_status cv_start_setup(cv_solver *s, const cv_problem *p) {
+  cv_status st;
+  cv_free(s->y);
+  cv_free(s->mult);
+  s->y = s->mult = NULL;
+  cv_disc_free(&s->disc);
+  s->have = 0;
+  st = cv_disc_init(&s->disc, p, s, s->msg, sizeof s->msg);
+  if (st) {
+    if (st == CVAR_ENOMEM) cv_set_msg(s->msg, sizeof s->msg, "out of memory building the mesh");
+    return st;
+  }
+  s->y = cv_malloc((size_t)s->disc.ndof * sizeof *s->y);
+  s->mult = cv_calloc((size_t)s->disc.nodes * p->nc + p->ni + 1, sizeof *s->mult);
+  if (!s->y || !s->mult) {
+    cv_set_msg(s->msg, sizeof s->msg, "out of memory for %d nodal values", s->disc.ndof);
+    return CVAR_ENOMEM;
+  }
+  st = cv_start_values(s, p, &s->disc, s->y, 0);
+  if (st) return st;
+  s->have = 1;
+  detect_singular_ends(p, &s->disc, s->y);
+  s->disc.sing_a |= s->near_sing[0];
+  s->disc.sing_b |= s->near_sing[1];
+  st = cv_disc_build_singular_rules(&s->disc);
+  if (st) cv_set_msg(s->msg, sizeof s->msg, "out of memory for the singular-end quadrature");
+  return st;
+}
+
+/* The discrete integral of F over element e with the rule (tau, omega) of n points. */
+static int element_integral(const cv_problem *p, const cv_disc *d, const double *Y, long e,
+                            int q, const double *tau, const double *omega, double *buf,
+                            double *S) {
+  int n = p->n, P1 = cv_disc_edeg(d, e) + 1;
+  long j0 = cv_disc_enode(d, e);
+  double phi[CV_MAX_DEGREE + 1], dphi[CV_MAX_DEGREE + 1];
+  double x0 = d->xe[e], h = d->xe[e + 1] - x0, *x = buf, *y = x + q, *dy = y + (size_t)n * q;
+  double *F = dy + (size_t)n * q;
+  for (int k = 0; k < q; k++) {
+    x[k] = x0 + 0.5 * (tau[k] + 1.0) * h;
+    cv_lagrange(P1 - 1, cv_disc_eref(d, e)->xi, tau[k], phi, dphi);
+    for (int i = 0; i < n; i++) {
+      double a = 0.0, b = 0.0;
+      for (int l = 0; l < P1; l++) {
+        a += Y[(j0 + l) * n + i] * phi[l];
+        b += Y[(j0 + l) * n + i] * dphi[l];
+      }
+      y[i * q + k] = a;
+      dy[i * q + k] = b * 2.0 / h;
+    }
+  }
+  cv_partials o = {F, NULL, NULL, NULL, NULL, NULL};
+  int rc = p->F(q, x, y, dy, CVAR_NEED_F, &o, p->user);
+  double sum = 0.0;
+  for (int k = 0; k < q; k++) sum += 0.5 * h * omega[k] * F[k];
+  *S = sum;
+  return rc == 0 && isfinite(sum);
+}
+
+/* |integral under the element's own rule - under the singular-end rule at c| over element
+ * e (Q-2 mapping x = c +- u^2 with qs Gauss points in u); INFINITY if F fails. */
+static double rule_gap(const cv_problem *p, const cv_disc *d, const double *Y, long e, int end,
+                       double *buf, double *own) {
+  int qs = cv_disc_eref(d, e)->qs;
+  double t[CV_MAX_QUAD], w[CV_MAX_QUAD], tau[CV_MAX_QUAD], om[CV_MAX_QUAD];
+  cv_gauss_legendre(qs, t, w);
+  double x0 = d->xe[e], x1 = d->xe[e + 1], h = x1 - x0, J = 0.5 * h, c = end ? d->b : d->a;
+  double u0 = sqrt(fabs(x0 - c)), u1 = sqrt(fabs(x1 - c));
+  for (int k = 0; k < qs; k++) {
+    double u = u0 + (u1 - u0) * 0.5 * (t[k] + 1.0), x = end ? c - u * u : c + u * u;
+    tau[k] = 2.0 * (x - x0) / h - 1.0;
+    om[k] = 0.5 * fabs(u1 - u0) * w[k] * 2.0 * u / J;
+  }
+  cv_rule r = cv_disc_rule(d, e);
+  double S0, S1;
+  int ok = element_integral(p, d, Y, e, r.q, r.tau, r.omega, buf, &S0) &&
+           element_integral(p, d, Y, e, qs, tau, om, buf, &S1);
+  *own = ok ? fabs(S0) : 0.0;
+  return ok ? fabs(S1 - S0) : INFINITY;
+}
+
+/* A nearly singular end (theory Q-3): F finite at the end value but varying on a scale
+ * far below the end element (the brachistochrone to (10, 0.01): 1/sqrt(y) with y coming
+ * up to 0.01 at slope -18). The element's rule then under-integrates it and the minimiser
+ * exploits that. The end element's integral under its own rule is compared with the
+ * singular-end rule (Q-2) at that end, and so is its neighbour's: the end is unresolved
+ * when the end element's gap exceeds 1e-8 of the action (or of the element's own integral,
+ * for an action near zero) and 100 times its neighbour's
+ * (a smooth F on coarse elements has gaps of one size everywhere), or F cannot be
+ * evaluated at the finer points. *rel: the end element's gap relative to the action. */
+int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
+                            double action, double *rel) {
+  *rel = 0.0;
+  if (end ? d->sing_b : d->sing_a) return 0;
+  long e = end ? d->E - 1 : 0, e1 = end ? d->E - 2 : 1;
+  int q = d->ref.qs > d->ref.q ? d->ref.qs : d->ref.q;
+  double *buf = cv_malloc((size_t)q * (2 * (size_t)p->n + 2) * sizeof *buf);
+  if (!buf) return 0;
+  double own, own1;
+  double gap = rule_gap(p, d, Y, e, end, buf, &own);
+  double next = d->E > 1 && isfinite(gap) ? rule_gap(p, d, Y, e1, end, buf, &own1) : 0.0;
+  cv_free(buf);
+  *rel = gap / fmax(fmax(fabs(action), own), DBL_MIN);
+  return !(*rel <= 1e-8) && !(gap <= 100.0 * next);
+}
