@@ -2,7 +2,8 @@
  * problems: time of one whole --tol solve (fresh solver: configure, all rounds, free; the
  * fastest of repeats filling 50 ms), nodes, rounds, the estimate and the true error, and, in
  * the same run, the time of one solve on the best hand-picked mesh of docs/performance.md
- * for that accuracy (the baseline), with the ratio.
+ * for that accuracy (the baseline), with the ratio; then the brachistochrone's action error
+ * against sqrt(nodes) as the tolerance falls (HP-5: exp(-b sqrt(N))).
  * Usage: bench_tol [scene_dir (default: the tests' copy of the reference problems)]
  * SPDX-License-Identifier: MIT */
 #include <math.h>
@@ -129,5 +130,35 @@ int main(int argc, char **argv) {
     cv_problem_free(p);
     scene_free(s);
   }
+  /* Exponential convergence in sqrt(unknowns) (HP-5): the brachistochrone's action error
+   * against the nodes as T falls; b from the least-squares line ln(err) = c - b sqrt(N). */
+  char path[1024], err[SC_ERRLEN];
+  snprintf(path, sizeof path, "%s/brachistochrone.scene", dir);
+  scene *s = scene_load_file(path, 0, NULL, err, sizeof err);
+  cv_problem *p = s ? scene_problem_new(s, scene_method_need(s->method), err, sizeof err) : NULL;
+  if (!p) {
+    fprintf(stderr, "%s\n", err);
+    scene_free(s);
+    return 1;
+  }
+  printf("\nbrachistochrone: action error against sqrt(nodes) under --tol\n%8s %6s %10s %10s\n",
+         "tol", "nodes", "sqrt(N)", "act_err");
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int m = 0;
+  for (double T = 1e-3; T >= 0.99e-12; T /= 10) {
+    bench_result a;
+    if (run(s, p, T, 0, 0, &a) < 0) break;
+    double r = sqrt((double)a.nodes), e = fmax(a.errA, 1e-16);
+    printf("%8.0e %6d %10.2f %10.2e\n", T, a.nodes, r, a.errA);
+    if (a.errA > 1e-14) { /* above round-off */
+      sx += r, sy += log(e), sxx += r * r, sxy += r * log(e);
+      m++;
+    }
+  }
+  if (m >= 3)
+    printf("fit ln(err) = c - b sqrt(N): b = %.3f (%d points above round-off)\n",
+           -(m * sxy - sx * sy) / (m * sxx - sx * sx), m);
+  cv_problem_free(p);
+  scene_free(s);
   return 0;
 }
