@@ -194,6 +194,40 @@ CVAR_API cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *vari
                                         const char *unknowns, const char *F,
                                         const char *parameters, char *err, size_t errlen);
 
+/** \name Tables: functions given as data
+ * A table is the C^2 cubic spline (not-a-knot ends, tensor product in 2-D and 3-D) through
+ * values on a rectilinear grid of 1, 2 or 3 coordinates (docs/theory.md TB-1 .. TB-4), with
+ * exact partial derivatives. Tables are reference counted: a problem that uses one keeps
+ * its own reference, so the caller may free its handle at any time. A table is immutable
+ * and may be read from several threads at once. */
+/**@{*/
+/** A tabulated function. Opaque; made by cv_table_new, released by cv_table_free. */
+typedef struct cv_table cv_table;
+/** A table in dim = 1, 2 or 3 coordinates. n[k] >= 4 values along coordinate k, given in
+ * coords[k][0 .. n[k]-1], strictly increasing and finite. values holds the n[0]*...*n[dim-1]
+ * finite grid values, the last coordinate fastest: the value at (i0, i1, i2) is
+ * values[(i0*n[1] + i1)*n[2] + i2]. Everything is copied. NULL on failure, with *why (may
+ * be NULL) CVAR_EINVAL or CVAR_ENOMEM. Memory: 2^dim doubles per grid value. */
+CVAR_API cv_table *cv_table_new(int dim, const int *n, const double *const *coords,
+                       const double *values, cv_status *why);
+/** Release the caller's reference; NULL is a no-op. */
+CVAR_API void cv_table_free(cv_table *t);
+/** Number of coordinates (0 for NULL). */
+CVAR_API int cv_table_get_dim(const cv_table *t);
+/** The grid's range [lo, hi] along coordinate k (0-based); lo or hi may be NULL. */
+CVAR_API cv_status cv_table_get_range(const cv_table *t, int k, double *lo, double *hi);
+/** The spline's partial derivative of orders order[k] (NULL: the value) at the point u.
+ * Returns 0; or k + 1 when u[k] lies outside the grid along coordinate k (no
+ * extrapolation; *value is then NaN); -1 for NULL arguments. */
+CVAR_API int cv_table_eval(const cv_table *t, const double *u, const int *order, double *value);
+/** Make t callable as `name(u)`, `name(u, v)` or `name(u, v, w)` (and its derivatives
+ * `name.1(...)`, `name.12(...)`, docs/expressions.md) in the formulas given afterwards to
+ * cv_problem_set_integrand_expr. The problem takes its own reference. The name must be an
+ * identifier that is not a function, pi, or a table already added (CVAR_EINVAL). When a
+ * solve fails after the path left a table's grid, cv_solver_last_error() names the table. */
+CVAR_API cv_status cv_problem_add_table(cv_problem *p, const char *name, cv_table *t);
+/**@}*/
+
 /** Pointwise constraint G(x, y) = 0 (no y'), at m points: G[k], and when asked for
  * (need & CVAR_NEED_GRAD) Gy[i*m + k] = dG/dy_i, (need & CVAR_NEED_HESS)
  * Gyy[(i*n + j)*m + k] = d2G/dy_i dy_j. Gy/Gyy are NULL when not asked for. Returns as
@@ -478,6 +512,42 @@ CVAR_API cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *
 CVAR_API const char *cv_report_json(const cv_report *r);
 /** Release a report; NULL is a no-op. */
 CVAR_API void cv_report_free(cv_report *r);
+/**@}*/
+
+/** \name Every stationary path: deflation (theory DF-1..DF-5) */
+/**@{*/
+/** How a cv_solve_all search went. */
+typedef struct {
+  int starts;     /**< starting points tried (the plain solve from the guess counts as one) */
+  int failed;     /**< starts from which no stationary path converged */
+  int duplicates; /**< starts that converged to a path already found */
+  int found;      /**< distinct converged paths kept (cv_solver_get_num_solutions) */
+  char stop[200]; /**< why the search stopped, one sentence */
+} cv_search_info;
+
+/** Search for up to max >= 1 distinct stationary paths of p (minima and saddles) with the
+ * same ends: a plain cv_solve from the guess, then Newton on the deflated system (DF-3) from
+ * the guess, the straight line and perturbations of every path found along its softest
+ * Hessian directions (DF-4); every path is polished by plain Newton (adaptively when
+ * cv_solver_set_adapt is on) and reported with its own Morse index. Two paths are the same
+ * when their nodal values differ by at most the larger of their error estimates (adaptive
+ * solves) and 1e-6 of their size (DF-5). Newton engine only (else CVAR_EINVAL).
+ * Returns CVAR_OK when at least one path converged; the paths are then ordered by
+ * increasing action and path 0 is selected: every getter above reads the selected path.
+ * Otherwise the status and getters describe the failed plain solve. A later cv_solve
+ * forgets the paths. */
+CVAR_API cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max);
+/** Work limit of cv_solve_all: its Newton iterations after the first solve (deflated and
+ * polishing) stop at factor (>= 1, default 8) times the iterations of that first solve
+ * (counted as at least 8). */
+CVAR_API cv_status cv_solver_set_search_work(cv_solver *s, double factor);
+/** Number of distinct converged paths of the last cv_solve_all (0 otherwise). */
+CVAR_API int cv_solver_get_num_solutions(const cv_solver *s);
+/** Make path k (0 <= k < cv_solver_get_num_solutions) the one the getters read (nodes,
+ * values, action, Morse index, multipliers, ...). CVAR_ESTATE without a cv_solve_all. */
+CVAR_API cv_status cv_solver_select_solution(cv_solver *s, int k);
+/** What the last cv_solve_all tried and why it stopped. CVAR_ESTATE without one. */
+CVAR_API cv_status cv_solver_get_search(const cv_solver *s, cv_search_info *info);
 /**@}*/
 
 #ifdef __cplusplus

@@ -79,10 +79,10 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     memcpy(name, a, nl);
     name[nl] = '\0';
     int flag = strcmp(name, "--quiet") == 0 || strcmp(name, "--help") == 0 ||
-               strcmp(name, "-h") == 0;
+               strcmp(name, "-h") == 0 || strcmp(name, "--all") == 0;
     static const char *const valued[] = {
       "--elements", "--degree", "--method", "--tolerance", "--max-iterations", "--set",
-      "--adapt", "--tol", "--continue", "--json", "--csv", "--plot", NULL};
+      "--adapt", "--tol", "--continue", "--json", "--csv", "--plot", "--max", "--work", NULL};
     int known = flag;
     for (int k = 0; valued[k]; k++)
       known |= strcmp(name, valued[k]) == 0;
@@ -93,6 +93,8 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
         return bad(cmd, "%s takes no value", name);
       if (strcmp(name, "--quiet") == 0)
         o->quiet = 1;
+      else if (strcmp(name, "--all") == 0)
+        o->all = 1;
       else
         o->help = 1;
       continue;
@@ -111,6 +113,12 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     } else if (strcmp(name, "--degree") == 0) {
       if (parse_int(v, 1, 8, &o->degree) < 0)
         return bad(cmd, "--degree needs a whole number from 1 to 8, got '%s'", v);
+    } else if (strcmp(name, "--max") == 0) {
+      if (parse_int(v, 1, 1000, &o->max_paths) < 0)
+        return bad(cmd, "--max needs a whole number of paths from 1 to 1000, got '%s'", v);
+    } else if (strcmp(name, "--work") == 0) {
+      if (parse_pos_double(v, &o->work) < 0 || o->work < 1 || o->work > 1e6)
+        return bad(cmd, "--work needs a factor from 1 to 1e6, got '%s'", v);
     } else if (strcmp(name, "--max-iterations") == 0) {
       if (parse_int(v, 1, INT_MAX, &o->max_iterations) < 0)
         return bad(cmd, "--max-iterations needs a whole number >= 1, got '%s'", v);
@@ -176,6 +184,8 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
   if (o->tol > 0 && o->adapt > 0)
     return bad(cmd, "--tol and --adapt cannot be combined (--tol chooses the mesh and the "
                "degrees, --adapt the mesh at one degree)");
+  if ((o->max_paths || o->work > 0) && !o->all)
+    return bad(cmd, "--max and --work belong to --all; give --all too");
   if (o->json && o->csv && strcmp(o->json, "-") == 0 && strcmp(o->csv, "-") == 0)
     return bad(cmd, "--json - and --csv - cannot both write to stdout");
   if (o->json && o->csv && strcmp(o->json, o->csv) == 0 && strcmp(o->json, "-") != 0)
@@ -187,7 +197,7 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
 int cli_only_scene_options(const char *cmd, const cli_opts *o)
 {
   if (o->csv || o->plot || o->adapt > 0 || o->tol > 0 || o->cont || o->elements || o->degree ||
-      o->method >= 0 || o->tolerance > 0 || o->max_iterations) {
+      o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all) {
     fprintf(stderr, "calcvar %s: only --set, --json and --quiet apply to %s\n", cmd, cmd);
     return EXIT_BADINPUT;
   }

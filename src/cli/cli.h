@@ -25,6 +25,8 @@ typedef struct {
   sc_set *set;
   const char *json, *csv, *plot;
   int quiet, help;
+  int all, max_paths; /* --all, --max K (0: default 8) */
+  double work;        /* --work F: the search's work limit (0: default 8) */
 } cli_opts;
 
 /* args.c: parse argv (after the command word). Returns 0, or EXIT_BADINPUT after printing
@@ -85,6 +87,10 @@ typedef struct {
 int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_converge_json(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_plot_converge(cli_outfile *o, const cli_conv_row *rows, int nrows);
+
+/* cli_all.c: `solve --all`: the deflated search, its reports; returns the exit status. */
+int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, double adapt,
+                cli_outfile *jf, cli_outfile *cf, cli_outfile *pf);
 
 /* Subcommands. */
 int cli_converge(int argc, char **argv);

@@ -2,7 +2,7 @@
  * Hamiltonian and conservation laws of a scene's integrand, for a person or as JSON.
  * SPDX-License-Identifier: MIT
  *
- * The expressions come from scene_equations_new (src/scene/scene_mechanics.c). They are
+ * The expressions come from scene_equations_new (src/scene/scene_mechanics.c, src/mech). They are
  * printed in the scene grammar (ex_print), with parameters as numbers, so the JSON strings
  * parse and evaluate without the scene (docs/mechanics.md).
  */
@@ -24,7 +24,7 @@ static void usage(FILE *f)
 }
 
 /* e printed in the scene grammar, malloc'ed; NULL on allocation failure. */
-static char *print_expr(const scene *s, const sc_equations *eq, ex_id e)
+static char *print_expr(const scene *s, const mech_equations *eq, ex_id e)
 {
   const char *const *names = (const char *const *)eq->names;
   size_t len = ex_print(s->dag, e, names, NULL, 0) + 1;
@@ -39,7 +39,7 @@ typedef struct {
   char **mom, **el, *H, *F;
 } texts;
 
-static int texts_make(texts *t, const scene *s, const sc_equations *eq)
+static int texts_make(texts *t, const scene *s, const mech_equations *eq)
 {
   int n = s->n;
   memset(t, 0, sizeof *t);
@@ -71,7 +71,7 @@ static void texts_free(texts *t, int n)
   free(t->F);
 }
 
-static int write_json(FILE *f, const scene *s, const sc_equations *eq, const texts *t)
+static int write_json(FILE *f, const scene *s, const mech_equations *eq, const texts *t)
 {
   json_t *o = json_object(), *mom = json_object(), *el = json_object(), *cyc = json_array();
   int rc = -1;
@@ -111,7 +111,7 @@ static const char *shortest(double v, char *buf, size_t len)
   return buf;
 }
 
-static void write_text(FILE *f, const scene *s, const sc_equations *eq, const texts *t)
+static void write_text(FILE *f, const scene *s, const mech_equations *eq, const texts *t)
 {
   int n = s->n, ncyc = 0;
   char num[32];
@@ -172,7 +172,7 @@ int cli_equations(int argc, char **argv)
     return rc;
   }
   scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
-  sc_equations eq;
+  mech_equations eq;
   texts t;
   cli_outfile jf = {0};
   memset(&eq, 0, sizeof eq);
@@ -187,7 +187,7 @@ int cli_equations(int argc, char **argv)
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if (scene_equations_new(s, &eq, err, sizeof err) < 0 || texts_make(&t, s, &eq) < 0) {
+  if (scene_equations_new(s, &eq, err, sizeof err) != CVAR_OK || texts_make(&t, s, &eq) < 0) {
     fprintf(stderr, "%s\n", err[0] ? err : "calcvar equations: out of memory");
     rc = EXIT_UNSOLVED;
     goto done;
@@ -205,7 +205,7 @@ int cli_equations(int argc, char **argv)
 done:
   cli_outfile_abandon(&jf);
   texts_free(&t, s ? s->n : 0);
-  scene_equations_free(&eq);
+  mech_equations_free(&eq);
   scene_free(s);
   cli_opts_free(&o);
   return rc;

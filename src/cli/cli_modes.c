@@ -2,7 +2,7 @@
  * its small oscillations, for a person or as JSON (SCENES.md).
  * SPDX-License-Identifier: MIT
  *
- * The numbers come from scene_modes_new (src/scene/scene_modes.c). Exit status: 0 modes
+ * The numbers come from scene_modes_new (src/scene/scene_mechanics.c, src/mech). Exit status: 0 modes
  * found; 1 no equilibrium from the guess, M not positive definite, or non-finite values
  * (nothing written); 2 bad input, including a scene whose integrand or a constraint
  * depends on the variable, or that has integral constraints (modes does not apply).
@@ -31,12 +31,12 @@ static void usage(FILE *f)
         "  --json FILE   the same as JSON ('-' for stdout)\n", f);
 }
 
-static const char *kind_name(sc_mode_kind k)
+static const char *kind_name(mech_mode_kind k)
 {
-  return k == SC_MODE_STABLE ? "stable" : k == SC_MODE_UNSTABLE ? "unstable" : "neutral";
+  return k == MECH_MODE_STABLE ? "stable" : k == MECH_MODE_UNSTABLE ? "unstable" : "neutral";
 }
 
-static int write_json(FILE *f, const scene *s, const sc_modes *md)
+static int write_json(FILE *f, const scene *s, const mech_modes *md)
 {
   int n = s->n;
   json_t *o = json_object(), *eqm = json_object(), *modes = json_array();
@@ -118,7 +118,7 @@ static void print_matrix(FILE *f, const char *label, int n, const double *A)
   }
 }
 
-static void write_text(FILE *f, const scene *s, const sc_modes *md)
+static void write_text(FILE *f, const scene *s, const mech_modes *md)
 {
   int n = s->n;
   fprintf(f, "%s (%s)\n", s->title, s->file);
@@ -146,9 +146,9 @@ static void write_text(FILE *f, const scene *s, const sc_modes *md)
   for (int k = 0; k < md->nmodes; k++) {
     double w2 = md->omega2[k];
     char what[64];
-    if (md->kind[k] == SC_MODE_STABLE)
+    if (md->kind[k] == MECH_MODE_STABLE)
       snprintf(what, sizeof what, "omega %.6g, period %.6g", sqrt(w2), TWO_PI / sqrt(w2));
-    else if (md->kind[k] == SC_MODE_UNSTABLE)
+    else if (md->kind[k] == MECH_MODE_UNSTABLE)
       snprintf(what, sizeof what, "growth rate %.6g", sqrt(-w2));
     else
       snprintf(what, sizeof what, "free motion");
@@ -164,11 +164,11 @@ static void write_text(FILE *f, const scene *s, const sc_modes *md)
   for (int k = 0; k < md->ngyro; k++) {
     double w = md->gyro_omega[k], r = md->gyro_growth[k];
     char what[96];
-    if (md->gyro_kind[k] == SC_MODE_STABLE)
+    if (md->gyro_kind[k] == MECH_MODE_STABLE)
       snprintf(what, sizeof what, "omega %.6g, period %.6g", w, TWO_PI / w);
-    else if (md->gyro_kind[k] == SC_MODE_UNSTABLE && w > 0)
+    else if (md->gyro_kind[k] == MECH_MODE_UNSTABLE && w > 0)
       snprintf(what, sizeof what, "growth rate %.6g, oscillating with omega %.6g", r, w);
-    else if (md->gyro_kind[k] == SC_MODE_UNSTABLE)
+    else if (md->gyro_kind[k] == MECH_MODE_UNSTABLE)
       snprintf(what, sizeof what, "growth rate %.6g", r);
     else
       snprintf(what, sizeof what, "free motion");
@@ -192,7 +192,7 @@ int cli_modes(int argc, char **argv)
     return rc;
   }
   scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
-  sc_modes md;
+  mech_modes md;
   cli_outfile jf = {0};
   memset(&md, 0, sizeof md);
   if (!s) {
@@ -205,11 +205,10 @@ int cli_modes(int argc, char **argv)
     rc = EXIT_BADINPUT;
     goto done;
   }
-  int st = scene_modes_new(s, &md, err, sizeof err);
-  if (st != SC_MODES_OK) {
+  cv_status st = scene_modes_new(s, &md, err, sizeof err);
+  if (st != CVAR_OK) {
     fprintf(stderr, "%s\n", err);
-    rc = st == SC_MODES_EXPLICIT || st == SC_MODES_CONSTRAINED ? EXIT_BADINPUT
-                                                                 : EXIT_UNSOLVED;
+    rc = st == CVAR_EINVAL ? EXIT_BADINPUT : EXIT_UNSOLVED;
     goto done;
   }
   if (o.json) {
@@ -224,7 +223,7 @@ int cli_modes(int argc, char **argv)
   rc = EXIT_SOLVED;
 done:
   cli_outfile_abandon(&jf);
-  scene_modes_free(&md);
+  mech_modes_free(&md);
   scene_free(s);
   cli_opts_free(&o);
   return rc;

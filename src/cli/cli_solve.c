@@ -26,6 +26,9 @@ static void usage(FILE *f)
         "  --tol T              choose mesh and degrees until the estimated max nodal\n"
         "                       error <= T (elements/degree, if given, are the start)\n"
         "  --continue name=from:to   continuation in a parameter\n"
+        "  --all                every stationary path that can be found (deflation)\n"
+        "  --max K              at most K paths with --all (default 8)\n"
+        "  --work F             --all's work limit: F times the first solve's (default 8)\n"
         "  --json FILE          JSON report ('-' for stdout)\n"
         "  --csv FILE           nodal table ('-' for stdout)\n"
         "  --plot FILE          picture of the solution (.png or .svg)\n"
@@ -46,6 +49,16 @@ static int unsupported(const cli_opts *o, const scene *s)
   if (o->cont && (o->adapt > 0 || s->adapt > 0 || o->tol > 0 || s->tol > 0)) {
     fprintf(stderr, "calcvar solve: --continue and adaptive refinement cannot be combined "
             "(continuation keeps one mesh)\n");
+    return EXIT_BADINPUT;
+  }
+  if (o->all && o->cont) {
+    fprintf(stderr, "calcvar solve: --all and --continue cannot be combined (the search "
+            "keeps one scene)\n");
+    return EXIT_BADINPUT;
+  }
+  if (o->all && s->method != CVAR_METHOD_NEWTON) {
+    fprintf(stderr, "calcvar solve: --all needs the Newton engine (method %s finds minima "
+            "only, not the saddles the search is for)\n", cv_method_name(s->method));
     return EXIT_BADINPUT;
   }
   if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
@@ -126,6 +139,10 @@ int cli_solve(int argc, char **argv)
   }
   cv_status st;
   char cont_msg[256] = "";
+  if (o.all) {
+    rc = cli_all_run(&o, s, p, sv, adapt, &jf, &cf, &pf);
+    goto done;
+  }
   if (o.cont) {
     /* continuation replaces scene, problem and solver by those of its last step */
     cv_solver_free(sv);

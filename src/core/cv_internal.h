@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include "calcvar.h"
 #include "cv_memory.h" /* the one allocator (tests may inject failures) */
+#include "cv_table_internal.h"
 
 /* Largest batch handed to an integrand callback (documented in calcvar.h). */
 #define CV_BATCH 256
@@ -42,6 +43,10 @@ struct cv_problem {
   double *endval;  /* endval[2*k + end] */
   cv_guess_fn guess;
   void *guess_user;
+  cv_note_fn note;   /* the integrand's failure note (cv_table_internal.h), or NULL */
+  int ntables;       /* tables added by cv_problem_add_table, each with a reference */
+  char **table_name;
+  cv_table **table;
 };
 
 /* ---- reference element: GLL nodes, Gauss-Legendre rule, basis tables (cv_quadrature.c) */
@@ -67,6 +72,9 @@ void cv_gauss_lobatto(int p, double *xi, double *w);
 /* Lagrange basis on nodes xi[0..p] at s: phi[l] and (if dphi) phi_l'(s). */
 void cv_lagrange(int p, const double *xi, double s, double *phi, double *dphi);
 void cv_refelem_init(cv_refelem *r, int p, int q);
+/* The singular-end rule (Q-2) on the element touching end 0 (a) or 1 (b), qs points, for
+ * degree p (1 <= p <= CV_MAX_DEGREE, 1 <= qs <= CV_MAX_QUAD); cached for the process. */
+cv_rule cv_end_rule(int p, int qs, int end);
 
 /* ---- mesh (cv_mesh.c) ---- */
 enum { CV_MESH_UNIFORM, CV_MESH_GRADED, CV_MESH_USER };
@@ -260,8 +268,17 @@ struct cv_solver {
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
   int near_sing[2];            /* ends found nearly singular after a solve */
+  double search_work;          /* cv_solve_all's work limit (cv_deflation.c) */
+  struct cv_pathset *paths;    /* the paths of the last cv_solve_all (cv_deflation.c) */
+  /* The sparse LDL^T of the Hessian pattern of `disc` (CHOLMOD common, pattern, symbolic
+   * analysis) and the y dof of each unknown: made by the first Newton run on the mesh and
+   * reused by the next ones on it (retries, continuation steps); dropped with the mesh. */
+  struct cv_ldlt *ldlt;
+  int *gof;
 };
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
+/* Release the solver's factor of its mesh (before the mesh changes). */
+void cv_solver_drop_factor(cv_solver *s);
 /* The start of a solve (cv_start.c): cv_start_setup discretises the current mesh spec,
  * allocates the results and fills s->y with the starting values and flags singular ends;
  * cv_start_values fills Y with the given start / guess, or (line = 1) the straight line. */
@@ -273,6 +290,8 @@ cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, d
  * the action under the singular-end rule there. */
 int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
                             double action, double *rel);
+/* The paths found by cv_solve_all (cv_deflation.c); NULL is a no-op. */
+void cv_pathset_free(struct cv_pathset *ps);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
 /* ---- error estimate and hp decisions (cv_estimate.c, cv_hp.c) ---- */
 /* Start s (mesh set) from `from` interpolated at its nodes. */

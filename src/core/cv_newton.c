@@ -28,11 +28,14 @@ typedef struct {
   double *g, *gt, *delta, *Yt, *Mt, *dreg, *corr;
   double *dsave, *x0; /* diagonal of H and first solve of the shifted factor (N-6), lazily */
   double tau;         /* shift of the factor in L (0: L is the factor of H itself) */
+  int borrowed;       /* L and gof belong to the solver (its mesh's factor) */
 } newton_ws;
 
 static void ws_free(newton_ws *w) {
-  cv_free(w->gof);
-  cv_ldlt_free(w->L);
+  if (!w->borrowed) {
+    cv_free(w->gof);
+    cv_ldlt_free(w->L);
+  }
   cv_free(w->g);
   cv_free(w->gt);
   cv_free(w->delta);
@@ -47,14 +50,30 @@ static void ws_free(newton_ws *w) {
 /* Every array here is a fresh page range of a large solve, and faulting it in is a large
  * part of the run time (docs/performance.md): the refinement arrays exist only with
  * multipliers. */
-static cv_status ws_init(newton_ws *w, const cv_disc *d, size_t nmult, char *msg, size_t len) {
+/* The factor of the solver's own mesh is the solver's: made on the first run, reused by
+ * the next runs on the same mesh (a retry, every continuation step) with its CHOLMOD
+ * common and symbolic analysis. */
+static cv_status ws_init(newton_ws *w, cv_solver *s, const cv_disc *d, size_t nmult, char *msg,
+                         size_t len) {
   size_t nf = (size_t)d->nfree, one = nf ? nf : 1;
   memset(w, 0, sizeof *w);
   w->d = d;
-  w->gof = cv_malloc(one * sizeof *w->gof);
-  if (!w->gof) return CVAR_ENOMEM;
-  cv_status st = cv_ldlt_new(d, w->gof, &w->L, msg, len);
-  if (st) return st;
+  w->borrowed = d == &s->disc;
+  if (w->borrowed && s->ldlt) {
+    w->gof = s->gof;
+    w->L = s->ldlt;
+  } else {
+    if (w->borrowed) cv_solver_drop_factor(s); /* a gof left by a failed attempt */
+    w->gof = cv_malloc(one * sizeof *w->gof);
+    if (w->borrowed) s->gof = w->gof;
+    if (!w->gof) return CVAR_ENOMEM;
+    cv_status st = cv_ldlt_new(d, w->gof, &w->L, msg, len);
+    if (w->borrowed) {
+      s->gof = w->gof;
+      s->ldlt = w->L; /* NULL on failure: s->gof is freed with the mesh */
+    }
+    if (st) return st;
+  }
   w->colptr = cv_ldlt_colptr(w->L);
   w->g = cv_malloc(one * sizeof *w->g);
   w->gt = cv_malloc(one * sizeof *w->gt);
@@ -258,7 +277,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   s->gnorm = NAN;
   s->action = NAN;
   memset(&kkt, 0, sizeof kkt);
-  st = ws_init(&w, d, nmult, s->msg, sizeof s->msg);
+  st = ws_init(&w, s, d, nmult, s->msg, sizeof s->msg);
   if (!st) st = cv_kkt_init(&kkt, p, d, w.colptr);
   if (st) {
     if (st == CVAR_ENOMEM)

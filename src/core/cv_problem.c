@@ -1,6 +1,8 @@
 /* src/core/cv_problem.c — the problem object: interval, unknowns, end values, integrand, guess.
  * SPDX-License-Identifier: MIT */
+#include <ctype.h>
 #include <math.h>
+#include <string.h>
 
 #include "cv_internal.h"
 
@@ -48,6 +50,12 @@ void cv_problem_free(cv_problem *p) {
     if (p->pc[k].release) p->pc[k].release(p->pc[k].user);
   for (int k = 0; k < p->ni; k++)
     if (p->ic[k].release) p->ic[k].release(p->ic[k].user);
+  for (int k = 0; k < p->ntables; k++) {
+    cv_free(p->table_name[k]);
+    cv_table_free(p->table[k]);
+  }
+  cv_free(p->table_name);
+  cv_free(p->table);
   cv_free(p->pc);
   cv_free(p->ic);
   cv_free(p->fixed);
@@ -62,6 +70,7 @@ cv_status cv_problem_set_integrand_owned(cv_problem *p, cv_integrand_fn F, void 
     return CVAR_EINVAL;
   }
   release_integrand(p);
+  p->note = NULL;
   p->F = F;
   p->user = user;
   p->release = release;
@@ -161,3 +170,49 @@ cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, void *user, 
 
 int cv_problem_get_num_constraints(const cv_problem *p) { return p ? p->nc : 0; }
 int cv_problem_get_num_integrals(const cv_problem *p) { return p ? p->ni : 0; }
+
+cv_status cv_problem_set_integrand_note(cv_problem *p, cv_note_fn note) {
+  if (!p) return CVAR_EINVAL;
+  p->note = note;
+  return CVAR_OK;
+}
+
+cv_status cv_problem_add_table(cv_problem *p, const char *name, cv_table *t) {
+  if (!p || !name || !t || !(isalpha((unsigned char)name[0]) || name[0] == '_'))
+    return CVAR_EINVAL;
+  for (const char *q = name; *q; q++)
+    if (!(isalnum((unsigned char)*q) || *q == '_')) return CVAR_EINVAL;
+  for (int k = 0; k < p->ntables; k++)
+    if (strcmp(p->table_name[k], name) == 0) return CVAR_EINVAL;
+  size_t len = strlen(name);
+  char *copy = cv_malloc(len + 1);
+  char **names = cv_malloc(((size_t)p->ntables + 1) * sizeof *names);
+  cv_table **tabs = cv_malloc(((size_t)p->ntables + 1) * sizeof *tabs);
+  if (!copy || !names || !tabs) {
+    cv_free(copy);
+    cv_free(names);
+    cv_free(tabs);
+    return CVAR_ENOMEM;
+  }
+  memcpy(copy, name, len + 1);
+  if (p->ntables) {
+    memcpy(names, p->table_name, (size_t)p->ntables * sizeof *names);
+    memcpy(tabs, p->table, (size_t)p->ntables * sizeof *tabs);
+  }
+  names[p->ntables] = copy;
+  tabs[p->ntables] = cv_table_ref(t);
+  cv_free(p->table_name);
+  cv_free(p->table);
+  p->table_name = names;
+  p->table = tabs;
+  p->ntables++;
+  return CVAR_OK;
+}
+
+int cv_problem_num_tables(const cv_problem *p) { return p ? p->ntables : 0; }
+const char *cv_problem_table_name(const cv_problem *p, int i) {
+  return p && i >= 0 && i < p->ntables ? p->table_name[i] : NULL;
+}
+const cv_table *cv_problem_table(const cv_problem *p, int i) {
+  return p && i >= 0 && i < p->ntables ? p->table[i] : NULL;
+}

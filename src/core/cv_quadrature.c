@@ -1,8 +1,18 @@
 /* src/core/cv_quadrature.c — Gauss-Legendre rules, Gauss-Lobatto-Legendre nodes, Lagrange basis.
  * SPDX-License-Identifier: MIT */
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <string.h>
 
 #include "cv_internal.h"
+
+/* The rules depend only on (p, q) and are the same for every solver: each is computed
+ * once per process, on first use, and copied from then on (theory Q-1, E-1). Computing
+ * them was ~10 % of a small warm solve and a third of the instructions of a cold one
+ * (docs/performance.md). Writers hold the lock; a reader sees a slot only after its
+ * ready flag is set with release order, so the copy is never torn. */
+static pthread_mutex_t rule_lock = PTHREAD_MUTEX_INITIALIZER;
 
 /* Legendre P_n(s) and P_n'(s) by the three-term recurrence. */
 static void legendre(int n, double s, double *P, double *dP) {
@@ -24,7 +34,7 @@ static void legendre(int n, double s, double *P, double *dP) {
 
 /* q-point Gauss-Legendre rule on [-1, 1], theory (Q-1): roots of P_q by Newton from
  * the Chebyshev-like guess cos(pi (k + 3/4) / (q + 1/2)), weights 2 / ((1 - t^2) P_q'^2). */
-void cv_gauss_legendre(int q, double *t, double *w) {
+static void gauss_legendre_compute(int q, double *t, double *w) {
   for (int k = 0; k < q; k++) {
     double s = cos(CV_PI * (k + 0.75) / (q + 0.5)), P, dP;
     for (int it = 0; it < 100; it++) {
@@ -42,7 +52,7 @@ void cv_gauss_legendre(int q, double *t, double *w) {
 /* Gauss-Lobatto-Legendre nodes: +-1 and the roots of P_p'; weights 2/(p(p+1) P_p^2),
  * theory (E-1). Interior roots by Newton on P_p' using P_p'' from the Legendre ODE:
  * (1 - s^2) P'' = 2 s P' - p (p + 1) P. */
-void cv_gauss_lobatto(int p, double *xi, double *w) {
+static void gauss_lobatto_compute(int p, double *xi, double *w) {
   xi[0] = -1.0;
   xi[p] = 1.0;
   for (int j = 1; j < p; j++) {
@@ -64,6 +74,50 @@ void cv_gauss_lobatto(int p, double *xi, double *w) {
   }
 }
 
+static struct {
+  atomic_int ready;
+  double t[CV_MAX_QUAD], w[CV_MAX_QUAD];
+} gl_cache[CV_MAX_QUAD + 1];
+
+static struct {
+  atomic_int ready;
+  double xi[CV_MAX_DEGREE + 1], w[CV_MAX_DEGREE + 1];
+} gll_cache[CV_MAX_DEGREE + 1];
+
+void cv_gauss_legendre(int q, double *t, double *w) {
+  if (q < 1 || q > CV_MAX_QUAD) {
+    gauss_legendre_compute(q, t, w);
+    return;
+  }
+  if (!atomic_load_explicit(&gl_cache[q].ready, memory_order_acquire)) {
+    pthread_mutex_lock(&rule_lock);
+    if (!atomic_load_explicit(&gl_cache[q].ready, memory_order_relaxed)) {
+      gauss_legendre_compute(q, gl_cache[q].t, gl_cache[q].w);
+      atomic_store_explicit(&gl_cache[q].ready, 1, memory_order_release);
+    }
+    pthread_mutex_unlock(&rule_lock);
+  }
+  memcpy(t, gl_cache[q].t, (size_t)q * sizeof *t);
+  memcpy(w, gl_cache[q].w, (size_t)q * sizeof *w);
+}
+
+void cv_gauss_lobatto(int p, double *xi, double *w) {
+  if (p < 1 || p > CV_MAX_DEGREE) {
+    gauss_lobatto_compute(p, xi, w);
+    return;
+  }
+  if (!atomic_load_explicit(&gll_cache[p].ready, memory_order_acquire)) {
+    pthread_mutex_lock(&rule_lock);
+    if (!atomic_load_explicit(&gll_cache[p].ready, memory_order_relaxed)) {
+      gauss_lobatto_compute(p, gll_cache[p].xi, gll_cache[p].w);
+      atomic_store_explicit(&gll_cache[p].ready, 1, memory_order_release);
+    }
+    pthread_mutex_unlock(&rule_lock);
+  }
+  memcpy(xi, gll_cache[p].xi, (size_t)(p + 1) * sizeof *xi);
+  memcpy(w, gll_cache[p].w, (size_t)(p + 1) * sizeof *w);
+}
+
 void cv_lagrange(int p, const double *xi, double s, double *phi, double *dphi) {
   for (int l = 0; l <= p; l++) {
     double v = 1.0, dv = 0.0;
@@ -78,7 +132,7 @@ void cv_lagrange(int p, const double *xi, double s, double *phi, double *dphi) {
   }
 }
 
-void cv_refelem_init(cv_refelem *r, int p, int q) {
+static void refelem_compute(cv_refelem *r, int p, int q) {
   r->p = p;
   r->q = q;
   cv_gauss_lobatto(p, r->xi, r->wl);
@@ -88,4 +142,60 @@ void cv_refelem_init(cv_refelem *r, int p, int q) {
   /* Singular-end rules (Q-2): twice the regular points plus four, capped; the
    * transformed integrand is smooth but not polynomial. */
   r->qs = 2 * q + 4 > CV_MAX_QUAD ? CV_MAX_QUAD : 2 * q + 4;
+}
+
+static struct {
+  atomic_int ready;
+  cv_refelem r;
+} ref_cache[CV_MAX_DEGREE + 1][CV_MAX_QUAD + 1];
+
+void cv_refelem_init(cv_refelem *r, int p, int q) {
+  if (p < 1 || p > CV_MAX_DEGREE || q < 1 || q > CV_MAX_QUAD) {
+    refelem_compute(r, p, q);
+    return;
+  }
+  if (!atomic_load_explicit(&ref_cache[p][q].ready, memory_order_acquire)) {
+    cv_refelem tmp;
+    refelem_compute(&tmp, p, q); /* outside the lock: it takes the lock itself */
+    pthread_mutex_lock(&rule_lock);
+    if (!atomic_load_explicit(&ref_cache[p][q].ready, memory_order_relaxed)) {
+      ref_cache[p][q].r = tmp;
+      atomic_store_explicit(&ref_cache[p][q].ready, 1, memory_order_release);
+    }
+    pthread_mutex_unlock(&rule_lock);
+  }
+  *r = ref_cache[p][q].r;
+}
+
+/* The singular-end rule (Q-2) on the element touching an end, in reference coordinates:
+ * x = c +- u^2 with u from 0 to sqrt(h) maps Gauss point t_k in u to
+ * tau_k = -+(1 - (t_k + 1)^2 / 2) whatever h, with weight omega_k = w_k (t_k + 1) in tau
+ * (the end check of Q-3 uses it; the element rules of cv_disc.c are built per element). */
+static struct {
+  atomic_int ready;
+  double tau[CV_MAX_QUAD], om[CV_MAX_QUAD];
+  double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
+} end_cache[2][CV_MAX_DEGREE + 1][CV_MAX_QUAD + 1];
+
+cv_rule cv_end_rule(int p, int qs, int end) {
+  end = end != 0;
+  if (!atomic_load_explicit(&end_cache[end][p][qs].ready, memory_order_acquire)) {
+    double t[CV_MAX_QUAD], w[CV_MAX_QUAD], xi[CV_MAX_DEGREE + 1], wl[CV_MAX_DEGREE + 1];
+    cv_gauss_legendre(qs, t, w);
+    cv_gauss_lobatto(p, xi, wl);
+    pthread_mutex_lock(&rule_lock);
+    if (!atomic_load_explicit(&end_cache[end][p][qs].ready, memory_order_relaxed)) {
+      for (int k = 0; k < qs; k++) {
+        double s = 0.5 * (t[k] + 1.0) * (t[k] + 1.0) - 1.0;
+        end_cache[end][p][qs].tau[k] = end ? -s : s;
+        end_cache[end][p][qs].om[k] = w[k] * (t[k] + 1.0);
+        cv_lagrange(p, xi, end ? -s : s, end_cache[end][p][qs].B + k * (p + 1),
+                    end_cache[end][p][qs].D + k * (p + 1));
+      }
+      atomic_store_explicit(&end_cache[end][p][qs].ready, 1, memory_order_release);
+    }
+    pthread_mutex_unlock(&rule_lock);
+  }
+  return (cv_rule){qs, end_cache[end][p][qs].tau, end_cache[end][p][qs].om,
+                   end_cache[end][p][qs].B, end_cache[end][p][qs].D};
 }

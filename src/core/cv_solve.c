@@ -2,6 +2,7 @@
  * and continuation policy when Newton fails from the start.
  * SPDX-License-Identifier: MIT */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 #include <time.h>
 
@@ -18,6 +19,7 @@ static void results_reset(cv_solver *s) {
   cv_free(s->y);
   cv_free(s->mult);
   s->y = s->mult = NULL;
+  cv_solver_drop_factor(s);
   cv_disc_free(&s->disc);
   s->have = 0;
   s->iterations = 0;
@@ -176,10 +178,22 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
 cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   if (!s) return CVAR_EINVAL;
   double t0 = cv_now();
+  cv_pathset_free(s->paths); /* a plain solve forgets the paths of cv_solve_all */
+  s->paths = NULL;
   s->err_est = NAN;
   s->rounds = 0;
+  if (p && p->note) p->note(p->user, 1);
   cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
   s->status = st;
+  /* A failure the integrand can explain (a table's grid left): the cause first, then what
+   * the engine saw. */
+  const char *note = st != CVAR_OK && p && p->note ? p->note(p->user, 0) : NULL;
+  if (note && note[0]) {
+    char m[2 * sizeof s->msg];
+    snprintf(m, sizeof m, "%s%s%s", note, s->msg[0] ? "; " : "", s->msg);
+    memcpy(s->msg, m, sizeof s->msg - 1); /* truncated to the message buffer */
+    s->msg[sizeof s->msg - 1] = '\0';
+  }
   s->time = cv_now() - t0;
   return st;
 }

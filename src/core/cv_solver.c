@@ -18,6 +18,7 @@ cv_solver *cv_solver_new(cv_status *why) {
   s->rtol = s->atol = 1e-10;
   s->maxit = 50;
   s->continuation = 1;
+  s->search_work = 8.0;
   s->adapt_max = 1000000;
   s->err_est = NAN;
   s->status = CVAR_ESTATE;
@@ -26,8 +27,16 @@ cv_solver *cv_solver_new(cv_status *why) {
   return s;
 }
 
+void cv_solver_drop_factor(cv_solver *s) {
+  cv_ldlt_free(s->ldlt);
+  cv_free(s->gof);
+  s->ldlt = NULL;
+  s->gof = NULL;
+}
+
 void cv_solver_free(cv_solver *s) {
   if (!s) return;
+  cv_solver_drop_factor(s);
   cv_free(s->mesh.t);
   cv_free(s->mesh.degrees);
   cv_free(s->mesh.breaks);
@@ -35,6 +44,7 @@ void cv_solver_free(cv_solver *s) {
   cv_free(s->y);
   cv_free(s->mult);
   cv_disc_free(&s->disc);
+  cv_pathset_free(s->paths);
   cv_free(s);
 }
 

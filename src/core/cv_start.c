@@ -126,6 +126,7 @@ cv_status cv_start_setup(cv_solver *s, const cv_problem *p) {
   cv_free(s->y);
   cv_free(s->mult);
   s->y = s->mult = NULL;
+  cv_solver_drop_factor(s);
   cv_disc_free(&s->disc);
   s->have = 0;
   st = cv_disc_init(&s->disc, p, s, s->msg, sizeof s->msg);
@@ -150,23 +151,21 @@ cv_status cv_start_setup(cv_solver *s, const cv_problem *p) {
   return st;
 }
 
-/* The discrete integral of F over element e with the rule (tau, omega) of n points. */
+/* The discrete integral of F over element e with rule r (reference points, weights and
+ * basis tables). buf: q (2 n + 2) doubles. Returns 0 when F fails or is not finite. */
 static int element_integral(const cv_problem *p, const cv_disc *d, const double *Y, long e,
-                            int q, const double *tau, const double *omega, double *buf,
-                            double *S) {
-  int n = p->n, P1 = cv_disc_edeg(d, e) + 1;
-  long j0 = cv_disc_enode(d, e);
-  double phi[CV_MAX_DEGREE + 1], dphi[CV_MAX_DEGREE + 1];
+                            const cv_rule *r, double *buf, double *S) {
+  int n = p->n, P1 = cv_disc_edeg(d, e) + 1, q = r->q;
   double x0 = d->xe[e], h = d->xe[e + 1] - x0, *x = buf, *y = x + q, *dy = y + (size_t)n * q;
   double *F = dy + (size_t)n * q;
+  const double *Ye = Y + (size_t)cv_disc_enode(d, e) * n;
   for (int k = 0; k < q; k++) {
-    x[k] = x0 + 0.5 * (tau[k] + 1.0) * h;
-    cv_lagrange(P1 - 1, cv_disc_eref(d, e)->xi, tau[k], phi, dphi);
+    x[k] = x0 + 0.5 * (r->tau[k] + 1.0) * h;
     for (int i = 0; i < n; i++) {
       double a = 0.0, b = 0.0;
       for (int l = 0; l < P1; l++) {
-        a += Y[(j0 + l) * n + i] * phi[l];
-        b += Y[(j0 + l) * n + i] * dphi[l];
+        a += Ye[l * n + i] * r->B[k * P1 + l];
+        b += Ye[l * n + i] * r->D[k * P1 + l];
       }
       y[i * q + k] = a;
       dy[i * q + k] = b * 2.0 / h;
@@ -175,29 +174,39 @@ static int element_integral(const cv_problem *p, const cv_disc *d, const double 
   cv_partials o = {F, NULL, NULL, NULL, NULL, NULL};
   int rc = p->F(q, x, y, dy, CVAR_NEED_F, &o, p->user);
   double sum = 0.0;
-  for (int k = 0; k < q; k++) sum += 0.5 * h * omega[k] * F[k];
+  for (int k = 0; k < q; k++) sum += 0.5 * h * r->omega[k] * F[k];
   *S = sum;
   return rc == 0 && isfinite(sum);
 }
 
-/* |integral under the element's own rule - under the singular-end rule at c| over element
- * e (Q-2 mapping x = c +- u^2 with qs Gauss points in u); INFINITY if F fails. */
+/* |integral under the element's own rule - under the singular-end rule at the end| over
+ * element e (Q-2: x = c +- u^2, qs Gauss points in u); INFINITY if F fails. *own: the
+ * element's integral under its own rule. */
 static double rule_gap(const cv_problem *p, const cv_disc *d, const double *Y, long e, int end,
                        double *buf, double *own) {
-  int qs = cv_disc_eref(d, e)->qs;
-  double t[CV_MAX_QUAD], w[CV_MAX_QUAD], tau[CV_MAX_QUAD], om[CV_MAX_QUAD];
-  cv_gauss_legendre(qs, t, w);
-  double x0 = d->xe[e], x1 = d->xe[e + 1], h = x1 - x0, J = 0.5 * h, c = end ? d->b : d->a;
-  double u0 = sqrt(fabs(x0 - c)), u1 = sqrt(fabs(x1 - c));
-  for (int k = 0; k < qs; k++) {
-    double u = u0 + (u1 - u0) * 0.5 * (t[k] + 1.0), x = end ? c - u * u : c + u * u;
-    tau[k] = 2.0 * (x - x0) / h - 1.0;
-    om[k] = 0.5 * fabs(u1 - u0) * w[k] * 2.0 * u / J;
-  }
-  cv_rule r = cv_disc_rule(d, e);
+  const cv_refelem *re = cv_disc_eref(d, e); /* the element's own degree (HP-1) */
+  int qs = re->qs, P1 = re->p + 1;
   double S0, S1;
-  int ok = element_integral(p, d, Y, e, r.q, r.tau, r.omega, buf, &S0) &&
-           element_integral(p, d, Y, e, qs, tau, om, buf, &S1);
+  cv_rule r0 = cv_disc_rule(d, e), r1;
+  double tau[CV_MAX_QUAD], om[CV_MAX_QUAD];
+  double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
+  if (e == (end ? d->E - 1 : 0)) {
+    r1 = cv_end_rule(re->p, qs, end); /* the element touching the end: fixed tables */
+  } else {
+    double t[CV_MAX_QUAD], w[CV_MAX_QUAD];
+    cv_gauss_legendre(qs, t, w);
+    double x0 = d->xe[e], x1 = d->xe[e + 1], h = x1 - x0, J = 0.5 * h, c = end ? d->b : d->a;
+    double u0 = sqrt(fabs(x0 - c)), u1 = sqrt(fabs(x1 - c));
+    for (int k = 0; k < qs; k++) {
+      double u = u0 + (u1 - u0) * 0.5 * (t[k] + 1.0), x = end ? c - u * u : c + u * u;
+      tau[k] = 2.0 * (x - x0) / h - 1.0;
+      om[k] = 0.5 * fabs(u1 - u0) * w[k] * 2.0 * u / J;
+      cv_lagrange(re->p, re->xi, tau[k], B + k * P1, D + k * P1);
+    }
+    r1 = (cv_rule){qs, tau, om, B, D};
+  }
+  int ok = element_integral(p, d, Y, e, &r0, buf, &S0) &&
+           element_integral(p, d, Y, e, &r1, buf, &S1);
   *own = ok ? fabs(S0) : 0.0;
   return ok ? fabs(S1 - S0) : INFINITY;
 }
@@ -220,9 +229,10 @@ int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double 
   double *buf = cv_malloc((size_t)q * (2 * (size_t)p->n + 2) * sizeof *buf);
   if (!buf) return 0;
   double own, own1;
-  double gap = rule_gap(p, d, Y, e, end, buf, &own);
-  double next = d->E > 1 && isfinite(gap) ? rule_gap(p, d, Y, e1, end, buf, &own1) : 0.0;
-  cv_free(buf);
+  double gap = rule_gap(p, d, Y, e, end, buf, &own), next = 0.0;
   *rel = gap / fmax(fmax(fabs(action), own), DBL_MIN);
+  /* the neighbour only when the end element's gap is large (rarely: a solve's cost) */
+  if (!(*rel <= 1e-8) && d->E > 1 && isfinite(gap)) next = rule_gap(p, d, Y, e1, end, buf, &own1);
+  cv_free(buf);
   return !(*rel <= 1e-8) && !(gap <= 100.0 * next);
 }

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "calcvar.h"
+#include "core/cv_table_internal.h"
 #include "expr/ex_integrand.h"
 
 /* Names known while parsing: the variable (slot 0), the unknowns (slots 1..n, primed
@@ -129,6 +130,16 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
   }
   d = ex_dag_new();
   if (!d) goto nomem;
+  for (int i = 0; i < cv_problem_num_tables(p); i++) {
+    const char *tn = cv_problem_table_name(p, i);
+    int clash = strcmp(tn, c.var) == 0;
+    for (int j = 0; j < c.n; j++) clash |= strcmp(tn, c.unk[j]) == 0;
+    if (clash || (why = bad_name(tn))) {
+      msg(err, errlen, "table '%s': %s", tn, clash ? "the name is already used" : why);
+      goto cleanup;
+    }
+    if (ex_dag_add_table(d, tn, (cv_table *)cv_problem_table(p, i)) < 0) goto nomem;
+  }
   if (parameters && parameters[0]) {
     if ((np = ex_list_split(parameters, &plist)) < 0) goto nomem;
     c.pname = cv_calloc((size_t)np, sizeof *c.pname);
@@ -147,7 +158,7 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
         msg(err, errlen, "parameters: '%s' %s", name, why);
         goto cleanup;
       }
-      int clash = strcmp(name, c.var) == 0;
+      int clash = strcmp(name, c.var) == 0 || ex_dag_find_table(d, name) >= 0;
       for (int j = 0; j < c.n; j++) clash |= strcmp(name, c.unk[j]) == 0;
       for (int j = 0; j < i; j++) clash |= strcmp(name, c.pname[j]) == 0;
       if (clash) {
@@ -198,14 +209,16 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
     goto cleanup;
   }
   /* The problem owns g from here on, also when the call fails (it releases it). */
-  if (kind == FORMULA_INTEGRAND)
+  if (kind == FORMULA_INTEGRAND) {
     st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
-  else if (kind == FORMULA_CONSTRAINT)
+    if (st == CVAR_OK) st = cv_problem_set_integrand_note(p, ex_integrand_note);
+  } else if (kind == FORMULA_CONSTRAINT) {
     st = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g,
                                          ex_integrand_release, index);
-  else
+  } else {
     st = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release, c_rhs,
                                        index);
+  }
   if (st != CVAR_OK) msg(err, errlen, "%s", cv_strerror(st));
   goto cleanup;
 nomem:

@@ -190,6 +190,7 @@ ex_id ex_if(ex_dag *d, ex_id c, ex_id a, ex_id b) {
 }
 
 ex_id ex_make(ex_dag *d, ex_op op, ex_id a, ex_id b, ex_id c) {
+  if (op == EX_TABLE) return -1; /* its identity is not in (op, a, b, c): ex_remake */
   switch (ex_op_arity(op)) {
   case 1: return ex_unary(d, op, a);
   case 2: return ex_binary(d, op, a, b);

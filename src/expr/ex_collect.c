@@ -233,7 +233,7 @@ static int normal(ex_dag *d, ex_id id, poly *pl, const ex_id *map, poly *P) {
   default: break;
   }
   /* An atom: the node rebuilt over normalised operands. */
-  ex_id r = ex_make(d, nd.op, map[nd.a], nd.b >= 0 ? map[nd.b] : -1, nd.c >= 0 ? map[nd.c] : -1);
+  ex_id r = ex_remake(d, &nd, map[nd.a], nd.b >= 0 ? map[nd.b] : -1, nd.c >= 0 ? map[nd.c] : -1);
   if (r < 0) return -1;
   if (d->nodes[r].op == EX_NUM) {
     mono m = {d->nodes[r].v, 0, NULL};

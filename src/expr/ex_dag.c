@@ -24,6 +24,7 @@ ex_dag *ex_dag_new(void) {
 
 void ex_dag_free(ex_dag *d) {
   if (!d) return;
+  ex_dag_free_tables(d);
   cv_free(d->nodes);
   cv_free(d->table);
   cv_free(d);
@@ -153,7 +154,7 @@ int ex_op_arity(ex_op op) {
   case EX_NUM: case EX_SLOT: return 0;
   case EX_ADD: case EX_SUB: case EX_MUL: case EX_DIV: case EX_POW: case EX_ATAN2:
   case EX_MIN: case EX_MAX: case EX_LT: case EX_LE: case EX_GT: case EX_GE: return 2;
-  case EX_IF: return 3;
+  case EX_IF: case EX_TABLE: return 3; /* a table call: 1 to 3 (absent ones are -1) */
   default: return 1;
   }
 }
@@ -225,6 +226,11 @@ int ex_eval(const ex_dag *d, ex_id e, const double *slots, double *value) {
     switch (nd->op) {
     case EX_NUM: val[id] = nd->v; break;
     case EX_SLOT: val[id] = slots ? slots[nd->a] : NAN; break;
+    case EX_TABLE: {
+      double u[3] = {val[nd->a], nd->b >= 0 ? val[nd->b] : 0.0, nd->c >= 0 ? val[nd->c] : 0.0};
+      ex_table_apply(d, nd, u, &val[id]); /* NaN outside the grid */
+      break;
+    }
     default:
       val[id] = ex_apply(nd->op, val[nd->a], nd->b >= 0 ? val[nd->b] : 0.0,
                          nd->c >= 0 ? val[nd->c] : 0.0);

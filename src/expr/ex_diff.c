@@ -55,6 +55,10 @@ static ex_id rule(ex_dag *d, ex_id id, ex_node nd, int slot, ex_id da, ex_id db,
   case EX_MAX: return ex_if(d, ex_binary(d, EX_GE, a, b), da, db);
   case EX_LT: case EX_LE: case EX_GT: case EX_GE: return NUM(0.0);
   case EX_IF: return ex_if(d, a, db, dc);
+  case EX_TABLE: {
+    ex_id dargs[3] = {da, db, dc};
+    return ex_table_diff(d, &nd, dargs);
+  }
   default: return -1;
   }
 }

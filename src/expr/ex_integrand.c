@@ -16,6 +16,7 @@ struct ex_integrand {
   double *scratch;  /* one batch per output, for groups the caller did not ask for */
   const double **in;
   double **outp;
+  char note[320];   /* why the last failing evaluation failed (a table's grid left) */
 };
 
 static void set_err(char *err, size_t errlen, const char *msg) {
@@ -99,6 +100,13 @@ void ex_integrand_free(ex_integrand *g) {
 
 void ex_integrand_release(void *g) { ex_integrand_free(g); }
 
+const char *ex_integrand_note(void *user, int reset) {
+  ex_integrand *g = user;
+  if (!g) return NULL;
+  if (reset) g->note[0] = 0;
+  return g->note;
+}
+
 int ex_integrand_num_unknowns(const ex_integrand *g) { return g ? g->n : 0; }
 unsigned ex_integrand_max_need(const ex_integrand *g) { return g ? g->max_need : 0; }
 
@@ -140,6 +148,9 @@ static int eval_into(ex_integrand *g, int m, const double *x, const double *y,
         for (int j = i; j < n; j++, o++) g->outp[o] = dest(g, Fpp, (i * n + j) * M + k0, o);
     }
     ex_tape_eval(g->tape[level], mm, g->in, g->outp, g->work);
+    /* A table met a point outside its grid: "cannot evaluate here" (the line search
+     * shortens the step), and the note names the table. */
+    if (ex_tape_fault(g->tape[level], mm, g->work, g->note, sizeof g->note)) return 1;
   }
   /* Symmetric blocks: the lower triangle is a copy of the upper. */
   for (int i = 0; i < n; i++)

@@ -49,5 +49,8 @@ unsigned ex_integrand_max_need(const ex_integrand *g);
 void ex_integrand_free(ex_integrand *g);
 /* ex_integrand_free with the signature of a release callback (void *). */
 void ex_integrand_release(void *g);
+/* A cv_note_fn (core/cv_table_internal.h): the sentence of the last evaluation that failed
+ * because a table was called outside its grid ("" if none); reset clears it. */
+const char *ex_integrand_note(void *user, int reset);
 
 #endif /* CV_EX_INTEGRAND_H */

@@ -27,6 +27,9 @@ struct ex_dag {
   int *table; /* open-addressing hash of node ids, -1 = empty */
   size_t tcap;
   int max_slot; /* largest slot used, so `dep` is exact when max_slot < 64 */
+  int ntables;  /* registered tables (ex_table.c), each with a reference */
+  char **tab_name;
+  struct cv_table **tabs;
 };
 
 /* Number of operands of an operation (0..3). */
@@ -52,5 +55,19 @@ ex_id ex_make(ex_dag *d, ex_op op, ex_id a, ex_id b, ex_id c);
  * skip_conditions, the conditions of `if` and comparison operands are not entered (they
  * have zero derivative). */
 void ex_mark_reachable(const ex_dag *d, ex_id e, unsigned char *mark, int skip_conditions);
+
+/* Rebuild a node like nd on new operands through the simplifying constructors (all ops,
+ * including table calls, whose identity lives in nd->v). */
+ex_id ex_remake(ex_dag *d, const ex_node *nd, ex_id a, ex_id b, ex_id c);
+/* Table calls (ex_table.c): value of an EX_TABLE node at argument values u[0..dim-1];
+ * 0, or k + 1 when u is outside the grid along coordinate k (value NaN). */
+int ex_table_apply(const ex_dag *d, const ex_node *nd, const double *u, double *value);
+/* d(call)/d slot = sum_k call_{+e_k} * dargs[k] (TB-5). */
+ex_id ex_table_diff(ex_dag *d, const ex_node *nd, const ex_id *dargs);
+/* Encoding of a call in the node's v: index*64 + 16*o0 + 4*o1 + o2. */
+#define EX_TABLE_CODE(index, o0, o1, o2) ((double)((index) * 64 + (o0) * 16 + (o1) * 4 + (o2)))
+void ex_table_decode(double v, int *index, int ord[3]);
+/* Free the registry (ex_dag_free). */
+void ex_dag_free_tables(ex_dag *d);
 
 #endif /* CV_EX_INTERNAL_H */

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "calcvar.h"
 #include "expr/ex_internal.h"
 
 /* Nesting bound: each level costs a handful of small stack frames, so 200 levels is far
@@ -153,6 +154,56 @@ static ex_id parse_call(parser *p, const ex_function *f, size_t at) {
   }
 }
 
+/* A table call name(args) or name.K(args) (expr.h): K lists the coordinates (1..dim) to
+ * differentiate by, e.g. h.12 = d2h/du dv. pos is at the '.' or '('. */
+static ex_id parse_table_call(parser *p, int index, const char *name, size_t at) {
+  const cv_table *t = p->d->tabs[index];
+  int dim = cv_table_get_dim(t), ord[3] = {0, 0, 0};
+  if (p->s[p->pos] == '.') {
+    size_t k0 = ++p->pos;
+    while (isdigit((unsigned char)p->s[p->pos])) {
+      int k = p->s[p->pos] - '1';
+      if (k < 0 || k >= dim)
+        return fail(p, p->pos, "'%s' has %d coordinate%s: a derivative index is 1%s", name,
+                    dim, dim == 1 ? "" : "s", dim == 1 ? "" : dim == 2 ? " or 2" : ", 2 or 3");
+      ord[k]++;
+      p->pos++;
+    }
+    if (p->pos == k0 || p->pos - k0 > 6)
+      return fail(p, k0, "after '%s.' write the coordinates to differentiate by (e.g. %s.1)",
+                  name, name);
+    skip_ws(p);
+    if (p->s[p->pos] != '(')
+      return fail(p, at, "'%s' is a table: write %s(...)", name, name);
+  }
+  ex_id args[3];
+  int n = 0;
+  p->pos++; /* '(' */
+  for (;;) {
+    if (n == 3) break;
+    args[n] = parse_sum(p);
+    if (args[n] < 0) return -1;
+    n++;
+    skip_ws(p);
+    if (p->s[p->pos] == ',') {
+      p->pos++;
+      continue;
+    }
+    if (p->s[p->pos] == ')') {
+      p->pos++;
+      break;
+    }
+    char buf[16];
+    return fail(p, p->pos, "expected ',' or ')' in the arguments of '%s' but found %s", name,
+                found(p, buf, sizeof buf));
+  }
+  if (n != dim || (n == 3 && p->s[p->pos - 1] != ')'))
+    return fail(p, at, "table '%s' has %d coordinate%s, so it takes %d argument%s%s", name,
+                dim, dim == 1 ? "" : "s", dim, dim == 1 ? "" : "s",
+                n == 3 && p->s[p->pos - 1] != ')' ? ", not more" : "");
+  return built(p, ex_table_call(p->d, index, ord, args));
+}
+
 static ex_id parse_name(parser *p) {
   size_t at = p->pos, i = at;
   while (is_name_char((unsigned char)p->s[i])) i++;
@@ -165,6 +216,11 @@ static ex_id parse_name(parser *p) {
   p->pos = i;
   skip_ws(p);
   const ex_function *f = ex_function_find(name);
+  int table = f ? -1 : ex_dag_find_table(p->d, name);
+  if (table >= 0 && !primes && (p->s[p->pos] == '(' || (p->s[p->pos] == '.' && p->pos == i)))
+    return parse_table_call(p, table, name, at);
+  if (table >= 0)
+    return fail(p, at, "'%s' is a table: write %s(...)", name, name);
   if (p->s[p->pos] == '(' && !primes) {
     if (!f) return fail(p, at, "unknown function '%s'", name);
     return parse_call(p, f, at);

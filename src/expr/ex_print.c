@@ -62,7 +62,8 @@ static int plain_factor(const ex_dag *d, ex_id e) {
   const ex_node *nd = &d->nodes[e];
   if (nd->op == EX_POW) nd = &d->nodes[nd->a];
   return nd->op == EX_SLOT || (nd->op >= EX_SIN && nd->op <= EX_ABS) ||
-         nd->op == EX_ATAN2 || nd->op == EX_MIN || nd->op == EX_MAX || nd->op == EX_IF;
+         nd->op == EX_ATAN2 || nd->op == EX_MIN || nd->op == EX_MAX || nd->op == EX_IF ||
+         nd->op == EX_TABLE;
 }
 
 static void put(printer *o, const char *s, size_t n) {
@@ -160,6 +161,25 @@ static void emit(printer *o, ex_id e) {
     child(o, nd->b, 0);
     puts_(o, ", ");
     child(o, nd->c, 0);
+    put(o, ")", 1);
+    break;
+  }
+  case EX_TABLE: { /* name(u, v) or name.K(u, v), K the axes differentiated (1-based) */
+    int index, ord[3], at = 0;
+    ex_table_decode(nd->v, &index, ord);
+    const char *name = ex_dag_table_name(d, index);
+    puts_(o, name ? name : "table?");
+    if (ord[0] + ord[1] + ord[2] > 0) {
+      tmp[at++] = '.';
+      for (int k = 0; k < 3; k++)
+        for (int r = 0; r < ord[k]; r++) tmp[at++] = (char)('1' + k);
+      tmp[at] = 0;
+      puts_(o, tmp);
+    }
+    put(o, "(", 1);
+    child(o, nd->a, 0);
+    if (nd->b >= 0) puts_(o, ", "), child(o, nd->b, 0);
+    if (nd->c >= 0) puts_(o, ", "), child(o, nd->c, 0);
     put(o, ")", 1);
     break;
   }

@@ -10,9 +10,12 @@
 #endif
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "calcvar.h"
+#include "core/cv_table_internal.h"
 #include "expr/ex_internal.h"
 
 /* Tape operations. Suffix V = vector operand, K = the instruction's scalar constant. */
@@ -21,7 +24,8 @@ typedef enum {
   T_ADD_VV, T_ADD_KV, T_SUB_VV, T_SUB_KV, T_SUB_VK, T_MUL_VV, T_MUL_KV,
   T_DIV_VV, T_DIV_KV, T_DIV_VK, T_NEG,
   T_POW_VV, T_POW_KV, T_POW_VK, T_SQR, T_CUBE, T_POW4, T_RECIP, T_RECIP2, T_SQRT, T_RSQRT,
-  T_ABS, T_FN1, T_ATAN2, T_MIN, T_MAX, T_LT, T_LE, T_GT, T_GE, T_IF
+  T_ABS, T_FN1, T_ATAN2, T_MIN, T_MAX, T_LT, T_LE, T_GT, T_GE, T_IF,
+  T_TABLE /* a table's spline or partial at 1..3 operands (ex_table.c, theory TB-2) */
 } tape_op;
 
 /* A location: a work register, an input slot or an output buffer. */
@@ -35,12 +39,33 @@ typedef struct {
   double (*fn)(double); /* T_FN1: the libm function */
   double k;             /* scalar operand (K variants, T_FILL) */
   loc dst, a, b, c;
+  int tab, multi;       /* T_TABLE: index in the tape's tables and in its call groups */
 } instr;
+
+/* One T_TABLE instruction computes every partial the tape needs of one table at the same
+ * arguments (value, gradient, Hessian entries): one cell search and one gather per point
+ * for all of them (cv_table_eval_multi). */
+enum { EX_TABLE_FUSE = 10 };
+typedef struct {
+  int n;
+  loc dst[EX_TABLE_FUSE];
+  int ord[EX_TABLE_FUSE][3];
+} table_group;
 
 struct ex_tape {
   int nslots, nout, nins, nregs;
   instr *ins;
+  int ntab;             /* tables the tape calls, each with a reference, and their names */
+  cv_table **tab;
+  char **tabname;
+  int ngroup;
+  table_group *group;
 };
+
+/* T_TABLE records the first point outside a table's grid in the EX_TAPE_FAULT doubles
+ * after the registers of the work array: [0] = table + 1 (0: none), [1] = coordinate + 1,
+ * [2..4] = the point. */
+enum { EX_TAPE_FAULT = 5 };
 
 static double (*unary_fn(ex_op op))(double) {
   switch (op) {
@@ -67,6 +92,7 @@ typedef struct {
   unsigned char live;   /* reachable from an output through non-constant nodes */
   unsigned char konst;  /* constant: its value is cval */
   unsigned char needv;  /* needs a vector location (computed or filled) */
+  unsigned char fused;  /* a table call computed by an earlier call's instruction */
   double cval;
   int last;             /* id of the last node reading it as a vector operand */
   loc home;
@@ -146,6 +172,7 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
       continue;
     }
     if (c->konst && !c->needv) continue; /* used only as a scalar (or output: filled later) */
+    if (c->fused) goto free_operands;
     instr in;
     memset(&in, 0, sizeof in);
     if (c->konst) {
@@ -203,6 +230,66 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
       case EX_GT: in.op = T_GT; break;
       case EX_GE: in.op = T_GE; break;
       case EX_IF: in.op = T_IF; break;
+      case EX_TABLE: {
+        int index, ord[3];
+        ex_table_decode(nd->v, &index, ord);
+        if (index < 0 || index >= d->ntables) goto fail;
+        in.op = T_TABLE;
+        in.tab = -1;
+        for (int j = 0; j < t->ntab; j++)
+          if (t->tab[j] == d->tabs[index]) in.tab = j;
+        if (in.tab < 0) {
+          cv_table **tabs = cv_realloc(t->tab, ((size_t)t->ntab + 1) * sizeof *tabs);
+          if (tabs) t->tab = tabs;
+          char **names = cv_realloc(t->tabname, ((size_t)t->ntab + 1) * sizeof *names);
+          if (names) t->tabname = names;
+          char *copy = cv_malloc(strlen(d->tab_name[index]) + 1);
+          if (!tabs || !names || !copy) {
+            cv_free(copy);
+            goto fail;
+          }
+          strcpy(copy, d->tab_name[index]);
+          t->tab[t->ntab] = cv_table_ref(d->tabs[index]);
+          t->tabname[t->ntab] = copy;
+          in.tab = t->ntab++;
+        }
+        table_group *gr = cv_realloc(t->group, ((size_t)t->ngroup + 1) * sizeof *gr);
+        if (!gr) goto fail;
+        t->group = gr;
+        gr = &t->group[t->ngroup];
+        in.multi = t->ngroup++;
+        gr->n = 1;
+        memcpy(gr->ord[0], ord, sizeof ord);
+        /* the later calls of this table at the same arguments join the instruction; their
+         * destinations are allocated now (after the operands', so never aliasing them) */
+        for (int j = id + 1; j < nn && gr->n < EX_TABLE_FUSE; j++) {
+          const ex_node *nj = &d->nodes[j];
+          if (!cn[j].live || cn[j].konst || nj->op != EX_TABLE || nj->a != nd->a ||
+              nj->b != nd->b || nj->c != nd->c)
+            continue;
+          int jindex, jord[3];
+          ex_table_decode(nj->v, &jindex, jord);
+          if (jindex != index) continue;
+          if (cn[j].home.space < 0) {
+            int r;
+            if (nfree > 0) {
+              int best = 0;
+              for (int i = 1; i < nfree; i++)
+                if (freeregs[i] < freeregs[best]) best = i;
+              r = freeregs[best];
+              freeregs[best] = freeregs[--nfree];
+            } else {
+              r = t->nregs++;
+            }
+            cn[j].home = (loc){L_REG, r};
+          }
+          cn[j].fused = 1;
+          gr->dst[gr->n] = cn[j].home;
+          memcpy(gr->ord[gr->n], jord, sizeof jord);
+          gr->n++;
+        }
+        break;
+      }
       default:
         in.op = T_FN1;
         in.fn = unary_fn(nd->op);
@@ -225,7 +312,9 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
       c->home = (loc){L_REG, r};
     }
     in.dst = c->home;
+    if (in.op == T_TABLE) t->group[in.multi].dst[0] = c->home;
     ins[n++] = in;
+  free_operands:
     if (!c->konst) {
       ex_id ops[3] = {nd->a, nd->b, nd->c};
       for (int i = 0; i < 3; i++) {
@@ -261,18 +350,27 @@ fail:
   cv_free(cn);
   cv_free(freeregs);
   cv_free(ins);
-  cv_free(t);
+  if (t) t->ins = NULL;
+  ex_tape_free(t);
   return NULL;
 }
 
 void ex_tape_free(ex_tape *t) {
   if (!t) return;
+  for (int j = 0; j < t->ntab; j++) {
+    cv_table_free(t->tab[j]);
+    cv_free(t->tabname[j]);
+  }
+  cv_free(t->tab);
+  cv_free(t->tabname);
+  cv_free(t->group);
   cv_free(t->ins);
   cv_free(t);
 }
 
 size_t ex_tape_work_size(const ex_tape *t, int m) {
-  return t && m > 0 ? (size_t)t->nregs * (size_t)m : 0;
+  if (!t || m <= 0) return 0;
+  return (size_t)t->nregs * (size_t)m + (t->ntab ? EX_TAPE_FAULT : 0);
 }
 
 int ex_tape_num_instructions(const ex_tape *t) { return t ? t->nins : 0; }
@@ -319,6 +417,31 @@ static void run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
   case T_GT: LOOP(A[k] > B[k] ? 1.0 : 0.0); break;
   case T_GE: LOOP(A[k] >= B[k] ? 1.0 : 0.0); break;
   case T_IF: LOOP(A[k] != 0 ? B[k] : C[k]); break;
+  case T_TABLE: break; /* run_table */
+  }
+}
+
+static double *where(loc l, int m, const double *const *in, double *const *out,
+                     double *work);
+
+/* T_TABLE over the m points: every partial of its group at once; a point outside the grid
+ * gives NaN and, the first time in this evaluation, a fault record (EX_TAPE_FAULT). */
+static void run_table(const ex_tape *t, const instr *in, int m, const double *const *inp,
+                      double *const *out, double *work, const double *A, const double *B,
+                      const double *C, double *fault) {
+  const cv_table *tab = t->tab[in->tab];
+  const table_group *g = &t->group[in->multi];
+  double *D[EX_TABLE_FUSE], v[EX_TABLE_FUSE];
+  for (int j = 0; j < g->n; j++) D[j] = where(g->dst[j], m, inp, out, work);
+  for (int k = 0; k < m; k++) {
+    double u[3] = {A[k], B ? B[k] : 0.0, C ? C[k] : 0.0};
+    int rc = cv_table_eval_multi(tab, u, g->n, (const int(*)[3])g->ord, v);
+    for (int j = 0; j < g->n; j++) D[j][k] = v[j];
+    if (rc != 0 && fault[0] == 0) {
+      fault[0] = in->tab + 1;
+      fault[1] = rc;
+      fault[2] = u[0], fault[3] = u[1], fault[4] = u[2];
+    }
   }
 }
 
@@ -335,12 +458,30 @@ static double *where(loc l, int m, const double *const *in, double *const *out,
 void ex_tape_eval(const ex_tape *t, int m, const double *const *in, double *const *out,
                   double *work) {
   if (!t || m <= 0) return;
+  double *fault = t->ntab ? work + (size_t)t->nregs * (size_t)m : NULL;
+  if (fault) fault[0] = 0;
   for (int i = 0; i < t->nins; i++) {
     const instr *p = &t->ins[i];
     double *D = where(p->dst, m, in, out, work);
     const double *A = where(p->a, m, in, out, work);
     const double *B = where(p->b, m, in, out, work);
     const double *C = where(p->c, m, in, out, work);
-    run(p, m, D, A, B, C);
+    if (p->op == T_TABLE) run_table(t, p, m, in, out, work, A, B, C, fault);
+    else run(p, m, D, A, B, C);
   }
+}
+
+int ex_tape_fault(const ex_tape *t, int m, const double *work, char *msg, size_t len) {
+  if (!t || !t->ntab || m <= 0 || !work) return 0;
+  const double *fault = work + (size_t)t->nregs * (size_t)m;
+  if (fault[0] == 0) return 0;
+  int j = (int)fault[0] - 1, k = (int)fault[1] - 1;
+  const char *axis[3] = {"first", "second", "third"};
+  double lo = 0, hi = 0;
+  cv_table_get_range(t->tab[j], k, &lo, &hi);
+  if (msg && len)
+    snprintf(msg, len, "the path left the grid of table '%s': its %s argument was %.15g, "
+             "outside [%.10g, %.10g] (tables are not extrapolated)", t->tabname[j],
+             axis[k < 0 ? 0 : k > 2 ? 2 : k], fault[2 + (k < 0 ? 0 : k > 2 ? 2 : k)], lo, hi);
+  return 1;
 }

@@ -26,6 +26,7 @@ typedef enum {
   EX_ATAN2, EX_MIN, EX_MAX,
   EX_LT, EX_LE, EX_GT, EX_GE, /* comparisons: value 1.0 or 0.0 */
   EX_IF,                      /* if(c, a, b): a where c != 0, else b */
+  EX_TABLE,                   /* a table's spline (or a partial of it) at 1..3 arguments */
   EX_NUM_OPS
 } ex_op;
 
@@ -106,6 +107,9 @@ size_t ex_tape_work_size(const ex_tape *t, int m);
 void ex_tape_eval(const ex_tape *t, int m, const double *const *in, double *const *out,
                   double *work);
 int ex_tape_num_instructions(const ex_tape *t);
+/* After ex_tape_eval with the same m and work: 1 when a table call met a point outside its
+ * grid (the outputs there are NaN), with a sentence naming the table in msg; else 0. */
+int ex_tape_fault(const ex_tape *t, int m, const double *work, char *msg, size_t len);
 
 /* Additions (not in the first version of this header). */
 /* Number of nodes in d; valid ids are 0 .. ex_dag_num_nodes(d) - 1. */
@@ -125,5 +129,25 @@ int ex_eval(const ex_dag *d, ex_id e, const double *slots, double *value);
  * distinct term once, numeric factors peeled off (2*t, t/2, -t). For display: combining
  * coefficients may change the value by rounding (a few ulps). -1 on allocation failure. */
 ex_id ex_collect(ex_dag *d, ex_id e);
+
+/* Tables (ex_table.c): a cv_table (calcvar.h) registered under a name becomes callable as
+ * `name(u, ...)` and `name.K(u, ...)` in ex_parse (K: one digit 1..3 per derivative, e.g.
+ * `h.1` = dh/du, `h.12` = d2h/du dv). The DAG keeps a reference to the table. A call node
+ * has the arguments as operands and ex_table_orders() derivative orders; ex_diff gives
+ * table-derivative nodes (chain rule), so every partial stays exact. */
+struct cv_table;
+/* Register t as `name` (an identifier, not a function or pi, not registered yet): its
+ * index 0, 1, ..., or -1 (bad or taken name, allocation failure). */
+int ex_dag_add_table(ex_dag *d, const char *name, struct cv_table *t);
+/* Index of the table called `name`, or -1. */
+int ex_dag_find_table(const ex_dag *d, const char *name);
+int ex_dag_num_tables(const ex_dag *d);
+const char *ex_dag_table_name(const ex_dag *d, int index);
+/* The call node of table `index` with derivative orders ord[k] (NULL: 0) at args[0..dim-1]
+ * (dim of the table). A call at numbers inside the grid folds to a number; an order above
+ * 3 along some coordinate is the number 0 (the spline is cubic). -1 on failure. */
+ex_id ex_table_call(ex_dag *d, int index, const int *ord, const ex_id *args);
+/* For an EX_TABLE node: the table index, and the orders into ord[3]; -1 otherwise. */
+int ex_table_of(const ex_dag *d, ex_id e, int ord[3]);
 
 #endif /* CV_EXPR_H */

@@ -38,11 +38,11 @@ static sc_set *split_sets(int nset, const char *const *set, char **buf, char *er
     }
     total += strlen(set[i]) + 1;
   }
-  sc_set *pairs = calloc((size_t)nset + 1, sizeof *pairs);
-  char *copy = malloc(total + 1), *q = copy;
+  sc_set *pairs = cv_calloc((size_t)nset + 1, sizeof *pairs);
+  char *copy = cv_malloc(total + 1), *q = copy;
   if (!pairs || !copy) {
-    free(pairs);
-    free(copy);
+    cv_free(pairs);
+    cv_free(copy);
     say(err, errlen, "%s", "out of memory");
     return NULL;
   }
@@ -52,8 +52,8 @@ static sc_set *split_sets(int nset, const char *const *set, char **buf, char *er
     char *eq = strchr(q, '=');
     if (!eq || eq == q) {
       say(err, errlen, "--set %s: expected name=value", set[i]);
-      free(pairs);
-      free(copy);
+      cv_free(pairs);
+      cv_free(copy);
       return NULL;
     }
     *eq = '\0';
@@ -78,7 +78,7 @@ static cv_scene *load(const char *path, const char *text, const char *name, int 
   sc_set *pairs = NULL;
   if (nset > 0 && !(pairs = split_sets(nset, set, &buf, err, errlen)))
     return NULL;
-  cv_scene *sc = calloc(1, sizeof *sc);
+  cv_scene *sc = cv_calloc(1, sizeof *sc);
   if (!sc) {
     say(err, errlen, "%s", "out of memory");
   } else {
@@ -86,12 +86,12 @@ static cv_scene *load(const char *path, const char *text, const char *name, int 
                  : scene_load_buffer(text, strlen(text), name ? name : "<text>", nset, pairs,
                                      err, errlen);
     if (!sc->s) {
-      free(sc);
+      cv_free(sc);
       sc = NULL;
     }
   }
-  free(pairs);
-  free(buf);
+  cv_free(pairs);
+  cv_free(buf);
   return sc;
 }
 
@@ -112,7 +112,7 @@ void cv_scene_free(cv_scene *sc)
   if (!sc)
     return;
   scene_free(sc->s);
-  free(sc);
+  cv_free(sc);
 }
 
 int cv_scene_get_num_unknowns(const cv_scene *sc)
@@ -212,7 +212,7 @@ cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *s, cv_sta
     st = CVAR_ESTATE;
     goto done;
   }
-  r = calloc(1, sizeof *r);
+  r = cv_calloc(1, sizeof *r);
   int rounds = isfinite(cv_solver_get_error_estimate(s)); /* --adapt or --tol: 1, 2 */
   if (!r || cli_report_build(&cr, sc->s, p, s, cv_solver_get_status(s),
                              rounds && sc->s->tol > 0 ? 2 : rounds) < 0 ||
@@ -238,6 +238,6 @@ void cv_report_free(cv_report *r)
 {
   if (!r)
     return;
-  free(r->json);
-  free(r);
+  free(r->json); /* from json_dumps: jansson's allocator */
+  cv_free(r);
 }

@@ -30,7 +30,7 @@ typedef struct {
 
 typedef enum {
   SEC_SCENE, SEC_PARAMETERS, SEC_DEFINITIONS, SEC_BOUNDARY, SEC_GUESS, SEC_CONSTRAINTS,
-  SEC_INTEGRALS, SEC_EXACT, SEC_REPORT, SEC_MESH, SEC_SOLVER, SEC_COUNT
+  SEC_INTEGRALS, SEC_EXACT, SEC_REPORT, SEC_MESH, SEC_SOLVER, SEC_TABLES, SEC_COUNT
 } sc_section;
 
 /* A logical line: a section header or a key line (with its continuations). */
@@ -100,6 +100,14 @@ int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
                    const char *what, double *value);
 const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap);
 int sc_first_slot(const scene *s, ex_id e, int from, int to);
+
+/* scene_load.c: a new name (identifier, not reserved, not taken; `role` for the message). */
+int sc_check_new_name(sc_loader *L, int line, const char *name, const char *role);
+
+/* scene_table.c: the [tables] section, and one CSV grid read into a table (`shown` names
+ * the file in messages "FILE:LINE: ..."; NULL with the message in err). */
+int sc_load_tables(sc_loader *L);
+struct cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t errlen);
 
 /* scene_eval.c */
 int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const double *x,

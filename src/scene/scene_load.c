@@ -86,11 +86,13 @@ static const char *taken(const scene *s, const char *name)
   for (int i = 0; i < s->ndefs; i++)
     if (s->defs[i].name && strcmp(name, s->defs[i].name) == 0)
       return "a definition";
+  if (ex_dag_find_table(s->dag, name) >= 0)
+    return "a table";
   return NULL;
 }
 
 /* A new name for the variable, an unknown, a parameter or a definition. */
-static int check_new_name(sc_loader *L, int line, const char *name, const char *role)
+int sc_check_new_name(sc_loader *L, int line, const char *name, const char *role)
 {
   const char *t;
   if (!ex_is_identifier(name)) {
@@ -126,7 +128,7 @@ static int load_scene_section(sc_loader *L)
   const sc_entry *e = find_entry(L, SEC_SCENE, "title");
   s->title = sc_strdup(e ? e->value : L->file);
   e = find_entry(L, SEC_SCENE, "variable");
-  if (e && check_new_name(L, e->line, e->value, "variable") < 0)
+  if (e && sc_check_new_name(L, e->line, e->value, "variable") < 0)
     return -1;
   s->variable = sc_strdup(e ? e->value : "x");
   if (!s->title || !s->variable)
@@ -148,7 +150,7 @@ static int load_scene_section(sc_loader *L)
   for (int i = 0; i < list.n; i++) {
     int line, col;
     sc_entry_locate(e, list.off[i], &line, &col);
-    if (check_new_name(L, line, list.item[i], "unknown") < 0) {
+    if (sc_check_new_name(L, line, list.item[i], "unknown") < 0) {
       ex_list_free(&list);
       return -1;
     }
@@ -184,7 +186,7 @@ static int load_parameters(sc_loader *L, int nset, const sc_set *set)
   }
   for (int i = 0; i < ne; i++) {
     const sc_entry *e = &L->raw.e[SEC_PARAMETERS][i];
-    if (check_new_name(L, e->line, e->key, "parameter") < 0)
+    if (sc_check_new_name(L, e->line, e->key, "parameter") < 0)
       return -1;
     s->params[i].name = sc_strdup(e->key);
     s->params[i].line = e->line;
@@ -243,7 +245,7 @@ static int load_definitions(sc_loader *L)
   /* Names first, so that a use before the definition is told as such. */
   for (int i = 0; i < ne; i++) {
     const sc_entry *e = &L->raw.e[SEC_DEFINITIONS][i];
-    if (check_new_name(L, e->line, e->key, "definition") < 0)
+    if (sc_check_new_name(L, e->line, e->key, "definition") < 0)
       return -1;
     s->defs[i].name = sc_strdup(e->key);
     s->defs[i].line = e->line;
@@ -322,7 +324,8 @@ scene *scene_load_buffer(const char *text, size_t len, const char *name, int nse
     scene_free(s);
     return NULL;
   }
-  if (load_scene_section(&L) < 0 || load_parameters(&L, nset, set) < 0 ||
+  if (load_scene_section(&L) < 0 || sc_load_tables(&L) < 0 ||
+      load_parameters(&L, nset, set) < 0 ||
       load_definitions(&L) < 0 || load_interval_integrand(&L) < 0 ||
       sc_load_boundary(&L) < 0 || sc_load_guess_exact(&L) < 0 ||
       sc_load_constraints(&L) < 0 || sc_load_report(&L) < 0 || sc_load_mesh(&L) < 0 ||

@@ -1,141 +1,113 @@
-/* src/scene/scene_mechanics.c — a scene's momenta, Euler–Lagrange equations, Hamiltonian
- * and conservation laws, built symbolically from its integrand (docs/theory.md part P).
+/* src/scene/scene_mechanics.c — a scene as a mech_problem (src/mech): its DAG, integrand,
+ * constraints and names, the guess at the start as Newton's start for the equilibrium;
+ * and the line of the entry a failure is about.
  * SPDX-License-Identifier: MIT */
-#include <stdlib.h>
 #include <string.h>
 
 #include "scene/scene_internal.h"
 #include "scene/scene_mechanics.h"
 
-/* Slots of scene_mechanics.h: 0 = x, 1..n = y, n+1..2n = y', 2n+1..3n = y''. */
-static int slot_y(int n, int i) { (void)n; return 1 + i; }
-static int slot_dy(int n, int i) { return 1 + n + i; }
-static int slot_ddy(int n, int i) { return 1 + 2 * n + i; }
+/* The arrays a mech_problem points to. */
+typedef struct {
+  mech_problem mp;
+  ex_id *ids;         /* [ncons + nints] */
+  const char **names; /* [n + ncons + nints] */
+  double *start;      /* [n] */
+} adapter;
 
-static ex_id add(ex_dag *d, ex_id a, ex_id b)
+static void adapter_free(adapter *a)
 {
-  return a >= 0 && b >= 0 ? ex_binary(d, EX_ADD, a, b) : -1;
+  cv_free(a->ids);
+  cv_free(a->names);
+  cv_free(a->start);
 }
 
-static ex_id mul(ex_dag *d, ex_id a, ex_id b)
+static int adapter_new(const scene *s, int with_start, adapter *a)
 {
-  return a >= 0 && b >= 0 ? ex_binary(d, EX_MUL, a, b) : -1;
-}
-
-/* d/dx G(x, y, y') along a path, by the chain rule (P-4):
- * G_x + sum_j G_{y_j} y'_j + sum_j G_{y'_j} y''_j. */
-static ex_id total_derivative(ex_dag *d, ex_id G, int n)
-{
-  ex_id r = ex_diff(d, G, 0);
-  for (int j = 0; j < n && r >= 0; j++) {
-    r = add(d, r, mul(d, ex_diff(d, G, slot_y(n, j)), ex_slot(d, slot_dy(n, j))));
-    r = add(d, r, mul(d, ex_diff(d, G, slot_dy(n, j)), ex_slot(d, slot_ddy(n, j))));
-  }
-  return r;
-}
-
-static char *cat(const char *a, const char *b)
-{
-  size_t la = strlen(a), lb = strlen(b);
-  char *s = cv_malloc(la + lb + 1);
-  if (s) {
-    memcpy(s, a, la);
-    memcpy(s + la, b, lb + 1);
-  }
-  return s;
-}
-
-static int make_names(const scene *s, sc_equations *eq)
-{
-  int n = s->n;
-  eq->nslots = 1 + 3 * n + s->ncons + s->nints;
-  if (!(eq->names = cv_calloc((size_t)eq->nslots, sizeof *eq->names)))
+  int n = s->n, nc = s->ncons, ni = s->nints;
+  memset(a, 0, sizeof *a);
+  a->ids = cv_malloc((size_t)(nc + ni + 1) * sizeof *a->ids);
+  a->names = cv_malloc((size_t)(n + nc + ni) * sizeof *a->names);
+  a->start = cv_malloc((size_t)n * sizeof *a->start);
+  if (!a->ids || !a->names || !a->start ||
+      (with_start && scene_eval_guess(s, 1, &s->a, a->start) < 0)) {
+    adapter_free(a);
     return -1;
-  eq->names[0] = cat(s->variable, "");
-  for (int i = 0; i < n; i++) {
-    eq->names[slot_y(n, i)] = cat(s->unknowns[i], "");
-    eq->names[slot_dy(n, i)] = cat(s->unknowns[i], "'");
-    eq->names[slot_ddy(n, i)] = cat(s->unknowns[i], "''");
   }
-  for (int c = 0; c < s->ncons; c++)
-    eq->names[1 + 3 * n + c] = cat("lambda_", s->cons[c].name);
-  for (int r = 0; r < s->nints; r++)
-    eq->names[1 + 3 * n + s->ncons + r] = cat("mu_", s->ints[r].name);
-  for (int k = 0; k < eq->nslots; k++)
-    if (!eq->names[k])
-      return -1;
+  for (int i = 0; i < n; i++)
+    a->names[i] = s->unknowns[i];
+  for (int c = 0; c < nc; c++) {
+    a->ids[c] = s->cons[c].expr;
+    a->names[n + c] = s->cons[c].name;
+  }
+  for (int r = 0; r < ni; r++) {
+    a->ids[nc + r] = s->ints[r].expr;
+    a->names[n + nc + r] = s->ints[r].name;
+  }
+  mech_problem *mp = &a->mp;
+  mp->dag = s->dag;
+  mp->n = n;
+  mp->F = s->F;
+  mp->ncons = nc;
+  mp->cons = a->ids;
+  mp->nints = ni;
+  mp->ints = a->ids + nc;
+  mp->variable = s->variable;
+  mp->unknowns = a->names;
+  mp->cons_names = a->names + n;
+  mp->int_names = a->names + n + nc;
+  mp->start = a->start;
+  mp->start_x = s->a;
   return 0;
 }
 
-/* Euler–Lagrange expression of unknown i for integrand G, in the sign of (P-4):
- * d/dx G_{y'_i} - G_{y_i}. */
-static ex_id el_of(ex_dag *d, ex_id G, int n, int i)
+/* The scene line of a mech_problem entry (MECH_AT_*), 0 for none. */
+static int line_of(const scene *s, int at)
 {
-  ex_id p = ex_diff(d, G, slot_dy(n, i));
-  ex_id dp = p >= 0 ? total_derivative(d, p, n) : -1;
-  ex_id gy = ex_diff(d, G, slot_y(n, i));
-  return dp >= 0 && gy >= 0 ? ex_binary(d, EX_SUB, dp, gy) : -1;
-}
-
-int scene_equations_new(scene *s, sc_equations *eq, char *err, size_t errlen)
-{
-  int n = s->n;
-  ex_dag *d = s->dag;
-  memset(eq, 0, sizeof *eq);
-  eq->n = n;
-  eq->hamiltonian = -1;
-  if (make_names(s, eq) < 0 || !(eq->momentum = cv_malloc((size_t)n * sizeof *eq->momentum)) ||
-      !(eq->el = cv_malloc((size_t)n * sizeof *eq->el)) ||
-      !(eq->cyclic = cv_malloc((size_t)n * sizeof *eq->cyclic)))
-    goto nomem;
-  eq->autonomous = !scene_F_depends_on_variable(s);
-  ex_id H = ex_unary(d, EX_NEG, s->F);
-  for (int i = 0; i < n; i++) {
-    eq->cyclic[i] = !scene_F_depends_on_unknown(s, i);
-    ex_id p = ex_diff(d, s->F, slot_dy(n, i));
-    H = add(d, H, mul(d, ex_slot(d, slot_dy(n, i)), p));
-    ex_id E = el_of(d, s->F, n, i);
-    /* Multipliers (P-8): L + sum_c lambda_c G_c + sum_r mu_r K_r. */
-    for (int c = 0; c < s->ncons && E >= 0; c++) {
-      ex_id gy = ex_diff(d, s->cons[c].expr, slot_y(n, i));
-      E = gy >= 0 ? ex_binary(d, EX_SUB, E, mul(d, ex_slot(d, 1 + 3 * n + c), gy)) : -1;
-    }
-    for (int r = 0; r < s->nints && E >= 0; r++) {
-      ex_id ek = el_of(d, s->ints[r].expr, n, i);
-      E = add(d, E, mul(d, ex_slot(d, 1 + 3 * n + s->ncons + r), ek));
-    }
-    if (p < 0 || E < 0 || (p = ex_collect(d, p)) < 0 || (E = ex_collect(d, E)) < 0)
-      goto nomem;
-    /* Sign: a positive constant coefficient of y_i'' when it is a negative constant. */
-    ex_id c = ex_diff(d, E, slot_ddy(n, i));
-    double cv;
-    if (c < 0)
-      goto nomem;
-    if (ex_eval_const(d, c, &cv) == 0 && cv < 0 && (E = ex_unary(d, EX_NEG, E)) < 0)
-      goto nomem;
-    eq->momentum[i] = p;
-    eq->el[i] = E;
-  }
-  if (H < 0 || (eq->hamiltonian = ex_collect(d, H)) < 0)
-    goto nomem;
+  if (at == MECH_AT_F)
+    return s->F_line;
+  int k = at - MECH_AT_CONS;
+  if (k >= 0 && k < s->ncons)
+    return s->cons[k].line;
+  if (k >= s->ncons && k < s->ncons + s->nints)
+    return s->ints[k - s->ncons].line;
   return 0;
-nomem:
-  sc_err(err, errlen, s->file, 0, "out of memory while building the equations");
-  scene_equations_free(eq);
-  return -1;
 }
 
-void scene_equations_free(sc_equations *eq)
+cv_status scene_equations_new(const scene *s, mech_equations *eq, char *err, size_t errlen)
 {
-  if (!eq)
-    return;
-  if (eq->names)
-    for (int k = 0; k < eq->nslots; k++)
-      cv_free(eq->names[k]);
-  cv_free(eq->names);
-  cv_free(eq->momentum);
-  cv_free(eq->el);
-  cv_free(eq->cyclic);
+  char why[SC_ERRLEN] = "";
+  adapter a;
   memset(eq, 0, sizeof *eq);
   eq->hamiltonian = -1;
+  if (err && errlen)
+    err[0] = '\0';
+  if (adapter_new(s, 0, &a) < 0) {
+    sc_err(err, errlen, s->file, 0, "out of memory while building the equations");
+    return CVAR_ENOMEM;
+  }
+  cv_status st = mech_equations_new(&a.mp, eq, why, sizeof why);
+  adapter_free(&a);
+  if (st != CVAR_OK)
+    sc_err(err, errlen, s->file, 0, "%s", why);
+  return st;
+}
+
+cv_status scene_modes_new(const scene *s, mech_modes *md, char *err, size_t errlen)
+{
+  char why[SC_ERRLEN] = "";
+  int at = MECH_AT_NONE;
+  adapter a;
+  memset(md, 0, sizeof *md);
+  if (err && errlen)
+    err[0] = '\0';
+  if (adapter_new(s, 1, &a) < 0) {
+    sc_err(err, errlen, s->file, 0, "out of memory while computing the modes");
+    return CVAR_ENOMEM;
+  }
+  cv_status st = mech_modes_new(&a.mp, md, &at, why, sizeof why);
+  adapter_free(&a);
+  if (st != CVAR_OK)
+    sc_err(err, errlen, s->file, line_of(s, at), "%s", why);
+  return st;
 }

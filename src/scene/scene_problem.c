@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "core/cv_table_internal.h"
 #include "expr/ex_integrand.h"
 #include "scene/scene_internal.h"
 
@@ -29,6 +30,8 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
     goto fail;
   }
   why = cv_problem_set_integrand_owned(p, ex_integrand_eval, ig, ex_integrand_release);
+  if (why == CVAR_OK) /* names a table whose grid the path left, when a solve fails */
+    why = cv_problem_set_integrand_note(p, ex_integrand_note);
   if (why != CVAR_OK) {
     sc_err(err, errlen, s->file, s->F_line, "integrand: %s", cv_strerror(why));
     goto fail;

@@ -33,17 +33,17 @@ const char *cli_status_string(cv_status st)
 
 void cli_report_free(cli_report *r)
 {
-  free(r->has_mom);
-  free(r->mom_min);
-  free(r->mom_max);
-  free(r->has_rep);
-  free(r->rep);
-  free(r->x);
-  free(r->y);
-  free(r->lam);
-  free(r->has_mu);
-  free(r->mu);
-  free(r->degrees);
+  cv_free(r->has_mom);
+  cv_free(r->mom_min);
+  cv_free(r->mom_max);
+  cv_free(r->has_rep);
+  cv_free(r->rep);
+  cv_free(r->x);
+  cv_free(r->y);
+  cv_free(r->lam);
+  cv_free(r->has_mu);
+  cv_free(r->mu);
+  cv_free(r->degrees);
   memset(r, 0, sizeof *r);
 }
 
@@ -70,9 +70,9 @@ static int nodal_error(cli_report *r, const scene *s)
     any |= s->exact[i] >= 0;
   if (!any)
     return 0;
-  double *ex = malloc((size_t)nn * n * sizeof *ex);
+  double *ex = cv_malloc((size_t)nn * n * sizeof *ex);
   if (!ex || scene_eval_exact(s, nn, r->x, ex) < 0) {
-    free(ex);
+    cv_free(ex);
     return -1;
   }
   double e = 0;
@@ -84,7 +84,7 @@ static int nodal_error(cli_report *r, const scene *s)
         finite &= isfinite(d);
         e = d > e ? d : e;
       }
-  free(ex);
+  cv_free(ex);
   if (finite) {
     r->has_err_nodal = 1;
     r->err_nodal = e;
@@ -140,11 +140,11 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
   if (nq <= 0)
     return 0;
   size_t q = (size_t)nq;
-  double *x = malloc(q * sizeof *x), *w = malloc(q * sizeof *w);
-  double *y = malloc(q * n * sizeof *y), *dy = malloc(q * n * sizeof *dy);
+  double *x = cv_malloc(q * sizeof *x), *w = cv_malloc(q * sizeof *w);
+  double *y = cv_malloc(q * n * sizeof *y), *dy = cv_malloc(q * n * sizeof *dy);
   size_t nv = q * (size_t)(n > s->nreports ? n : s->nreports);
-  double *v = malloc((nv > q ? nv : q) * sizeof *v);
-  double *H = malloc(q * sizeof *H), *mom = malloc(q * n * sizeof *mom);
+  double *v = cv_malloc((nv > q ? nv : q) * sizeof *v);
+  double *H = cv_malloc(q * sizeof *H), *mom = cv_malloc(q * n * sizeof *mom);
   if (!x || !w || !y || !dy || !v || !H || !mom)
     goto done;
   if (cv_solver_get_qpoints(sv, x, w, y, dy) != CVAR_OK) {
@@ -177,13 +177,13 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
   }
   rc = 0;
 done:
-  free(x);
-  free(w);
-  free(y);
-  free(dy);
-  free(v);
-  free(H);
-  free(mom);
+  cv_free(x);
+  cv_free(w);
+  cv_free(y);
+  cv_free(dy);
+  cv_free(v);
+  cv_free(H);
+  cv_free(mom);
   return rc;
 }
 
@@ -232,7 +232,7 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
   r->degree = cv_solver_get_degree(sv);
   r->nodes = cv_solver_get_num_nodes(sv);
   if (r->elements > 0) {
-    r->degrees = malloc((size_t)r->elements * sizeof *r->degrees);
+    r->degrees = cv_malloc((size_t)r->elements * sizeof *r->degrees);
     if (!r->degrees)
       return -1;
     cv_solver_get_degrees(sv, r->degrees);
@@ -245,14 +245,14 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
   r->time_s = cv_solver_get_time(sv);
   r->has_time = isfinite(r->time_s);
 
-  r->has_mom = calloc((size_t)n, sizeof *r->has_mom);
-  r->mom_min = calloc((size_t)n, sizeof *r->mom_min);
-  r->mom_max = calloc((size_t)n, sizeof *r->mom_max);
-  r->has_rep = calloc((size_t)s->nreports + 1, sizeof *r->has_rep);
-  r->rep = calloc((size_t)s->nreports + 1, sizeof *r->rep);
+  r->has_mom = cv_calloc((size_t)n, sizeof *r->has_mom);
+  r->mom_min = cv_calloc((size_t)n, sizeof *r->mom_min);
+  r->mom_max = cv_calloc((size_t)n, sizeof *r->mom_max);
+  r->has_rep = cv_calloc((size_t)s->nreports + 1, sizeof *r->has_rep);
+  r->rep = cv_calloc((size_t)s->nreports + 1, sizeof *r->rep);
   int nn = r->nodes > 0 ? r->nodes : 0;
-  r->x = calloc((size_t)nn + 1, sizeof *r->x);
-  r->y = calloc((size_t)nn * n + 1, sizeof *r->y);
+  r->x = cv_calloc((size_t)nn + 1, sizeof *r->x);
+  r->y = cv_calloc((size_t)nn * n + 1, sizeof *r->y);
   if (!r->has_mom || !r->mom_min || !r->mom_max || !r->has_rep || !r->rep || !r->x || !r->y)
     return -1;
   if (nn > 0 && (cv_solver_get_nodes(sv, r->x) != CVAR_OK ||
@@ -280,7 +280,7 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
     return -1;
   /* Multiplier fields (CSV lambda_NAME) and integral multipliers (JSON multipliers). */
   if (nn > 0 && s->ncons > 0) {
-    r->lam = malloc((size_t)nn * s->ncons * sizeof *r->lam);
+    r->lam = cv_malloc((size_t)nn * s->ncons * sizeof *r->lam);
     if (!r->lam)
       return -1;
     for (int c = 0; c < s->ncons; c++)
@@ -288,8 +288,8 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
         for (int j = 0; j < nn; j++)
           r->lam[(size_t)c * nn + j] = NAN;
   }
-  r->has_mu = calloc((size_t)s->nints + 1, sizeof *r->has_mu);
-  r->mu = calloc((size_t)s->nints + 1, sizeof *r->mu);
+  r->has_mu = cv_calloc((size_t)s->nints + 1, sizeof *r->has_mu);
+  r->mu = cv_calloc((size_t)s->nints + 1, sizeof *r->mu);
   if (!r->has_mu || !r->mu)
     return -1;
   for (int k = 0; k < s->nints; k++)

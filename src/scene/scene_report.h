@@ -12,6 +12,7 @@
 #include <stdio.h>
 
 #include "calcvar.h"
+#include "core/cv_memory.h"
 #include "scene/scene.h"
 
 /* The version of the JSON report's layout, written as its "schema" key; raised when a key

@@ -51,7 +51,7 @@ static double urand(double lo, double hi) { return lo + (hi - lo) * (rand() / (d
 static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *err,
                      size_t errlen)
 {
-  const sc_equations *eq = user;
+  const mech_equations *eq = user;
   char full[128];
   snprintf(full, sizeof full, "%s%.*s", name, primes, "''");
   for (int k = 0; k < eq->nslots; k++)
@@ -62,7 +62,7 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
 }
 
 /* Print e (of the scene's DAG), parse the text into `into`; -1 on failure. */
-static ex_id reparse(const scene *s, const sc_equations *eq, ex_id e, ex_dag *into, char *text,
+static ex_id reparse(const scene *s, const mech_equations *eq, ex_id e, ex_dag *into, char *text,
                      size_t len)
 {
   char err[256];
@@ -95,11 +95,11 @@ static scene *load_text(const char *text)
 static void pendulum(const char *dir, double m, double l, double g, int nset, const sc_set *set)
 {
   scene *s = load(dir, "pendulum_angle.scene", nset, set);
-  sc_equations eq;
+  mech_equations eq;
   char err[SC_ERRLEN] = "", tE[512], tp[512], tH[512], what[128];
   if (!s)
     return;
-  if (scene_equations_new(s, &eq, err, sizeof err) < 0) {
+  if (scene_equations_new(s, &eq, err, sizeof err) != CVAR_OK) {
     truth("pendulum equations", 0, err);
     scene_free(s);
     return;
@@ -132,7 +132,7 @@ static void pendulum(const char *dir, double m, double l, double g, int nset, co
     near(what, h, hh, 1e-12 * sc);
   }
   ex_dag_free(d);
-  scene_equations_free(&eq);
+  mech_equations_free(&eq);
   scene_free(s);
 }
 
@@ -140,10 +140,10 @@ static void pendulum(const char *dir, double m, double l, double g, int nset, co
 static void double_pendulum_equations(const char *dir)
 {
   scene *s = load(dir, "double_pendulum.scene", 0, NULL);
-  sc_equations eq;
+  mech_equations eq;
   char err[SC_ERRLEN] = "", t[2][512], tH[512], what[128];
   const double m = 1, l = 1, g = 9.81;
-  if (!s || scene_equations_new(s, &eq, err, sizeof err) < 0) {
+  if (!s || scene_equations_new(s, &eq, err, sizeof err) != CVAR_OK) {
     truth("double pendulum equations", 0, err);
     scene_free(s);
     return;
@@ -179,7 +179,7 @@ static void double_pendulum_equations(const char *dir)
     near(what, eh, hh, 1e-12 * sc);
   }
   ex_dag_free(d);
-  scene_equations_free(&eq);
+  mech_equations_free(&eq);
   scene_free(s);
 }
 
@@ -197,9 +197,9 @@ static void flags(const char *dir)
                {"straight_line.scene", 1, 1, -1}};
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     scene *s = load(dir, cases[c].file, 0, NULL);
-    sc_equations eq;
+    mech_equations eq;
     char err[SC_ERRLEN] = "";
-    if (!s || scene_equations_new(s, &eq, err, sizeof err) < 0) {
+    if (!s || scene_equations_new(s, &eq, err, sizeof err) != CVAR_OK) {
       truth(cases[c].file, 0, err);
       scene_free(s);
       continue;
@@ -208,7 +208,7 @@ static void flags(const char *dir)
     truth(cases[c].file, eq.cyclic[0] == cases[c].cyclic0, "cyclic flag of unknown 0");
     if (cases[c].cyclic1 >= 0)
       truth(cases[c].file, eq.cyclic[1] == cases[c].cyclic1, "cyclic flag of unknown 1");
-    scene_equations_free(&eq);
+    mech_equations_free(&eq);
     scene_free(s);
   }
 }
@@ -218,18 +218,18 @@ static void double_pendulum_modes(const char *dir, double l, double g, int nset,
                                   const sc_set *set)
 {
   scene *s = load(dir, "double_pendulum.scene", nset, set);
-  sc_modes md;
+  mech_modes md;
   char err[SC_ERRLEN] = "", what[128];
   if (!s)
     return;
-  int rc = scene_modes_new(s, &md, err, sizeof err);
-  truth("double pendulum modes", rc == SC_MODES_OK, err);
-  if (rc == SC_MODES_OK) {
+  cv_status rc = scene_modes_new(s, &md, err, sizeof err);
+  truth("double pendulum modes", rc == CVAR_OK, err);
+  if (rc == CVAR_OK) {
     double w2[2] = {g / l * (2 - sqrt(2.0)), g / l * (2 + sqrt(2.0))};
     for (int k = 0; k < 2; k++) {
       snprintf(what, sizeof what, "double pendulum l=%g g=%g omega2[%d]", l, g, k);
       near(what, md.omega2[k], w2[k], 1e-12 * w2[k]);
-      truth(what, md.kind[k] == SC_MODE_STABLE, "kind stable");
+      truth(what, md.kind[k] == MECH_MODE_STABLE, "kind stable");
       const double *v = md.shape + 2 * k;
       double Mv[2], Kv[2], vMv = 0;
       for (int i = 0; i < 2; i++) {
@@ -250,7 +250,7 @@ static void double_pendulum_modes(const char *dir, double l, double g, int nset,
     near("double pendulum equilibrium a", md.equilibrium[0], 0, 0);
     near("double pendulum equilibrium b", md.equilibrium[1], 0, 0);
   }
-  scene_modes_free(&md);
+  mech_modes_free(&md);
   scene_free(s);
 }
 
@@ -264,22 +264,22 @@ static const char *top_text =
 static void inverted_pendulum(void)
 {
   scene *s = load_text(top_text);
-  sc_modes md;
+  mech_modes md;
   char err[SC_ERRLEN] = "";
   if (!s)
     return;
-  int rc = scene_modes_new(s, &md, err, sizeof err);
-  truth("inverted pendulum modes", rc == SC_MODES_OK, err);
-  if (rc == SC_MODES_OK) {
+  cv_status rc = scene_modes_new(s, &md, err, sizeof err);
+  truth("inverted pendulum modes", rc == CVAR_OK, err);
+  if (rc == CVAR_OK) {
     near("inverted pendulum equilibrium", md.equilibrium[0], M_PI, 1e-14);
     truth("inverted pendulum Newton iterations", md.iterations >= 2 && md.iterations < 10,
           "expected a few");
-    truth("inverted pendulum kind", md.kind[0] == SC_MODE_UNSTABLE, "unstable");
+    truth("inverted pendulum kind", md.kind[0] == MECH_MODE_UNSTABLE, "unstable");
     near("inverted pendulum growth rate", sqrt(-md.omega2[0]), sqrt(9.81 / 0.5),
          1e-12 * sqrt(9.81 / 0.5));
     near("inverted pendulum unit M-norm", md.shape[0] * md.shape[0] * md.mass[0], 1, 1e-14);
   }
-  scene_modes_free(&md);
+  mech_modes_free(&md);
   scene_free(s);
 }
 
@@ -288,57 +288,57 @@ static void special_cases(void)
 {
   static const struct {
     const char *what, *text;
-    int rc;
+    cv_status rc;
     const char *msg;
   } cases[] = {
       {"two masses on a spring (translation neutral)",
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=a,b\n"
        "integrand=(a'^2 + b'^2)/2 - 3*(a - b)^2/2\n[boundary]\na=0,0\nb=1,1\n",
-       SC_MODES_OK, NULL},
+       CVAR_OK, NULL},
       {"constant force (no equilibrium)",
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=y\nintegrand=y'^2/2 + 2*y\n"
        "[boundary]\ny=0,0\n",
-       SC_MODES_NO_EQUILIBRIUM, "no equilibrium"},
+       CVAR_EMAXITER, "no equilibrium"},
       {"b without kinetic energy (M singular)",
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=a,b\n"
        "integrand=a'^2/2 - a^2/2 - b^2/2\n[boundary]\na=0,0\nb=0,0\n",
-       SC_MODES_MASS, "not positive definite"},
+       CVAR_ESINGULAR, "not positive definite"},
       {"negative kinetic energy (M not positive definite)",
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=y\nintegrand=-y'^2/2 - y^2/2\n"
        "[boundary]\ny=0,0\n",
-       SC_MODES_MASS, "not positive definite"},
+       CVAR_ESINGULAR, "not positive definite"},
       {"explicit variable",
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=y\nintegrand=y'^2/2 - x*y^2\n"
        "[boundary]\ny=0,0\n",
-       SC_MODES_EXPLICIT, "t.scene:5: the integrand depends explicitly on x"},
+       CVAR_EINVAL, "t.scene:5: the integrand depends explicitly on x"},
       {"constraint (Cartesian pendulum, g = l = 1)",
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=x1,y1\nintegrand=(x1'^2+y1'^2)/2 - y1\n"
        "[boundary]\nx1=0,0\ny1=-1,-1\n[constraints]\nrod = x1^2 + y1^2 - 1\n",
-       SC_MODES_OK, NULL},
+       CVAR_OK, NULL},
       {"integral constraint",
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=y\nintegrand=y'^2/2 - y^2/2\n"
        "[boundary]\ny=0,0\n[integrals]\narea = y, 1\n",
-       SC_MODES_CONSTRAINED, "t.scene:9: modes does not handle integral constraints"},
+       CVAR_EINVAL, "t.scene:9: modes does not handle integral constraints"},
       {"moving constraint",
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=a,b\nintegrand=(a'^2+b'^2)/2\n"
        "[boundary]\na=0,free\nb=0,free\n[constraints]\nslide = a - x*b\n",
-       SC_MODES_EXPLICIT, "t.scene:10: the constraint 'slide' depends on x"},
+       CVAR_EINVAL, "t.scene:10: the constraint 'slide' depends on x"},
       {"not finite at the guess",
        "[scene]\ntitle=t\ninterval=0,1\nunknowns=y\nintegrand=y'^2/2 + log(y)\n"
        "[boundary]\ny=0,1\n",
-       SC_MODES_NONFINITE, "not finite"},
+       CVAR_ENONFINITE, "not finite"},
   };
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     scene *s = load_text(cases[c].text);
-    sc_modes md;
+    mech_modes md;
     char err[SC_ERRLEN] = "";
     if (!s)
       continue;
-    int rc = scene_modes_new(s, &md, err, sizeof err);
+    cv_status rc = scene_modes_new(s, &md, err, sizeof err);
     truth(cases[c].what, rc == cases[c].rc, err[0] ? err : "(no message)");
     if (cases[c].msg)
       truth(cases[c].what, strstr(err, cases[c].msg) != NULL, err);
-    if (rc == SC_MODES_OK && strstr(cases[c].what, "Cartesian pendulum")) {
+    if (rc == CVAR_OK && strstr(cases[c].what, "Cartesian pendulum")) {
       /* hanging at (0, -1): lambda = -g/(2l) = -1/2, one mode on the circle, omega2 = g/l,
        * shape along x with unit mass norm */
       truth("pendulum: one constrained mode", md.nmodes == 1 && md.nc == 1, "nmodes");
@@ -349,8 +349,8 @@ static void special_cases(void)
       near("pendulum: shape x", md.shape[0], 1, 1e-13);
       near("pendulum: shape y", md.shape[1], 0, 1e-13);
     }
-    if (rc == SC_MODES_OK && c == 0) {
-      truth("spring: lower mode neutral", md.kind[0] == SC_MODE_NEUTRAL, "neutral");
+    if (rc == CVAR_OK && c == 0) {
+      truth("spring: lower mode neutral", md.kind[0] == MECH_MODE_NEUTRAL, "neutral");
       near("spring: lower omega2", md.omega2[0], 0, 1e-12);
       near("spring: upper omega2", md.omega2[1], 6, 1e-12);
       near("spring: neutral shape a = b", md.shape[0] - md.shape[1], 0, 1e-12);
@@ -358,7 +358,7 @@ static void special_cases(void)
            1, 1e-12);
       near("spring: equilibrium a = b", md.equilibrium[0] - md.equilibrium[1], 0, 1e-12);
     }
-    scene_modes_free(&md);
+    mech_modes_free(&md);
     scene_free(s);
   }
 }

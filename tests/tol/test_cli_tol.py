@@ -32,6 +32,12 @@ checks = 0
 # singular Hessian on any mesh (the reference README asks for "a correct line or an
 # honest failure"); --tol must end the same way as a plain solve.
 SAME_AS_PLAIN = {"straight_line_parametric.scene"}
+# Scenes whose [exact] is the answer of a nearby problem, not of the scene itself: the path
+# over a tabulated ridge is exact for the cylinder the table samples, and the table's
+# spline differs from it by ~1e-8 (the scene says so). There the true error cannot fall
+# below that modelling floor, and the spline's third derivative jumps at every grid line,
+# so below ~1e-10 the rounds may end with exit 1 (a cap or no progress, with a sentence).
+MODEL_FLOOR = {"height_map_path.scene": 2e-8}
 
 
 def check(what, ok, detail=""):
@@ -72,6 +78,11 @@ def check_tol(path, T):
                                                                  d0.get("status")))
         return
     roundoff = "round-off floor" in d.get("message", "")
+    floor = MODEL_FLOOR.get(name, 0.0)
+    if floor and T < 1e-9 and r.returncode == 1:
+        check(what + " stops with a sentence and the estimate", "error_estimate" in d and
+              d.get("status") == "max_iterations", d.get("message"))
+        return
     if T < 1e-11 and r.returncode == 1 and roundoff:
         check(what + " stops at the floor with the estimate", "error_estimate" in d, d)
         return
@@ -93,9 +104,10 @@ def check_tol(path, T):
     err = d.get("error", {})
     if "max_nodal" in err:
         e = err["max_nodal"]
-        check(what + " true max nodal error <= 10 T", e <= 10 * T, "%.3g" % e)
-        check(what + " estimate >= 0.1 x true error", est >= 0.1 * e,
-              "estimate %.3g, true %.3g" % (est, e))
+        check(what + " true max nodal error <= 10 T", e <= max(10 * T, floor), "%.3g" % e)
+        if e > 10 * floor:
+            check(what + " estimate >= 0.1 x true error", est >= 0.1 * e,
+                  "estimate %.3g, true %.3g" % (est, e))
     elif "action" in err and d.get("action"):
         rel = err["action"] / max(1.0, abs(d["action"]))
         check(what + " relative action error <= 10 T", rel <= 10 * T, "%.3g" % rel)

@@ -1,0 +1,110 @@
+/* bench/bench_cold.c — the first solve in a fresh process against a warm solve (issue 14,
+ * item 10; docs/performance.md). The parent runs itself N times as a child process that
+ * times its first cv_solve (problem and solver made before the clock starts, as a program
+ * would), then times N warm solves in its own process, each with a fresh solver, and
+ * prints medians and their ratio: both measured in the same run.
+ *   bench_cold [N]    (default 41)
+ * Timings on a shared machine are noisy: compare the ratio, not absolute figures.
+ * SPDX-License-Identifier: MIT */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "calcvar.h"
+
+static double now(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/* Fish-eye ray n = 2 / (1 + x^2 + y^2) from (-1, 0) to (1, 0)... as in the tests: on
+ * [-1, 1] with y(+-1) = 0, 2 elements of degree 4 (max nodal error ~1e-8). */
+static int fisheye_F(int m, const double *x, const double *y, const double *dy,
+                     unsigned need, cv_partials *o, void *user) {
+  (void)need, (void)user;
+  for (int k = 0; k < m; k++) {
+    double p = dy[k], s = sqrt(1 + p * p), r = 1 + x[k] * x[k] + y[k] * y[k];
+    double nn = 2 / r, ny = -4 * y[k] / (r * r);
+    double nyy = -4 / (r * r) + 16 * y[k] * y[k] / (r * r * r);
+    o->F[k] = nn * s;
+    if (o->Fy) { o->Fy[k] = ny * s; o->Fp[k] = nn * p / s; }
+    if (o->Fyy) { o->Fyy[k] = nyy * s; o->Fyp[k] = ny * p / s; o->Fpp[k] = nn / (s * s * s); }
+  }
+  return 0;
+}
+
+static int catenary_F(int m, const double *x, const double *y, const double *dy,
+                      unsigned need, cv_partials *o, void *user) {
+  (void)x, (void)need, (void)user;
+  for (int k = 0; k < m; k++) {
+    double s = sqrt(1 + dy[k] * dy[k]);
+    o->F[k] = y[k] * s;
+    if (o->Fy) { o->Fy[k] = s; o->Fp[k] = y[k] * dy[k] / s; }
+    if (o->Fyy) { o->Fyy[k] = 0; o->Fyp[k] = dy[k] / s; o->Fpp[k] = y[k] / (s * s * s); }
+  }
+  return 0;
+}
+
+/* One timed solve of problem `which` with a fresh solver; returns seconds (NAN on failure). */
+static double timed_solve(int which) {
+  cv_problem *p = which == 0 ? cv_problem_new(1, 0, 1, NULL) : cv_problem_new(1, -1, 1, NULL);
+  if (which == 0) {
+    cv_problem_set_integrand(p, fisheye_F, NULL);
+    cv_problem_set_dirichlet(p, 0, -2 + sqrt(5), -2 + sqrt(4));
+  } else {
+    cv_problem_set_integrand(p, catenary_F, NULL);
+    cv_problem_set_dirichlet(p, 0, 2 * cosh(0.5), 2 * cosh(0.5));
+  }
+  cv_solver *s = cv_solver_new(NULL);
+  cv_solver_set_elements(s, which == 0 ? 2 : 3);
+  cv_solver_set_degree(s, 4);
+  double t0 = now();
+  cv_status st = cv_solve(s, p);
+  double t = now() - t0;
+  cv_solver_free(s);
+  cv_problem_free(p);
+  return st == CVAR_OK ? t : NAN;
+}
+
+static int cmp(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return (x > y) - (x < y);
+}
+
+int main(int argc, char **argv) {
+  if (argc == 3 && strcmp(argv[1], "--child") == 0) {
+    printf("%.9e\n", timed_solve(atoi(argv[2])));
+    return 0;
+  }
+  int N = argc > 1 ? atoi(argv[1]) : 41;
+  if (N < 1) N = 1;
+  double *cold = malloc((size_t)N * sizeof *cold), *warm = malloc((size_t)N * sizeof *warm);
+  const char *names[2] = {"fish-eye, 2 elements of degree 4",
+                          "catenary, 3 elements of degree 4"};
+  printf("%-34s %12s %12s %7s\n", "problem (median of N)", "cold [us]", "warm [us]", "ratio");
+  for (int which = 0; which < 2; which++) {
+    for (int i = 0; i < N; i++) {
+      char cmd[4096];
+      snprintf(cmd, sizeof cmd, "'%s' --child %d", argv[0], which);
+      FILE *f = popen(cmd, "r");
+      cold[i] = NAN;
+      if (!f || fscanf(f, "%lf", &cold[i]) != 1) cold[i] = NAN;
+      if (f) pclose(f);
+    }
+    timed_solve(which); /* the first in this process is a cold one: not counted */
+    for (int i = 0; i < N; i++) warm[i] = timed_solve(which);
+    qsort(cold, (size_t)N, sizeof *cold, cmp);
+    qsort(warm, (size_t)N, sizeof *warm, cmp);
+    double c = cold[N / 2], w = warm[N / 2];
+    printf("%-34s %12.1f %12.1f %7.2f   (cold min %.1f max %.1f)\n", names[which], 1e6 * c,
+           1e6 * w, c / w, 1e6 * cold[0], 1e6 * cold[N - 1]);
+  }
+  free(cold);
+  free(warm);
+  return 0;
+}

@@ -1,0 +1,30 @@
+/* src/core/cv_table_internal.h — library-internal hooks of tables (cv_table.c) and of the
+ * integrand's failure note (cv_problem.c, cv_solve.c), used by src/expr and src/scene.
+ * SPDX-License-Identifier: MIT */
+#ifndef CV_TABLE_INTERNAL_H
+#define CV_TABLE_INTERNAL_H
+#include <stddef.h>
+
+#include "calcvar.h"
+
+/* Another reference to t (returned); cv_table_free releases each. */
+cv_table *cv_table_ref(cv_table *t);
+/* cv_table_new that also writes a sentence on failure (msg may be NULL). */
+cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords,
+                           const double *values, cv_status *why, char *msg, size_t len);
+/* Several partials of t at the point u at once (one cell search, theory TB-2): out[j] has
+ * the orders ord[j][0..dim-1]. Returns 0, or k + 1 when u is outside the grid along axis k
+ * (then every out[j] is NaN). */
+int cv_table_eval_multi(const cv_table *t, const double *u, int nord, const int (*ord)[3],
+                        double *out);
+/* Tables added to a problem (cv_problem_add_table), for the formula compiler: count and
+ * the i-th name and table (borrowed). */
+int cv_problem_num_tables(const cv_problem *p);
+const char *cv_problem_table_name(const cv_problem *p, int i);
+const cv_table *cv_problem_table(const cv_problem *p, int i);
+/* A note on the integrand's last failure ("the path left the grid of table 'c' ..."), put
+ * by cv_solve at the front of its message when a solve fails; `reset` nonzero clears it
+ * (called when a solve starts). Returns the note or NULL. */
+typedef const char *(*cv_note_fn)(void *user, int reset);
+cv_status cv_problem_set_integrand_note(cv_problem *p, cv_note_fn note);
+#endif
