@@ -67,7 +67,7 @@ static int stop_rule(cv_solver *s, double est, double best, double floor_, int s
                      int next_size) {
   double tol = s->adapt_tol;
   const char *what = s->hp ? "nodes" : "elements";
-  if ((best <= floor_ && tol < floor_) || (stalled >= STALL_ROUNDS_FLOOR && best <= 1e3 * floor_)) {
+  if ((best <= floor_ && tol < floor_) || (stalled >= STALL_ROUNDS_FLOOR && best <= 10.0 * floor_)) {
     cv_set_msg(s->msg, sizeof s->msg,
                "the error estimate reached %.2g > %.2g and can go no lower: that is the "
                "round-off floor of double precision for this solution (about %.1g, from "
