@@ -213,7 +213,7 @@ static int draw(const char *dir, const char *name, const char *title, point pts[
   snprintf(t, sizeof t, "%s: work against precision", title);
   cli_plot_panel pan = {t, "run time of one solve [s]", "max nodal error", 1, 1, nl, lines};
   cli_outfile o;
-  if (cli_outfile_open(&o, path) < 0)
+  if (cli_outfile_open(&o, path, NULL) < 0)
     return -1;
   if (cli_plot_write(&o, 1, &pan) < 0) {
     cli_outfile_abandon(&o);

@@ -222,7 +222,8 @@ CVAR_API cv_status cv_table_get_range(const cv_table *t, int k, double *lo, doub
 CVAR_API int cv_table_eval(const cv_table *t, const double *u, const int *order, double *value);
 /** Make t callable as `name(u)`, `name(u, v)` or `name(u, v, w)` (and its derivatives
  * `name.1(...)`, `name.12(...)`, docs/expressions.md) in the formulas given afterwards to
- * cv_problem_set_integrand_expr. The problem takes its own reference. The name must be an
+ * cv_problem_set_integrand_expr, cv_problem_add_constraint_expr and
+ * cv_problem_add_integral_expr. The problem takes its own reference. The name must be an
  * identifier that is not a function, pi, or a table already added (CVAR_EINVAL). When a
  * solve fails after the path left a table's grid, cv_solver_last_error() names the table. */
 CVAR_API cv_status cv_problem_add_table(cv_problem *p, const char *name, cv_table *t);
@@ -468,9 +469,10 @@ CVAR_API cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, do
 /** A loaded scene. Opaque; made by cv_scene_load_file or cv_scene_load_text, released by
  * cv_scene_free. */
 typedef struct cv_scene cv_scene;
-/** Load the scene file at path. set: nset strings "name=value" (value a constant
- * expression) overriding [parameters]; NULL when nset is 0. NULL on failure, with the
- * sentence in err. */
+/** Load the scene file at path: a regular file of at most 4 MiB, or "-" for standard
+ * input (read once per process; "<stdin>" in messages). set: nset strings "name=value"
+ * (value a constant expression) overriding [parameters]; NULL when nset is 0. NULL on
+ * failure, with the sentence in err. */
 CVAR_API cv_scene *cv_scene_load_file(const char *path, int nset, const char *const *set,
                                       char *err, size_t errlen);
 /** Load a scene from NUL-terminated text; name (NULL: "<text>") stands for the file in
@@ -512,6 +514,65 @@ CVAR_API cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *
 CVAR_API const char *cv_report_json(const cv_report *r);
 /** Release a report; NULL is a no-op. */
 CVAR_API void cv_report_free(cv_report *r);
+/**@}*/
+
+/** @name Many parameter sets on one compiled scene (the engine of `calcvar batch`)
+ * A scene file is read and compiled once, its [parameters] as inputs of the compiled
+ * expressions; each row (values of some parameters) is then solved as `calcvar solve
+ * SCENE --set name=value ...` would solve it, on several threads (docs/scale-out.md).
+ * @{ */
+/** A compiled scene and its per-thread solvers. */
+typedef struct cv_batch cv_batch;
+
+/** One solved row. outputs is the caller's: NULL, or room for cv_batch_num_outputs()
+ * values (the [report] integrals, then the [integrals] multipliers), NaN where absent. */
+typedef struct {
+  cv_status status;       /**< CVAR_OK only when converged */
+  int iterations;         /**< Newton (or minimiser) iterations */
+  double time_s;          /**< wall-clock seconds of this row */
+  int has_result;         /**< converged: action, morse_index, errors, outputs are set */
+  double action;          /**< the discrete action */
+  int morse_index;        /**< -1 when unknown (a method other than Newton) */
+  double error_max_nodal; /**< against [exact]; NaN without it */
+  double error_estimate;  /**< of an adaptive solve; NaN otherwise */
+  double *outputs;        /**< see above */
+  int warm;               /**< 1: started from the previous row's solution */
+  char message[400];      /**< the report's sentence */
+} cv_batch_result;
+
+/** Read and compile the scene file (exit-2 kind of problems come back NULL with
+ * "FILE:LINE: what is wrong" in err). */
+CVAR_API cv_batch *cv_batch_new(const char *scene_path, char *err, size_t errlen);
+/** Release; NULL is a no-op. */
+CVAR_API void cv_batch_free(cv_batch *b);
+/** The number of the scene's [parameters]. */
+CVAR_API int cv_batch_num_parameters(const cv_batch *b);
+/** Name of parameter i (file order), NULL when out of range. */
+CVAR_API const char *cv_batch_parameter_name(const cv_batch *b, int i);
+/** Result columns besides the fixed ones: [report] names, then "mu_" + integral name. */
+CVAR_API int cv_batch_num_outputs(const cv_batch *b);
+/** Name of output k, NULL when out of range. */
+CVAR_API const char *cv_batch_output_name(const cv_batch *b, int k);
+/** Which parameters a row gives, in order (default: none, i.e. the scene's values). Set
+ * before the first cv_batch_solve (CVAR_EINVAL after it). */
+CVAR_API cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names,
+                                        char *err, size_t errlen);
+/** Threads (default 1; 0 = the cores available). */
+CVAR_API cv_status cv_batch_set_threads(cv_batch *b, int nthreads);
+/** Start each row from the previous row's solution on the same thread (default off); a
+ * failed warm start is retried from the scene's guess and the row's message says so. */
+CVAR_API cv_status cv_batch_set_warm_start(cv_batch *b, int on);
+/** Override [mesh] elements and degree (0 keeps the scene's). */
+CVAR_API cv_status cv_batch_set_mesh(cv_batch *b, int elements, int degree);
+/** Check a row's values without solving: CVAR_EINVAL with a sentence when they make the
+ * scene invalid (e.g. an interval with a >= b). */
+CVAR_API cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err,
+                                      size_t errlen);
+/** Solve nrows rows (row r is rows[r*ncols .. r*ncols+ncols-1]); res[r] receives row r
+ * whatever order the threads took them in. CVAR_OK when the rows were all attempted (each
+ * has its own status), else an error for the whole call (e.g. CVAR_ENOMEM). */
+CVAR_API cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows,
+                                  cv_batch_result *res);
 /**@}*/
 
 /** \name Every stationary path: deflation (theory DF-1..DF-5) */

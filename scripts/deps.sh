@@ -9,4 +9,9 @@ $SUDO apt-get install -y -qq --no-install-recommends \
   build-essential meson ninja-build pkg-config \
   libsuitesparse-dev libnlopt-dev libinih-dev libjansson-dev liblapack-dev \
   libplplot-dev plplot-driver-cairo \
-  doxygen groff-base >/dev/null   # the API reference and the man page (tests 'docs')
+  doxygen groff-base \
+  libopenmpi-dev openmpi-bin \
+  g++ libgeographiclib-dev geographiclib-tools strace >/dev/null
+# doxygen, groff: the API reference and the man page (tests 'docs'); OpenMPI: calcvar batch
+# under mpirun (test batch_mpi); strace: --continue opens its scene once (test cli_batch);
+# g++ and GeographicLib: bench/bench_geodesic only.

@@ -1,6 +1,7 @@
 #!/bin/sh
 # scripts/fuzz.sh — build the scene-loader fuzzer with clang (libFuzzer + ASan + UBSan) and
-# run it for N seconds (default 60) on the reference and malformed scenes as seed corpus.
+# run it for N seconds (default 60) on the reference and malformed scenes as seed corpus;
+# then fuzz the command's output paths (tests/fuzz/fuzz_outpath.py) for N/3 seconds.
 # usage: scripts/fuzz.sh [SECONDS]      exit status: 0 clean, nonzero on a finding.
 # SPDX-License-Identifier: MIT
 set -eu
@@ -24,5 +25,16 @@ done
   -linih -lcholmod -lnlopt -llapack -lm -o "$out/fuzz_scene"
 cp "$root"/tests/scene/data/*.scene "$root"/tests/scene/bad/*.scene "$out/corpus/" 2>/dev/null || true
 cd "$out"
-exec ./fuzz_scene -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 \
-  -dict="$root/tests/fuzz/scene.dict" corpus
+rc=0
+./fuzz_scene -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 \
+  -dict="$root/tests/fuzz/scene.dict" corpus || rc=1
+# Output paths (devices, FIFOs, links, directories, the input scene) against the built
+# command, for a third of the time: needs build/ (scripts/build.sh) or CALCVAR.
+calcvar=${CALCVAR:-$root/build/src/cli/calcvar}
+if [ -x "$calcvar" ]; then
+  python3 "$root/tests/fuzz/fuzz_outpath.py" "$calcvar" "$root/tests/scene/data" \
+    $((secs / 3 + 1)) || rc=1
+else
+  echo "fuzz.sh: $calcvar not built: output-path fuzzing skipped"
+fi
+exit $rc

@@ -9,8 +9,9 @@
 #include "scene/scene.h"
 #include "scene/scene_report.h"
 
-/* Exit statuses of SCENES.md. */
-enum { EXIT_SOLVED = 0, EXIT_UNSOLVED = 1, EXIT_BADINPUT = 2 };
+/* Exit statuses of SCENES.md, and (an addition, docs/cli.md) 3 when a report or the
+ * standard output could not be written. */
+enum { EXIT_SOLVED = 0, EXIT_UNSOLVED = 1, EXIT_BADINPUT = 2, EXIT_IOERROR = 3 };
 
 /* Options of `solve` (and later `converge`): zero / NULL / -1 mean "as the scene says". */
 typedef struct {
@@ -20,6 +21,7 @@ typedef struct {
   double tolerance;
   double adapt;
   double tol; /* --tol: automatic accuracy (hp) */
+  int max_elements; /* --max-elements: the adaptive cap (0: 2e6) */
   const char *cont; /* --continue name=from:to */
   int nset;
   sc_set *set;
@@ -36,23 +38,47 @@ void cli_opts_free(cli_opts *o);
 /* For commands that only read a scene: EXIT_BADINPUT (after a message) if a solve-only
  * option was given, else 0. */
 int cli_only_scene_options(const char *cmd, const cli_opts *o);
+/* --method, --tolerance and --max-iterations, where given, override the scene's [solver]. */
+void cli_apply_solver_options(const cli_opts *o, scene *s);
 
 /* cli_continue.c: `solve --continue name=from:to` (see there). */
-int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver **svp,
-                       cv_status *stp, char *cont_msg, size_t cmlen, char *err, size_t errlen);
+/* s0: the scene, loaded once with parameters as inputs (scene_load_file_inputs) and
+ * owned from here on; it is compiled once. *bp owns it and *sp is its instance at the
+ * reported value: free *pp and *svp, then cv_batch_free(*bp). */
+int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene **sp,
+                       cv_problem **pp, cv_solver **svp, cv_status *stp, char *cont_msg,
+                       size_t cmlen, char *err, size_t errlen);
 
 int cli_report_csv(FILE *f, const cli_report *r);
 void cli_report_text(FILE *f, const cli_report *r);
 
-/* outfile.c: all-or-nothing output files (a temporary file renamed at the end). */
+/* outfile.c: output files written completely or not at all (a temporary file renamed at
+ * the end), streamed into devices and FIFOs, links followed; a directory or the input scene
+ * `input` (may be NULL or "-") is refused. open and both commits return 0, or -1 after
+ * printing why (the file is then abandoned). */
 typedef struct {
-  const char *path; /* "-" is stdout */
-  char *tmp;
+  const char *path; /* as given, for messages; "-" is stdout */
+  char *dest;       /* path with symbolic links followed */
+  char *tmp;        /* the temporary file beside dest (regular files) */
+  char *scratch;    /* a rendering scratch file in $TMPDIR (streams) */
+  int stream;       /* dest is a device, FIFO or socket: written through */
   FILE *f;
 } cli_outfile;
-int cli_outfile_open(cli_outfile *o, const char *path);
+int cli_outfile_open(cli_outfile *o, const char *path, const char *input);
 int cli_outfile_commit(cli_outfile *o);
+/* Commit when the writer succeeded (wrote >= 0), else say why (a write error) and abandon. */
+int cli_outfile_finish(cli_outfile *o, int wrote);
+/* For a library that writes a file by name (PLplot): the name to write to, then
+ * commit_rendered moves or copies it into place. */
+int cli_outfile_render_name(cli_outfile *o, const char **name);
+int cli_outfile_commit_rendered(cli_outfile *o);
 void cli_outfile_abandon(cli_outfile *o);
+/* args.c: the start of a command that reads one scene (equations, modes): parse the
+ * arguments (--help prints usage), accept only the scene options, load the scene into *s
+ * and open --json's file in *jf. Returns -1 to go on, else the exit status (after a
+ * message); the caller releases o, *s and *jf in either case. */
+int cli_scene_command_start(const char *cmd, int argc, char **argv, void (*usage)(FILE *),
+                            cli_opts *o, scene **s, cli_outfile *jf);
 
 /* plot.c: curves on panels stacked top to bottom, written with PLplot to the temporary
  * file of an open cli_outfile (.svg or .png by its path) and renamed into place. */
@@ -94,6 +120,7 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, doubl
 
 /* Subcommands. */
 int cli_converge(int argc, char **argv);
+int cli_batch(int argc, char **argv);     /* cli_batch.c */
 int cli_gallery(void);
 int cli_solve(int argc, char **argv);
 int cli_check(int argc, char **argv);

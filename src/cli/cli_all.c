@@ -161,7 +161,7 @@ static int write_plot(cli_outfile *o, cli_report *r, const int *keep, int np, cv
       ln->x = xs;
       ln->y = yk + (size_t)i * NPLOT;
       ln->colour = num - 1;
-      ln->style = n > 1 ? i % 8 : 0;
+      ln->style = i > 0 ? 1 + i % 7 : 0; /* PLplot styles 0 and 1 are both solid */
       if (n > 1)
         snprintf(labels[nl], sizeof labels[nl], "%d %s: %s", num, s->unknowns[i],
                  r[k].kind ? r[k].kind : "?");
@@ -232,17 +232,17 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, doubl
   for (int k = 0; k < np; k++)
     listed += keep[k];
   rc = listed > 0 ? EXIT_SOLVED : EXIT_UNSOLVED;
-  if (jf->f && (write_json(jf->f, r, keep, np, &in, listed) < 0 || cli_outfile_commit(jf) < 0)) {
+  if (jf->f && cli_outfile_finish(jf, write_json(jf->f, r, keep, np, &in, listed)) < 0) {
     fprintf(stderr, "calcvar solve: the JSON report could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   if (pf->f && write_plot(pf, r, keep, np, sv, s) < 0) {
     fprintf(stderr, "calcvar solve: the plot could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
-  if (cf->f && (write_csv(cf->f, r, keep, np, s) < 0 || cli_outfile_commit(cf) < 0)) {
+  if (cf->f && cli_outfile_finish(cf, write_csv(cf->f, r, keep, np, s)) < 0) {
     fprintf(stderr, "calcvar solve: the CSV table could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   int stdout_taken = (o->json && strcmp(o->json, "-") == 0) || (o->csv && strcmp(o->csv, "-") == 0);
   if (!o->quiet && !stdout_taken) {

@@ -37,7 +37,7 @@ static void usage(FILE *f)
         "  --method M, --tolerance T, --max-iterations K, --set name=value   as for solve\n"
         "  --quiet              no table on stdout\n"
         "Errors are against [exact]; without it they are estimates from a finer mesh.\n"
-        "exit status: 0 every mesh converged, 1 some did not, 2 bad input\n", f);
+        "exit status: 0 every mesh converged, 1 some did not, 2 bad input, 3 write error\n", f);
 }
 
 static int bad(const char *fmt, const char *v)
@@ -88,7 +88,7 @@ static int split_args(int argc, char **argv, conv_opts *c, char **rest, int *nre
 {
   static const char *const valued[] = {"--elements", "--method", "--tolerance",
                                        "--max-iterations", "--set", "--adapt", "--tol", "--continue",
-                                       "--json", "--csv", "--plot", NULL};
+                                       "--json", "--csv", "--plot", "--max-elements", NULL};
   static const char *const mine[] = {"--levels", "--degree", "--svg"};
   c->levels = 6;
   *nrest = 0;
@@ -265,7 +265,8 @@ int cli_converge(int argc, char **argv)
     goto done;
   }
   const char *notmine = o.csv ? "--csv" : o.plot ? "--plot" : o.adapt > 0 ? "--adapt"
-                        : o.tol > 0 ? "--tol" : o.cont ? "--continue" : NULL;
+                        : o.tol > 0 ? "--tol" : o.cont ? "--continue"
+                        : o.max_elements ? "--max-elements" : NULL;
   if (notmine) {
     rc = bad("%s is an option of solve, not of converge", notmine);
     goto done;
@@ -283,12 +284,7 @@ int cli_converge(int argc, char **argv)
     s->elements = o.elements;
   if (c.ndeg == 0)
     c.deg[c.ndeg++] = s->degree;
-  if (o.method >= 0)
-    s->method = (cv_method)o.method;
-  if (o.tolerance > 0)
-    s->tolerance = o.tolerance;
-  if (o.max_iterations)
-    s->max_iterations = o.max_iterations;
+  cli_apply_solver_options(&o, s);
   s->adapt = 0; /* converge studies fixed meshes: a scene's adapt or tol does not apply */
   s->tol = 0;
   /* The finest mesh, and the reference mesh of an estimate (p^2 times the nodes), must
@@ -304,8 +300,8 @@ int cli_converge(int argc, char **argv)
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if ((o.json && cli_outfile_open(&jf, o.json) < 0) ||
-      (c.svg && cli_outfile_open(&gf, c.svg) < 0)) {
+  if ((o.json && cli_outfile_open(&jf, o.json, o.scene_path) < 0) ||
+      (c.svg && cli_outfile_open(&gf, c.svg, o.scene_path) < 0)) {
     rc = EXIT_BADINPUT;
     goto done;
   }
@@ -329,13 +325,13 @@ int cli_converge(int argc, char **argv)
     }
   s->elements = e0;
   rc = all_ok ? EXIT_SOLVED : EXIT_UNSOLVED;
-  if (jf.f && (cli_converge_json(jf.f, rows, nrows) < 0 || cli_outfile_commit(&jf) < 0)) {
+  if (jf.f && cli_outfile_finish(&jf, cli_converge_json(jf.f, rows, nrows)) < 0) {
     fprintf(stderr, "calcvar converge: the JSON report could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   if (gf.f && cli_plot_converge(&gf, rows, nrows) < 0) {
     fprintf(stderr, "calcvar converge: the SVG could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   if (!o.quiet && !(o.json && strcmp(o.json, "-") == 0))
     cli_converge_text(stdout, rows, nrows);

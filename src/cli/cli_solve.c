@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "cli/cli.h"
+#include "scene/scene_batch.h"
 
 static void usage(FILE *f)
 {
@@ -23,6 +24,7 @@ static void usage(FILE *f)
         "  --max-iterations K   iteration limit (default 50)\n"
         "  --set name=value     override a parameter (repeatable)\n"
         "  --adapt TOL          refine until the estimated max nodal error < TOL\n"
+        "  --max-elements N     cap of adaptive refinement (default 2000000)\n"
         "  --tol T              choose mesh and degrees until the estimated max nodal\n"
         "                       error <= T (elements/degree, if given, are the start)\n"
         "  --continue name=from:to   continuation in a parameter\n"
@@ -33,7 +35,7 @@ static void usage(FILE *f)
         "  --csv FILE           nodal table ('-' for stdout)\n"
         "  --plot FILE          picture of the solution (.png or .svg)\n"
         "  --quiet              no summary on stdout\n"
-        "exit status: 0 converged, 1 not solved, 2 bad input\n", f);
+        "exit status: 0 converged, 1 not solved, 2 bad input, 3 write error\n", f);
 }
 
 /* Combinations that cannot be honoured: refuse (exit 2, nothing written) rather than
@@ -49,6 +51,11 @@ static int unsupported(const cli_opts *o, const scene *s)
   if (o->cont && (o->adapt > 0 || s->adapt > 0 || o->tol > 0 || s->tol > 0)) {
     fprintf(stderr, "calcvar solve: --continue and adaptive refinement cannot be combined "
             "(continuation keeps one mesh)\n");
+    return EXIT_BADINPUT;
+  }
+  if (o->max_elements > 0 && !(o->adapt > 0 || s->adapt > 0)) {
+    fprintf(stderr, "calcvar solve: --max-elements applies to adaptive refinement only "
+            "(--adapt TOL or [mesh] adapt)\n");
     return EXIT_BADINPUT;
   }
   if (o->all && o->cont) {
@@ -85,9 +92,12 @@ int cli_solve(int argc, char **argv)
     cli_opts_free(&o);
     return rc;
   }
-  scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
+  /* --continue: read once with the parameters as inputs, compiled once (issue 18) */
+  scene *s = o.cont ? scene_load_file_inputs(o.scene_path, o.nset, o.set, err, sizeof err)
+                    : scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
   cv_problem *p = NULL;
   cv_solver *sv = NULL;
+  cv_batch *cb = NULL; /* --continue: the compiled scene */
   cli_outfile jf = {0}, cf = {0}, pf = {0};
   cli_report r;
   memset(&r, 0, sizeof r);
@@ -100,12 +110,7 @@ int cli_solve(int argc, char **argv)
     s->elements = o.elements;
   if (o.degree)
     s->degree = o.degree;
-  if (o.method >= 0)
-    s->method = (cv_method)o.method;
-  if (o.tolerance > 0)
-    s->tolerance = o.tolerance;
-  if (o.max_iterations)
-    s->max_iterations = o.max_iterations;
+  cli_apply_solver_options(&o, s);
   if ((rc = unsupported(&o, s)) != 0)
     goto done;
   double tol = o.tol > 0 ? o.tol : s->tol;
@@ -117,22 +122,24 @@ int cli_solve(int argc, char **argv)
       s->degree = SCENE_TOL_START_DEGREE;
   }
   cv_status why;
-  if (!(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err)) ||
+  if ((!o.cont && !(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err))) ||
       !(sv = cv_solver_new(&why)) || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK) {
     fprintf(stderr, "%s\n", err[0] ? err : "calcvar solve: out of memory");
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if ((o.json && cli_outfile_open(&jf, o.json) < 0) ||
-      (o.csv && cli_outfile_open(&cf, o.csv) < 0) ||
-      (o.plot && cli_outfile_open(&pf, o.plot) < 0)) {
+  if ((o.json && cli_outfile_open(&jf, o.json, o.scene_path) < 0) ||
+      (o.csv && cli_outfile_open(&cf, o.csv, o.scene_path) < 0) ||
+      (o.plot && cli_outfile_open(&pf, o.plot, o.scene_path) < 0)) {
     rc = EXIT_BADINPUT;
     goto done;
   }
 
-  /* Adaptive refinement: [mesh] adapt or --adapt, capped at 2e6 elements (theory AD-1). */
+  /* Adaptive refinement: [mesh] adapt or --adapt, capped at --max-elements, default 2e6
+   * elements (theory AD-1). */
   double adapt = o.adapt > 0 ? o.adapt : s->adapt;
-  if (adapt > 0 && cv_solver_set_adapt(sv, adapt, 2000000) != CVAR_OK) {
+  int cap = o.max_elements > 0 ? o.max_elements : 2000000;
+  if (adapt > 0 && cv_solver_set_adapt(sv, adapt, cap) != CVAR_OK) {
     fprintf(stderr, "calcvar solve: invalid adaptive tolerance %g\n", adapt);
     rc = EXIT_BADINPUT;
     goto done;
@@ -146,15 +153,16 @@ int cli_solve(int argc, char **argv)
   if (o.cont) {
     /* continuation replaces scene, problem and solver by those of its last step */
     cv_solver_free(sv);
-    cv_problem_free(p);
-    scene_free(s);
-    s = NULL, p = NULL, sv = NULL;
-    if (cli_continue_solve(&o, &s, &p, &sv, &st, cont_msg, sizeof cont_msg, err,
+    scene *s0 = s;
+    s = NULL, sv = NULL;
+    const scene *si = NULL;
+    if (cli_continue_solve(&o, s0, &cb, &si, &p, &sv, &st, cont_msg, sizeof cont_msg, err,
                            sizeof err) < 0) {
       fprintf(stderr, "%s\n", err);
       rc = EXIT_BADINPUT;
       goto done;
     }
+    s = (scene *)si; /* the batch's instance: cb owns it (its DAG may grow for the report) */
   } else {
     st = cv_solve(sv, p);
   }
@@ -169,6 +177,19 @@ int cli_solve(int argc, char **argv)
     rc = EXIT_UNSOLVED;
     goto done;
   }
+  double xs, alpha;
+  if (st == CVAR_OK && scene_interior_singularity(s, sv, &xs, &alpha) == 1) {
+    /* a finite discrete action of an infinite one: not a solution (theory (SG-1)) */
+    st = r.st = CVAR_ENONFINITE;
+    r.status = cli_status_string(st);
+    r.has_morse = 0;
+    r.kind = NULL;
+    snprintf(r.message, sizeof r.message,
+             "the integrand is singular at %s = %.6g inside the interval: along the path "
+             "|F| grows like |%s - %.6g|^(-%.2f), so the action is infinite and the discrete "
+             "answer (which changes with the mesh) is no stationary path; split the interval "
+             "there or remove the singularity", s->variable, xs, s->variable, xs, alpha);
+  }
   if (cont_msg[0]) {
     size_t used = st == CVAR_OK ? strlen(r.message) : 0;
     char c0 = cont_msg[0] >= 'a' && cont_msg[0] <= 'z' ? (char)(cont_msg[0] - 'a' + 'A')
@@ -177,17 +198,17 @@ int cli_solve(int argc, char **argv)
              cont_msg + 1);
   }
   rc = st == CVAR_OK ? EXIT_SOLVED : EXIT_UNSOLVED;
-  if (jf.f && (cli_report_json(jf.f, &r) < 0 || cli_outfile_commit(&jf) < 0)) {
+  if (jf.f && cli_outfile_finish(&jf, cli_report_json(jf.f, &r)) < 0) {
     fprintf(stderr, "calcvar solve: the JSON report could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   if (pf.f && cli_plot_solution(&pf, &r, sv) < 0) {
     fprintf(stderr, "calcvar solve: the plot could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
-  if (cf.f && (cli_report_csv(cf.f, &r) < 0 || cli_outfile_commit(&cf) < 0)) {
+  if (cf.f && cli_outfile_finish(&cf, cli_report_csv(cf.f, &r)) < 0) {
     fprintf(stderr, "calcvar solve: the CSV table could not be written\n");
-    rc = EXIT_UNSOLVED;
+    rc = EXIT_IOERROR;
   }
   /* stdout carries the data when a report goes there; the summary would corrupt it. */
   int stdout_taken = (o.json && strcmp(o.json, "-") == 0) || (o.csv && strcmp(o.csv, "-") == 0);
@@ -202,7 +223,9 @@ done:
   cli_report_free(&r);
   cv_solver_free(sv);
   cv_problem_free(p);
-  scene_free(s);
+  if (!cb)
+    scene_free(s);
+  cv_batch_free(cb);
   cli_opts_free(&o);
   return rc;
 }

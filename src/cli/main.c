@@ -1,5 +1,6 @@
 /* src/cli/main.c — the calcvar command: dispatch to the subcommands.
  * SPDX-License-Identifier: MIT */
+#include <errno.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -14,12 +15,36 @@ static void usage(FILE *f)
         "  calcvar converge SCENE [opts]   error and run time over a sequence of meshes\n"
         "  calcvar equations SCENE         momenta, Euler-Lagrange equations, Hamiltonian\n"
         "  calcvar modes SCENE             equilibrium and small-oscillation frequencies\n"
+        "  calcvar batch SCENE TABLE.csv   one solve per table row (calcvar batch --help)\n"
         "  calcvar --help | --version\n"
-        "Scene files: docs/scenes.md. Exit status: 0 solved, 1 not solved, 2 bad input.\n",
+        "Scene files: docs/scenes.md (\"-\" reads one from standard input).\n"
+        "Exit status: 0 solved, 1 not solved, 2 bad input, 3 an output could not be "
+        "written.\n",
         f);
 }
 
-int main(int argc, char **argv)
+/* Standard output is checked like any output file: a full disk, /dev/full or a closed
+ * pipe must not pass for success (exit 3, docs/cli.md). */
+static int finish(int rc)
+{
+  errno = 0;
+  int bad = fflush(stdout) != 0 || ferror(stdout);
+  int e = errno;
+  if (fclose(stdout) != 0 && !bad) {
+    bad = 1;
+    e = errno;
+  }
+  if (!bad)
+    return rc;
+  fprintf(stderr, "calcvar: cannot write standard output: %s\n", e ? strerror(e) : "write error");
+  return rc == EXIT_BADINPUT ? rc : EXIT_IOERROR;
+}
+
+static int run(int argc, char **argv);
+
+int main(int argc, char **argv) { return finish(run(argc, argv)); }
+
+static int run(int argc, char **argv)
 {
   if (argc < 2)
     return cli_gallery();
@@ -42,6 +67,8 @@ int main(int argc, char **argv)
     return cli_equations(argc - 2, argv + 2);
   if (strcmp(cmd, "modes") == 0)
     return cli_modes(argc - 2, argv + 2);
+  if (strcmp(cmd, "batch") == 0)
+    return cli_batch(argc - 2, argv + 2);
   if (strcmp(cmd, "converge") == 0)
     return cli_converge(argc - 2, argv + 2);
   fprintf(stderr, "calcvar: unknown command '%s' (calcvar --help lists them)\n", cmd);

@@ -191,17 +191,16 @@ static void draw_panel(const cli_plot_panel *p)
 
 int cli_plot_write(cli_outfile *o, int npanels, const cli_plot_panel *panels)
 {
-  if (!o->f || o->f == stdout || !o->tmp || npanels < 1)
+  const char *name;
+  if (npanels < 1 || cli_outfile_render_name(o, &name) < 0)
     return -1;
-  /* PLplot opens the file itself, by name: hand it the temporary file. */
-  fclose(o->f);
-  o->f = NULL;
+  /* PLplot opens the file itself, by name: hand it the temporary (or scratch) file. */
   size_t n = strlen(o->path);
   int svg = n >= 4 && strcmp(o->path + n - 4, ".svg") == 0;
-  exit_tmp = o->tmp;
+  exit_tmp = name;
   plsexit(plplot_exit);
   plsdev(svg ? "svg" : "pngcairo");
-  plsfnam(o->tmp);
+  plsfnam(name);
   plspage(0, 0, 960, 100 + 460 * npanels, 0, 0);
   plscmap0(pal_r, pal_g, pal_b, NPAL);
   plssub(1, npanels);
@@ -211,14 +210,5 @@ int cli_plot_write(cli_outfile *o, int npanels, const cli_plot_panel *panels)
     draw_panel(&panels[k]);
   plend();
   exit_tmp = NULL;
-  if (access(o->tmp, F_OK) != 0 || rename(o->tmp, o->path) != 0) {
-    fprintf(stderr, "calcvar: cannot write %s\n", o->path);
-    unlink(o->tmp);
-    free(o->tmp);
-    o->tmp = NULL;
-    return -1;
-  }
-  free(o->tmp);
-  o->tmp = NULL;
-  return 0;
+  return cli_outfile_commit_rendered(o);
 }

@@ -23,9 +23,15 @@ void cli_report_text(FILE *f, const cli_report *r)
             r->nodes);
   if (r->has_action)
     fprintf(f, "  action      %.15g\n", r->action);
-  if (r->has_gradient_norm)
+  if (r->has_gradient_norm) {
     fprintf(f, "  residual    %.3g (max-norm of the scaled Euler-Lagrange residual)\n",
             r->gradient_norm);
+    /* Newton's convergence test is on the step, not on this number, which on fine meshes
+     * sits at a round-off floor that grows with the number of elements (docs/faq.md). */
+    if (r->method == CVAR_METHOD_NEWTON && r->st == CVAR_OK)
+      fprintf(f, "  test        Newton step within %.3g (relative to |y|); the residual is "
+              "not tested\n", s->tolerance);
+  }
   if (r->has_morse)
     fprintf(f, "  stationary  %s (Morse index %d)\n", r->kind, r->morse);
   if (r->has_err_nodal)

@@ -85,9 +85,13 @@ static int stop_rule(cv_solver *s, double est, double best, double floor_, int s
   }
   if (next_size > s->adapt_max) {
     cv_set_msg(s->msg, sizeof s->msg,
-               "the next refinement would exceed the cap of %d %s; the estimated max nodal "
-               "error reached is %.2g > %.2g",
-               s->adapt_max, what, est, tol);
+               "the next refinement would exceed the cap of %d %s after %d rounds; the "
+               "estimated max nodal error reached is %.2g > %.2g; %s",
+               s->adapt_max, what, s->rounds, est, tol,
+               s->hp ? "ask for a larger tolerance (or raise the cap: the max_nodes argument "
+                       "of cv_solver_set_tol)"
+                     : "use a higher degree or a looser tolerance (or raise the cap: "
+                       "--max-elements, or the max_elements argument of cv_solver_set_adapt)");
     return 1;
   }
   if (s->rounds >= MAX_ROUNDS) {
@@ -114,7 +118,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   cv_solver *f = cv_solver_new(&st);
   double *t = NULL, *eta = NULL, *sigma = NULL, *where = NULL;
   int *deg = NULL, E = 0, stalled = 0, warm = 0, misses = 0;
-  long iters = 0;
+  long iters = 0, iters_ref = 0; /* Newton iterations of all rounds; of the enriched solves */
   double tol = s->adapt_tol, best = INFINITY;
   cv_meshspec spec0 = s->mesh;
   int degree0 = s->degree;
@@ -156,6 +160,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     double est, floor_ = 0.0;
     char why[400];
     st = cv_estimate_enriched(s, p, f, &est, NULL, &floor_, eta, sigma, where, why, sizeof why);
+    iters_ref += f->iterations;
     if (st == CVAR_ENOMEM) goto cleanup;
     if (st) {
       /* HP-3: no bound from this mesh; halve every element and start the next round from
@@ -176,9 +181,11 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       s->err_est = est;
       if (est <= tol) {
         cv_set_msg(s->msg, sizeof s->msg,
-                   "converged with an estimated max nodal error of %.2g <= %.2g on %d elements "
-                   "(%d nodes) after %d rounds",
-                   est, tol, E, s->disc.nodes, s->rounds);
+                   "converged on %d elements (%d nodes) after %d round%s, %ld Newton "
+                   "iterations in all (and %ld on the reference meshes); estimated max nodal "
+                   "error %.2g <= %.2g",
+                   E, s->disc.nodes, s->rounds, s->rounds == 1 ? "" : "s", iters, iters_ref,
+                   est, tol);
         st = CVAR_OK;
         goto cleanup;
       }

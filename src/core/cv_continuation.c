@@ -84,8 +84,7 @@ cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, dou
       cv_set_msg(s->msg, sizeof s->msg,
                  "no stationary path found: Newton from the start did not converge, and "
                  "continuation from the start stalled at t = %.6g of 1 after %d steps (the "
-                 "path of solutions turns back or ends; beyond a critical value of the data "
-                 "there may be no solution)",
+                 "path of solutions from the start turns back or ends there)",
                  t, steps);
       goto cleanup;
     }

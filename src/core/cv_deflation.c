@@ -22,7 +22,7 @@
 #define WORK_FLOOR 8    /* the first solve counts as at least this many iterations */
 #define EIG_DIRS 3      /* lowest Hessian eigen-directions per path (DF-4) */
 #define EIG_STEPS 6     /* block inverse-iteration steps */
-#define MAX_BACKTRACK 30
+#define MAX_BACKTRACK 20
 #define ARMIJO 1e-4
 #define SAME_FLOOR 1e-6 /* paths closer than this times their size are one (DF-5) */
 
@@ -57,6 +57,7 @@ void cv_pathset_free(struct cv_pathset *ps) {
 
 /* Move the solver's results into q (the solver holds none afterwards), and back. */
 static void path_take(cv_path *q, cv_solver *s) {
+  cv_solver_drop_factor(s); /* the factor belongs to the mesh that leaves */
   q->disc = s->disc;
   q->y = s->y;
   q->mult = s->mult;
@@ -70,6 +71,7 @@ static void path_take(cv_path *q, cv_solver *s) {
 }
 
 static void path_give(cv_solver *s, cv_path *q) {
+  cv_solver_drop_factor(s);
   cv_disc_free(&s->disc);
   cv_free(s->y);
   cv_free(s->mult);
@@ -275,7 +277,8 @@ static cv_status defl_run(defl *w, const cv_solver *s, double *Y, int maxit, int
     int ok = 0;
     for (int ls = 0; ls < MAX_BACKTRACK; ls++, alpha *= 0.5) {
       put(w, Y, w->M, alpha * tau, w->delta, w->Yt, w->Mt);
-      cv_status ast = cv_kkt_eval(&w->kkt, w->Yt, w->Mt, &St, w->gt, Ax, w->dreg);
+      /* trials without the Hessian: a failing search backtracks often */
+      cv_status ast = cv_kkt_eval(&w->kkt, w->Yt, w->Mt, &St, w->gt, NULL, NULL);
       if (ast == CVAR_ECALLBACK || ast == CVAR_ENOMEM) return ast;
       if (ast) continue;
       Mt = deflation(w, w->Yt, NULL);
@@ -288,8 +291,8 @@ static cv_status defl_run(defl *w, const cv_solver *s, double *Y, int maxit, int
     if (!ok) return CVAR_ESTALL;
     memcpy(Y, w->Yt, (size_t)d->ndof * sizeof *Y);
     memcpy(w->M, w->Mt, (w->nmult + 1) * sizeof *w->M);
-    double *t = w->g;
-    w->g = w->gt, w->gt = t;
+    st = cv_kkt_eval(&w->kkt, Y, w->M, &St, w->g, Ax, w->dreg); /* and its Hessian */
+    if (st) return st;
     phi = phit;
     Mv = deflation(w, Y, w->r);
     double ymax = 0.0;

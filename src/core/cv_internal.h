@@ -43,7 +43,8 @@ struct cv_problem {
   double *endval;  /* endval[2*k + end] */
   cv_guess_fn guess;
   void *guess_user;
-  cv_note_fn note;   /* the integrand's failure note (cv_table_internal.h), or NULL */
+  int nnotes;        /* failure notes of callbacks (cv_table_internal.h) */
+  cv_note_source *notes;
   int ntables;       /* tables added by cv_problem_add_table, each with a reference */
   char **table_name;
   cv_table **table;

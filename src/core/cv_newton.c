@@ -259,6 +259,148 @@ static void apply_step(newton_ws *w, const double *Y, const double *M, double al
   }
 }
 
+/* Weighted RMS norm of the step in y, weights 1/(rtol |y| + atol) (N-4), in the same pass
+ * as the full-step trial point (apply_step with alpha = 1) into w->Yt, w->Mt, the slope
+ * g . delta, the merit phi and the reported residual s->gnorm of the current iterate
+ * (as in residual()), and the largest |y|. */
+static double step_norm(cv_solver *s, newton_ws *w, const double *Yc, const double *Mc,
+                        double atol, double *slope, double *phi, double *ymax) {
+  const cv_disc *d = w->d;
+  double wn = 0.0, sl = 0.0, ym = 0.0, rs = 0.0, rmax = 0.0;
+  int ny = 0;
+  for (int f = 0; f < d->nfree; f++) {
+    int gi = w->gof[f];
+    double df = w->delta[f], gf = w->g[f], r = gf * d->imass[f]; /* as in residual() */
+    sl += gf * df;
+    rs += r * r;
+    r = fabs(r);
+    if (!(r <= rmax)) rmax = r;
+    if (gi < 0) {
+      w->Mt[-1 - gi] = Mc[-1 - gi] + df;
+      continue;
+    }
+    double yf = Yc[gi], ay = fabs(yf), v = df / (s->rtol * ay + atol);
+    w->Yt[gi] = yf + df;
+    wn += v * v;
+    ny++;
+    if (!(ay <= ym)) ym = ay;
+  }
+  *slope = sl;
+  *phi = 0.5 * rs;
+  *ymax = ym;
+  s->gnorm = rmax;
+  return sqrt(wn / (ny ? ny : 1));
+}
+
+/* Factor the Hessian in Ax (N-1, N-5, N-6): *neg its negative pivots. A tiny pivot is
+ * first tried as a singular leading block (factor_shifted); a Hessian that stays singular
+ * sets the degenerate flag, the Morse index so far and the message. */
+static cv_status factor_hessian(cv_solver *s, newton_ws *w, double *Ax, int ncon, int *neg) {
+  char detail[200] = "";
+  double dmin, dmax;
+  cv_status st = cv_ldlt_factor(w->L, neg, &dmin, &dmax, detail, sizeof detail);
+  if (st == CVAR_OK && !(dmin > DEGENERATE_PIVOT)) st = CVAR_ESINGULAR;
+  w->tau = 0.0;
+  if (st == CVAR_ESINGULAR) { /* a singular leading block, or H itself (N-6) */
+    int negs = *neg;
+    cv_status sst = factor_shifted(w, Ax, &negs, detail, sizeof detail);
+    if (sst == CVAR_OK) st = CVAR_OK, *neg = negs;
+    else if (sst != CVAR_ESINGULAR) st = sst;
+  }
+  if (st == CVAR_ESINGULAR) {
+    s->degenerate = 1;
+    s->morse = *neg - ncon;
+    cv_set_msg(s->msg, sizeof s->msg,
+               ncon > 0
+                   ? "the Hessian of the Lagrangian is singular (pivot ratio %.1e at "
+                     "iteration %d): the constraints may be dependent or the action flat "
+                     "along them"
+                   : "the Hessian is singular (pivot ratio %.1e at iteration %d): the "
+                     "action is flat along some direction, as for an integrand invariant "
+                     "under reparametrisation such as arc length sqrt(x'^2 + y'^2); use "
+                     "the energy form x'^2 + y'^2 instead",
+               dmin, s->iterations);
+  } else if (st) {
+    cv_set_msg(s->msg, sizeof s->msg, "%s", detail);
+  }
+  return st;
+}
+
+/* The trial point of a line search and what it found (N-2). */
+typedef struct {
+  double alpha, St, phit, rnt;
+  int stale; /* accepted on S alone: phi and the residual of the new iterate are owed */
+} trial;
+
+/* Backtracking along delta from (Yc, Mc): on S where the Hessian is positive definite and
+ * nothing is constrained (use_S: the step descends S), else on the scaled residual merit
+ * phi = |g/m|^2 / 2, for which the Newton step is always a descent direction (N-2). The
+ * full-step trial point is already in w->Yt, w->Mt. Returns CVAR_OK with the accepted
+ * point in w->Yt, w->Mt, w->gt and *t; CVAR_ESTALL when no step was accepted (no message);
+ * an error of the integrand with its message. */
+static cv_status line_search(cv_solver *s, cv_kkt *kkt, const cv_homotopy *h, newton_ws *w,
+                             const double *Yc, const double *Mc, double *Ax, double S,
+                             double slope, double phi, double wn, int use_S, int timed,
+                             trial *t) {
+  t->alpha = 1.0, t->St = t->phit = t->rnt = 0.0, t->stale = 0;
+  for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
+    if (ls > 0) apply_step(w, Yc, Mc, t->alpha);
+    double ta = timed ? cv_now() : 0.0;
+    /* A step within the tolerance is the last one (taken in full below): the Hessian
+     * there would not be used, so only F and the gradient are evaluated. */
+    double *Axt = wn <= 1.0 ? NULL : Ax;
+    cv_status ast = eval_system(kkt, h, w, w->Yt, w->Mt, &t->St, w->gt, Axt, w->dreg);
+    if (timed) s->t_assemble += cv_now() - ta;
+    if (ast == CVAR_ECALLBACK || ast == CVAR_ENOMEM) {
+      cv_set_msg(s->msg, sizeof s->msg, "%s",
+                 ast == CVAR_ENOMEM ? "out of memory" : where_failed(ast));
+      return ast;
+    }
+    if (ast == CVAR_OK) {
+      /* Near the solution S changes by less than its round-off; a step within the
+       * tolerance is then taken in full. */
+      if ((use_S && t->St <= S + ARMIJO * t->alpha * slope) || wn <= 1.0) {
+        t->stale = 1;
+        return CVAR_OK;
+      }
+      t->phit = residual(w->d, w->gt, &t->rnt);
+      if (t->phit <= (1.0 - 2.0 * ARMIJO * t->alpha) * phi) return CVAR_OK;
+    }
+    t->alpha *= 0.5;
+  }
+  return CVAR_ESTALL;
+}
+
+/* Workspace and constraint system of one Newton run from (Y, M): the trial buffers start
+ * as copies (their fixed values are then set once), pointwise constraints are checked at
+ * the fixed ends and the multipliers initialised (C-5). *ncon: constraint rows. */
+static cv_status run_init(cv_solver *s, const cv_problem *p, cv_disc *d, newton_ws *w,
+                          cv_kkt *kkt, const double *Y, double *M, size_t nmult, int *ncon) {
+  int nf = d->nfree;
+  memset(kkt, 0, sizeof *kkt);
+  cv_status st = ws_init(w, s, d, nmult, s->msg, sizeof s->msg);
+  if (!st) st = cv_kkt_init(kkt, p, d, w->colptr);
+  if (st) {
+    if (st == CVAR_ENOMEM)
+      cv_set_msg(s->msg, sizeof s->msg, "out of memory setting up %d unknowns", nf);
+    return st;
+  }
+  *ncon = 0;
+  for (int f = 0; f < nf; f++) *ncon += w->gof[f] < 0;
+  /* Two buffers swap roles as iterate and trial; the trial's fixed values are set once. */
+  memcpy(w->Yt, Y, (size_t)d->ndof * sizeof *Y);
+  if (nmult) memcpy(w->Mt, M, nmult * sizeof *M);
+  if (d->nc > 0) {
+    st = cv_kkt_check_ends(kkt, Y, s->msg, sizeof s->msg);
+    if (st) return st;
+  }
+  if (*ncon > 0) {
+    st = cv_kkt_init_multipliers(kkt, Y, M);
+    if (st) cv_set_msg(s->msg, sizeof s->msg, "%s at the initial guess", where_failed(st));
+  }
+  return st;
+}
+
 cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M,
                         const cv_homotopy *h) {
   newton_ws w;
@@ -269,37 +411,15 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   double S = 0.0, scale = 0.0;
   int stale = 0; /* see the first residual below */
   double *Yc = Y, *Mc = M; /* the current iterate (see the swap below) */
-  char detail[200] = "";
 
   s->iterations = 0;
   s->morse = -1;
   s->degenerate = 0;
   s->gnorm = NAN;
   s->action = NAN;
-  memset(&kkt, 0, sizeof kkt);
-  st = ws_init(&w, s, d, nmult, s->msg, sizeof s->msg);
-  if (!st) st = cv_kkt_init(&kkt, p, d, w.colptr);
-  if (st) {
-    if (st == CVAR_ENOMEM)
-      cv_set_msg(s->msg, sizeof s->msg, "out of memory setting up %d unknowns", nf);
-    goto cleanup;
-  }
-  for (int f = 0; f < nf; f++) ncon += w.gof[f] < 0;
+  st = run_init(s, p, d, &w, &kkt, Y, M, nmult, &ncon);
+  if (st) goto cleanup;
   int constrained = ncon > 0;
-  /* Two buffers swap roles as iterate and trial; the trial's fixed values are set once. */
-  memcpy(w.Yt, Y, (size_t)d->ndof * sizeof *Y);
-  if (nmult) memcpy(w.Mt, M, nmult * sizeof *M);
-  if (d->nc > 0) {
-    st = cv_kkt_check_ends(&kkt, Y, s->msg, sizeof s->msg);
-    if (st) goto cleanup;
-  }
-  if (constrained) {
-    st = cv_kkt_init_multipliers(&kkt, Y, M);
-    if (st) {
-      cv_set_msg(s->msg, sizeof s->msg, "%s at the initial guess", where_failed(st));
-      goto cleanup;
-    }
-  }
   /* Absolute floor of the step tolerance: atol times the size of the solution (STYLE 8). */
   for (long i = 0; i < d->ndof; i++)
     if (fabs(Y[i]) > scale) scale = fabs(Y[i]);
@@ -330,36 +450,9 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   }
   for (;;) {
     int neg;
-    double dmin, dmax;
     double tf = timed ? cv_now() : 0.0;
-    st = cv_ldlt_factor(w.L, &neg, &dmin, &dmax, detail, sizeof detail);
-    if (st == CVAR_OK && !(dmin > DEGENERATE_PIVOT)) st = CVAR_ESINGULAR;
-    w.tau = 0.0;
-    if (st == CVAR_ESINGULAR) { /* a singular leading block, or H itself (N-6) */
-      int negs = neg;
-      cv_status sst = factor_shifted(&w, Ax, &negs, detail, sizeof detail);
-      if (sst == CVAR_OK) st = CVAR_OK, neg = negs;
-      else if (sst != CVAR_ESINGULAR) st = sst;
-    }
-    if (st) {
-      if (st == CVAR_ESINGULAR) {
-        s->degenerate = 1;
-        s->morse = neg - ncon;
-        cv_set_msg(s->msg, sizeof s->msg,
-                   constrained
-                       ? "the Hessian of the Lagrangian is singular (pivot ratio %.1e at "
-                         "iteration %d): the constraints may be dependent or the action flat "
-                         "along them"
-                       : "the Hessian is singular (pivot ratio %.1e at iteration %d): the "
-                         "action is flat along some direction, as for an integrand invariant "
-                         "under reparametrisation such as arc length sqrt(x'^2 + y'^2); use "
-                         "the energy form x'^2 + y'^2 instead",
-                   dmin, s->iterations);
-      } else {
-        cv_set_msg(s->msg, sizeof s->msg, "%s", detail);
-      }
-      goto cleanup;
-    }
+    st = factor_hessian(s, &w, Ax, ncon, &neg);
+    if (st) goto cleanup;
     /* Each constraint row adds one negative pivot to a quasi-definite KKT matrix (N-1). */
     s->morse = neg - ncon;
     for (int f = 0; f < nf; f++) w.delta[f] = -w.g[f];
@@ -373,29 +466,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
       goto cleanup;
     }
     s->iterations++;
-    /* Weighted RMS norm of the step in y, weights 1/(rtol |y| + atol) (N-4), in the same
-     * pass as the full-step trial point (apply_step with alpha = 1). */
-    double wn = 0.0, slope = 0.0, ymax = 0.0, rs = 0.0, rmax = 0.0;
-    int ny = 0;
-    for (int f = 0; f < nf; f++) {
-      int gi = w.gof[f];
-      double df = w.delta[f], gf = w.g[f], r = gf * d->imass[f]; /* as in residual() */
-      slope += gf * df;
-      rs += r * r;
-      r = fabs(r);
-      if (!(r <= rmax)) rmax = r;
-      if (gi < 0) {
-        w.Mt[-1 - gi] = Mc[-1 - gi] + df;
-        continue;
-      }
-      double yf = Yc[gi], ay = fabs(yf), v = df / (s->rtol * ay + atol);
-      w.Yt[gi] = yf + df;
-      wn += v * v;
-      ny++;
-      if (!(ay <= ymax)) ymax = ay;
-    }
-    phi = 0.5 * rs;
-    s->gnorm = rmax;
+    double slope, ymax, wn = step_norm(s, &w, Yc, Mc, atol, &slope, &phi, &ymax);
     stale = 0;
     if (!(ymax <= 1e12 * scale)) {
       st = CVAR_EDIVERGED;
@@ -405,63 +476,31 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
                  s->iterations);
       goto cleanup;
     }
-    wn = sqrt(wn / (ny ? ny : 1));
     if (!isfinite(wn)) {
       st = CVAR_ENONFINITE;
       cv_set_msg(s->msg, sizeof s->msg, "the Newton step is not finite");
       goto cleanup;
     }
-    /* Line search: on S where the Hessian is positive definite and nothing is constrained
-     * (the step descends S), else on the scaled residual merit phi = |g/m|^2 / 2, for
-     * which the Newton step is always a descent direction (N-2). */
-    double alpha = 1.0, St = 0.0, phit = 0.0, rnt = 0.0;
-    int accepted = 0, use_S = neg == 0 && !constrained && slope < 0;
-    for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
-      if (ls > 0) apply_step(&w, Yc, Mc, alpha);
-      ta = timed ? cv_now() : 0.0;
-      /* A step within the tolerance is the last one (taken in full below): the Hessian
-       * there would not be used, so only F and the gradient are evaluated. */
-      double *Axt = wn <= 1.0 ? NULL : Ax;
-      cv_status ast = eval_system(&kkt, h, &w, w.Yt, w.Mt, &St, w.gt, Axt, w.dreg);
-      if (timed) s->t_assemble += cv_now() - ta;
-      if (ast == CVAR_ECALLBACK || ast == CVAR_ENOMEM) {
-        st = ast;
-        cv_set_msg(s->msg, sizeof s->msg, "%s",
-                   ast == CVAR_ENOMEM ? "out of memory" : where_failed(ast));
-        goto cleanup;
-      }
-      if (ast == CVAR_OK) {
-        /* Near the solution S changes by less than its round-off; a step within the
-         * tolerance is then taken in full. */
-        if ((use_S && St <= S + ARMIJO * alpha * slope) || wn <= 1.0) {
-          accepted = stale = 1;
-          break;
-        }
-        phit = residual(d, w.gt, &rnt);
-        if (phit <= (1.0 - 2.0 * ARMIJO * alpha) * phi) {
-          accepted = 1;
-          break;
-        }
-      }
-      alpha *= 0.5;
-    }
-    if (!accepted) {
-      st = CVAR_ESTALL;
+    trial t;
+    st = line_search(s, &kkt, h, &w, Yc, Mc, Ax, S, slope, phi, wn,
+                     neg == 0 && !constrained && slope < 0, timed, &t);
+    if (st == CVAR_ESTALL)
       cv_set_msg(s->msg, sizeof s->msg,
                  "no progress: the line search found no decrease along the Newton step at "
                  "iteration %d (scaled residual %.3g); try a better [guess], more elements, or "
                  "continuation",
                  s->iterations, s->gnorm);
-      goto cleanup;
-    }
+    if (st) goto cleanup;
+    double alpha = t.alpha;
+    stale = t.stale;
     double *tmp = w.g;
     w.g = w.gt;
     w.gt = tmp;
     tmp = Yc, Yc = w.Yt, w.Yt = tmp;
     tmp = Mc, Mc = w.Mt, w.Mt = tmp;
-    S = St;
+    S = t.St;
     s->action = S;
-    if (!stale) phi = phit, s->gnorm = rnt;
+    if (!stale) phi = t.phit, s->gnorm = t.rnt;
     if ((wn <= 1.0 && alpha == 1.0) || s->iterations >= s->maxit) {
       phi = residual(d, w.g, &s->gnorm); /* reported */
       stale = 0;

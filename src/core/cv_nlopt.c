@@ -188,6 +188,107 @@ static cv_status precondition(nl_ctx *c, const cv_disc *d, const int *colptr) {
   return CVAR_OK;
 }
 
+/* NLopt's variables are the free y unknowns (var: variable of each free unknown, or -1;
+ * yof, fof: its y dof and free index), its constraints the multiplier rows (lrow: row of
+ * each free unknown, or -1; rows: the free index of each row). */
+static void index_unknowns(nl_ctx *c, const cv_disc *d) {
+  for (int f = 0; f < d->nfree; f++) c->lrow[f] = c->var[f] = -1;
+  for (long j = 0; j < d->nodes; j++) {
+    for (int i = 0; i < d->n; i++) {
+      int f = cv_disc_fidx(d, j * d->n + i);
+      if (f < 0) continue;
+      c->var[f] = c->nv;
+      c->yof[c->nv] = (int)(j * d->n + i);
+      c->fof[c->nv++] = f;
+    }
+    for (int k = 0; k < d->nc; k++) {
+      int f = cv_disc_lidx(d, j, k);
+      if (f >= 0) c->lrow[f] = c->m, c->rows[c->m++] = f;
+    }
+  }
+  for (int r = 0; r < d->ni; r++) c->lrow[d->nu0 + r] = c->m, c->rows[c->m++] = d->nu0 + r;
+}
+
+/* The NLopt object for s->method with the objective, tolerances and constraints (NL-2).
+ * MMA and CCSAQ take only inequality constraints; an equality as two opposite inequalities
+ * leaves them no interior to move in (they stall far from the answer). NLopt's remedy is
+ * AUGLAG_EQ: the equalities go to an augmented Lagrangian whose subproblems MMA or CCSAQ
+ * solve. *local: the subsidiary optimiser, if any (the caller destroys it). */
+static cv_status make_optimizer(nl_ctx *c, cv_solver *s, nlopt_opt *local, const double *tol) {
+  int eq_wrap = c->m > 0 && (s->method == CVAR_METHOD_MMA || s->method == CVAR_METHOD_CCSAQ);
+  c->opt = nlopt_create(eq_wrap ? NLOPT_AUGLAG_EQ : algorithm(s->method), (unsigned)c->nv);
+  if (!c->opt) return CVAR_ENOMEM;
+  if (s->method == CVAR_METHOD_AUGLAG || eq_wrap) {
+    *local = nlopt_create(eq_wrap ? algorithm(s->method) : NLOPT_LD_LBFGS, (unsigned)c->nv);
+    if (!*local) return CVAR_ENOMEM;
+    nlopt_set_xtol_rel(*local, s->rtol);
+    nlopt_set_ftol_rel(*local, 0.0);
+    nlopt_set_local_optimizer(c->opt, *local);
+  }
+  nlopt_set_min_objective(c->opt, objective, c);
+  nlopt_set_xtol_rel(c->opt, s->rtol);
+  nlopt_set_ftol_rel(c->opt, s->rtol * 1e-2);
+  /* Evaluations, not Newton iterations: a quasi-Newton method needs many more. */
+  nlopt_set_maxeval(c->opt, 200 * s->maxit);
+  if (c->m > 0) {
+    nlopt_result r;
+    r = nlopt_add_equality_mconstraint(c->opt, (unsigned)c->m, eq_constraints, c, tol);
+    if (r < 0) {
+      cv_set_msg(s->msg, sizeof s->msg, "NLopt refused the constraints (%s)",
+                 nlopt_result_to_string(r));
+      return CVAR_EDEPENDENCY;
+    }
+  }
+  return CVAR_OK;
+}
+
+/* The status and message for NLopt's result r (S0: the action at the start; *roundoff:
+ * the line search ended at round-off, accepted only on a larger fall of the residual).
+ * Runaway: iterates a thousand times the size of the data with the action far below its
+ * start mean the action is unbounded below, whatever code NLopt returned (L-BFGS may
+ * report a generic failure after overflowing steps). */
+static cv_status result_status(const nl_ctx *c, cv_solver *s, nlopt_result r, double S0,
+                               int *roundoff) {
+  cv_status st;
+  int runaway = c->ymax > 1e3 * c->scale && c->smin < S0 - 1e3 * (fabs(S0) + 1.0);
+  if ((r == NLOPT_FORCED_STOP && c->stop == CVAR_ENOTMIN) || (r < 0 && runaway)) {
+    st = CVAR_ENOTMIN;
+    cv_set_msg(s->msg, sizeof s->msg,
+               "the action decreases without bound under %s: it has no minimum here, so its "
+               "stationary path (if any) is a saddle that a minimiser cannot find; use method "
+               "newton, which reports the Morse index",
+               cv_method_name(s->method));
+  } else if (r == NLOPT_FORCED_STOP) {
+    st = c->stop ? c->stop : CVAR_EDEPENDENCY;
+    cv_set_msg(s->msg, sizeof s->msg, "%s stopped: %s", cv_method_name(s->method),
+               cv_strerror(st));
+  } else if (r == NLOPT_ROUNDOFF_LIMITED || r == NLOPT_FAILURE) {
+    /* L-BFGS reports a failed line search as a generic failure; near the minimum that is
+     * round-off. Accepted by the caller only if the residual fell by 1e4 (NL-2). */
+    st = CVAR_OK;
+    *roundoff = 1;
+    cv_set_msg(s->msg, sizeof s->msg,
+               "%s converged in %ld evaluations (its line search ended at round-off)",
+               cv_method_name(s->method), c->evals);
+  } else if (r == NLOPT_OUT_OF_MEMORY) {
+    st = CVAR_ENOMEM;
+    cv_set_msg(s->msg, sizeof s->msg, "NLopt ran out of memory");
+  } else if (r < 0) {
+    st = CVAR_EDEPENDENCY;
+    cv_set_msg(s->msg, sizeof s->msg, "NLopt failed: %s", nlopt_result_to_string(r));
+  } else if (r == NLOPT_MAXEVAL_REACHED || r == NLOPT_MAXTIME_REACHED) {
+    st = CVAR_EMAXITER;
+    cv_set_msg(s->msg, sizeof s->msg,
+               "%s did not converge within %d evaluations; raise max_iterations or use newton",
+               cv_method_name(s->method), 200 * s->maxit);
+  } else {
+    st = CVAR_OK;
+    cv_set_msg(s->msg, sizeof s->msg, "%s converged (%s) in %ld evaluations",
+               cv_method_name(s->method), nlopt_result_to_string(r), c->evals);
+  }
+  return st;
+}
+
 cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y) {
   nl_ctx c;
   cv_kkt kkt;
@@ -225,21 +326,7 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
     st = cv_kkt_check_ends(&kkt, Y, s->msg, sizeof s->msg);
     if (st) goto cleanup;
   }
-  for (int f = 0; f < d->nfree; f++) c.lrow[f] = c.var[f] = -1;
-  for (long j = 0; j < d->nodes; j++) {
-    for (int i = 0; i < d->n; i++) {
-      int f = cv_disc_fidx(d, j * d->n + i);
-      if (f < 0) continue;
-      c.var[f] = c.nv;
-      c.yof[c.nv] = (int)(j * d->n + i);
-      c.fof[c.nv++] = f;
-    }
-    for (int k = 0; k < d->nc; k++) {
-      int f = cv_disc_lidx(d, j, k);
-      if (f >= 0) c.lrow[f] = c.m, c.rows[c.m++] = f;
-    }
-  }
-  for (int r = 0; r < d->ni; r++) c.lrow[d->nu0 + r] = c.m, c.rows[c.m++] = d->nu0 + r;
+  index_unknowns(&c, d);
   if ((double)c.m * c.nv > MAX_DENSE_JACOBIAN) {
     st = CVAR_EINVAL;
     cv_set_msg(s->msg, sizeof s->msg,
@@ -273,42 +360,14 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
   if (st) goto cleanup;
   for (int v = 0; v < c.nv; v++) x[v] = 0.0; /* z = 0 is the initial guess y0 */
   /* Constraint tolerance: 10 rtol in units of G (or of the integral). */
-  for (int i = 0; i < c.m; i++) tol[i] = 10 * s->rtol;
-  /* MMA and CCSAQ take only inequality constraints; an equality as two opposite
-   * inequalities leaves them no interior to move in (they stall far from the answer). NLopt's
-   * remedy is AUGLAG_EQ: the equalities go to an augmented Lagrangian whose subproblems
-   * MMA or CCSAQ solve. */
-  int eq_wrap = c.m > 0 && (s->method == CVAR_METHOD_MMA || s->method == CVAR_METHOD_CCSAQ);
-  c.opt = nlopt_create(eq_wrap ? NLOPT_AUGLAG_EQ : algorithm(s->method), (unsigned)c.nv);
-  if (!c.opt) {
-    st = CVAR_ENOMEM;
-    goto cleanup;
-  }
-  if (s->method == CVAR_METHOD_AUGLAG || eq_wrap) {
-    local = nlopt_create(eq_wrap ? algorithm(s->method) : NLOPT_LD_LBFGS, (unsigned)c.nv);
-    if (!local) {
-      st = CVAR_ENOMEM;
-      goto cleanup;
-    }
-    nlopt_set_xtol_rel(local, s->rtol);
-    nlopt_set_ftol_rel(local, 0.0);
-    nlopt_set_local_optimizer(c.opt, local);
-  }
-  nlopt_set_min_objective(c.opt, objective, &c);
-  nlopt_set_xtol_rel(c.opt, s->rtol);
-  nlopt_set_ftol_rel(c.opt, s->rtol * 1e-2);
-  /* Evaluations, not Newton iterations: a quasi-Newton method needs many more. */
-  nlopt_set_maxeval(c.opt, 200 * s->maxit);
-  if (c.m > 0) {
-    nlopt_result r;
-    r = nlopt_add_equality_mconstraint(c.opt, (unsigned)c.m, eq_constraints, &c, tol);
-    if (r < 0) {
-      st = CVAR_EDEPENDENCY;
-      cv_set_msg(s->msg, sizeof s->msg, "NLopt refused the constraints (%s)",
-                 nlopt_result_to_string(r));
-      goto cleanup;
-    }
-  }
+  /* SLSQP stops as soon as the violation is within tol and S has stopped changing, and the
+   * point it reaches is then only as stationary as sqrt(tol) allows (hanging chain: scaled
+   * residual 1.4e-3 at tol 1e-9, 2e-5 at 1e-13, 7.5e-6 at 0). Its iterates satisfy the
+   * linearised constraints exactly, so it needs no slack: tol 0, and its stop is the f and
+   * x tolerances (NL-2). */
+  for (int i = 0; i < c.m; i++) tol[i] = s->method == CVAR_METHOD_SLSQP ? 0.0 : 10 * s->rtol;
+  st = make_optimizer(&c, s, &local, tol);
+  if (st) goto cleanup;
   double fmin = 0.0, S0 = 0.0;
   S0 = objective((unsigned)c.nv, x, NULL, &c);
   if (!isfinite(S0)) {
@@ -326,42 +385,7 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
    * start mean the action is unbounded below, whatever code NLopt returned (L-BFGS may
    * report a generic failure after overflowing steps). */
   int roundoff = 0;
-  int runaway = c.ymax > 1e3 * c.scale && c.smin < S0 - 1e3 * (fabs(S0) + 1.0);
-  if ((r == NLOPT_FORCED_STOP && c.stop == CVAR_ENOTMIN) || (r < 0 && runaway)) {
-    st = CVAR_ENOTMIN;
-    cv_set_msg(s->msg, sizeof s->msg,
-               "the action decreases without bound under %s: it has no minimum here, so its "
-               "stationary path (if any) is a saddle that a minimiser cannot find; use method "
-               "newton, which reports the Morse index",
-               cv_method_name(s->method));
-  } else if (r == NLOPT_FORCED_STOP) {
-    st = c.stop ? c.stop : CVAR_EDEPENDENCY;
-    cv_set_msg(s->msg, sizeof s->msg, "%s stopped: %s", cv_method_name(s->method),
-               cv_strerror(st));
-  } else if (r == NLOPT_ROUNDOFF_LIMITED || r == NLOPT_FAILURE) {
-    /* L-BFGS reports a failed line search as a generic failure; near the minimum that is
-     * round-off. Accepted below only if the residual fell by 1e4 (NL-2). */
-    st = CVAR_OK;
-    roundoff = 1;
-    cv_set_msg(s->msg, sizeof s->msg,
-               "%s converged in %ld evaluations (its line search ended at round-off)",
-               cv_method_name(s->method), c.evals);
-  } else if (r == NLOPT_OUT_OF_MEMORY) {
-    st = CVAR_ENOMEM;
-    cv_set_msg(s->msg, sizeof s->msg, "NLopt ran out of memory");
-  } else if (r < 0) {
-    st = CVAR_EDEPENDENCY;
-    cv_set_msg(s->msg, sizeof s->msg, "NLopt failed: %s", nlopt_result_to_string(r));
-  } else if (r == NLOPT_MAXEVAL_REACHED || r == NLOPT_MAXTIME_REACHED) {
-    st = CVAR_EMAXITER;
-    cv_set_msg(s->msg, sizeof s->msg,
-               "%s did not converge within %d evaluations; raise max_iterations or use newton",
-               cv_method_name(s->method), 200 * s->maxit);
-  } else {
-    st = CVAR_OK;
-    cv_set_msg(s->msg, sizeof s->msg, "%s converged (%s) in %ld evaluations",
-               cv_method_name(s->method), nlopt_result_to_string(r), c.evals);
-  }
+  st = result_status(&c, s, r, S0, &roundoff);
   /* Report: action, multipliers by least squares (C-5), scaled residual of the Lagrangian.
    * A minimiser stops on small changes of S or z, which can happen short of stationarity;
    * converged is said only when the residual fell by at least 100 (NL-2). */

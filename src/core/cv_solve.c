@@ -45,9 +45,13 @@ static cv_status grade_singular_ends(cv_solver *s, const cv_problem *p) {
   cv_status st = cv_start_setup(s, p);
   s->mesh = keep;
   if (st) return st;
-  cv_set_msg(s->note, sizeof s->note,
-             "the integrand is singular at %s, so the mesh was graded towards it (k = %g); ",
-             both ? "both ends" : at_a ? "the start" : "the end", k);
+  if (s->near_sing[0] || s->near_sing[1]) /* set by cv_solve_mesh, which says why */
+    cv_set_msg(s->note, sizeof s->note, "the mesh was graded towards %s (k = %g); ",
+               both ? "both ends" : at_a ? "the start" : "the end", k);
+  else
+    cv_set_msg(s->note, sizeof s->note,
+               "the integrand is singular at %s, so the mesh was graded towards %s (k = %g); ",
+               both ? "both ends" : at_a ? "the start" : "the end", both ? "them" : "it", k);
   return CVAR_OK;
 }
 
@@ -156,6 +160,36 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
   cv_status st = solve_once(s, p);
   double rel[2] = {0.0, 0.0};
   int un[2] = {0, 0};
+  /* Newton and continuation both lost on a uniform mesh, with no end flagged singular:
+   * once more with both ends integrated as singular and the mesh graded towards them
+   * (HC-3; the Poincare half-plane geodesic between (+-1, 0.01) rises from its ends at
+   * slope 100, which the uniform mesh does not resolve). */
+  if ((st == CVAR_ESTALL || st == CVAR_EDIVERGED || st == CVAR_EMAXITER) &&
+      s->method == CVAR_METHOD_NEWTON && s->mesh.kind == CV_MESH_UNIFORM && !s->start &&
+      s->have && !s->disc.sing_a && !s->disc.sing_b && s->maxit >= 20) {
+    char first[sizeof s->msg];
+    memcpy(first, s->msg, sizeof first);
+    int csteps = s->csteps;
+    s->near_sing[0] = s->near_sing[1] = 1;
+    cv_status st2 = solve_once(s, p);
+    s->near_sing[0] = s->near_sing[1] = 0;
+    if (st2 == CVAR_OK) {
+      char keep[sizeof s->note];
+      memcpy(keep, s->note, sizeof keep);
+      cv_set_msg(s->note, sizeof s->note,
+                 "on the uniform mesh Newton and continuation failed (%s), so both ends were "
+                 "integrated as singular; %s", cv_strerror(st), keep);
+      st = CVAR_OK;
+    } else {
+      /* both attempts failed: say what was tried, with the first attempt's detail */
+      s->note[0] = '\0';
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "%s; with the mesh graded towards both ends and both integrated as singular "
+                 "it failed too (%s)", first, cv_strerror(st2));
+      (void)csteps;
+      st = st2;
+    }
+  }
   for (int end = 0; end < 2 && st == CVAR_OK; end++)
     un[end] = cv_start_end_unresolved(p, &s->disc, s->y, end, s->action, &rel[end]);
   if (un[0] || un[1]) {
@@ -182,12 +216,14 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   s->paths = NULL;
   s->err_est = NAN;
   s->rounds = 0;
-  if (p && p->note) p->note(p->user, 1);
+  for (int k = 0; p && k < p->nnotes; k++) p->notes[k].fn(p->notes[k].user, 1);
   cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
   s->status = st;
   /* A failure the integrand can explain (a table's grid left): the cause first, then what
    * the engine saw. */
-  const char *note = st != CVAR_OK && p && p->note ? p->note(p->user, 0) : NULL;
+  const char *note = NULL;
+  for (int k = 0; st != CVAR_OK && p && k < p->nnotes && !(note && note[0]); k++)
+    note = p->notes[k].fn(p->notes[k].user, 0);
   if (note && note[0]) {
     char m[2 * sizeof s->msg];
     snprintf(m, sizeof m, "%s%s%s", note, s->msg[0] ? "; " : "", s->msg);

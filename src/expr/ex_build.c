@@ -1,7 +1,12 @@
 /* src/expr/ex_build.c — simplifying constructors: constant folding, 0/1 rules, canonical
- * operand order, sign normalisation. SPDX-License-Identifier: MIT
+ * operand order, sign normalisation (docs/theory.md (X-1)). SPDX-License-Identifier: MIT
  * Every rule replaces a node by one that is equal as a real function; none changes the
- * floating-point value except where noted (x - x = 0, 0*x = 0 also at x = inf). */
+ * floating-point value except where noted (x - x = 0, 0*x = 0 also at x = inf).
+ * Constants keep IEEE semantics (theory (EX-1)): a constant whose value is not finite
+ * (0/0, 1/0, sqrt(-1)) is not folded and takes part in no rule, so 0/0, (1/0)-(1/0) and
+ * sqrt(-1)*0 stay formulas whose value is NaN, never 0; the loader then refuses them. The
+ * rules x*0 = 0, x - x = 0 ... still apply to every x that depends on a slot (the
+ * derivative machinery relies on them). */
 #include <math.h>
 
 #include "expr/ex_internal.h"
@@ -15,6 +20,12 @@ static int is_neg_num(const ex_dag *d, ex_id e) { return is_num(d, e) && d->node
 static int is_op(const ex_dag *d, ex_id e, ex_op op) { return d->nodes[e].op == op; }
 static ex_id arg(const ex_dag *d, ex_id e) { return d->nodes[e].a; }
 static double val(const ex_dag *d, ex_id e) { return d->nodes[e].v; }
+/* A constant that did not fold to a finite number: a formula on no slot, or a non-finite
+ * number node. */
+static int bad_const(const ex_dag *d, ex_id e) {
+  const ex_node *nd = &d->nodes[e];
+  return nd->dep == 0 && nd->op != EX_SLOT && (nd->op != EX_NUM || !isfinite(nd->v));
+}
 
 ex_id ex_num(ex_dag *d, double v) {
   if (v == 0) v = 0.0; /* one zero: -0 and +0 are the same node */
@@ -28,11 +39,12 @@ ex_id ex_slot(ex_dag *d, int slot) {
 
 /* Fold an operation whose operands are all numbers, when the result is finite (a
  * non-finite constant stays a formula, so printed text re-parses and a domain error like
- * log(-1) stays visible). Returns -2 when not folded. */
+ * log(-1) stays visible). Returns -2 when an operand is not a number. */
 static ex_id fold(ex_dag *d, ex_op op, ex_id a, ex_id b, ex_id c) {
   if (!is_num(d, a) || (b >= 0 && !is_num(d, b)) || (c >= 0 && !is_num(d, c))) return -2;
   double r = ex_apply(op, val(d, a), b >= 0 ? val(d, b) : 0.0, c >= 0 ? val(d, c) : 0.0);
-  return isfinite(r) ? ex_num(d, r) : -2;
+  /* not finite: kept as the formula itself, untouched by any rule (IEEE: 0/0 is NaN) */
+  return isfinite(r) ? ex_num(d, r) : ex_intern(d, op, a, b, c, 0.0);
 }
 
 /* Canonical order of product operands: numbers first, then by id, so a*b and b*a are one
@@ -55,6 +67,7 @@ ex_id ex_unary(ex_dag *d, ex_op op, ex_id a) {
   if (!ok(d, a) || ex_op_arity(op) != 1) return -1;
   ex_id f = fold(d, op, a, -1, -1);
   if (f != -2) return f;
+  if (bad_const(d, a)) return ex_intern(d, op, a, -1, -1, 0.0); /* IEEE: no rule */
   switch (op) {
   case EX_NEG:
     if (is_op(d, a, EX_NEG)) return arg(d, a);                          /* -(-x) = x */
@@ -158,6 +171,7 @@ ex_id ex_binary(ex_dag *d, ex_op op, ex_id a, ex_id b) {
   if (!ok(d, a) || !ok(d, b) || ex_op_arity(op) != 2) return -1;
   ex_id f = fold(d, op, a, b, -1);
   if (f != -2) return f;
+  if (bad_const(d, a) || bad_const(d, b)) return ex_intern(d, op, a, b, -1, 0.0);
   switch (op) {
   case EX_ADD: return add(d, a, b);
   case EX_SUB: return sub(d, a, b);
@@ -184,6 +198,8 @@ ex_id ex_binary(ex_dag *d, ex_op op, ex_id a, ex_id b) {
 
 ex_id ex_if(ex_dag *d, ex_id c, ex_id a, ex_id b) {
   if (!ok(d, c) || !ok(d, a) || !ok(d, b)) return -1;
+  if (bad_const(d, c) || bad_const(d, a) || bad_const(d, b))
+    return ex_intern(d, EX_IF, c, a, b, 0.0);
   if (is_num(d, c)) return val(d, c) != 0 ? a : b;
   if (a == b) return a;
   return ex_intern(d, EX_IF, c, a, b, 0.0);

@@ -149,6 +149,23 @@ int ex_depends_on(const ex_dag *d, ex_id e, int slot) {
   return found;
 }
 
+ex_id ex_nonfinite_const(const ex_dag *d, ex_id e) {
+  if (!valid(d, e)) return -1;
+  unsigned char *mark = cv_calloc((size_t)e + 1, 1);
+  if (!mark) return -2;
+  ex_mark_reachable(d, e, mark, 0);
+  ex_id found = -1;
+  /* Increasing ids: operands come first, so the first hit is innermost. A constant formula
+   * left unfolded, or a number that is not finite, is what the folder refused. */
+  for (int id = 0; id <= e && found < 0; id++) {
+    const ex_node *nd = &d->nodes[id];
+    if (mark[id] && nd->dep == 0 && nd->op != EX_SLOT && (nd->op != EX_NUM || !isfinite(nd->v)))
+      found = id;
+  }
+  cv_free(mark);
+  return found;
+}
+
 int ex_op_arity(ex_op op) {
   switch (op) {
   case EX_NUM: case EX_SLOT: return 0;

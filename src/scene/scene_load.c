@@ -28,6 +28,13 @@ void scene_free(scene *s)
 {
   if (!s)
     return;
+  if (s->is_instance) { /* only what scene_instance_new copied */
+    cv_free(s->params);
+    cv_free(s->bc);
+    cv_free(s->ints);
+    cv_free(s);
+    return;
+  }
   cv_free(s->file);
   cv_free(s->title);
   cv_free(s->variable);
@@ -217,18 +224,24 @@ static int load_parameters(sc_loader *L, int nset, const sc_set *set)
         over = &set[k]; /* the last --set of a name wins */
     L->limit = i;
     char what[160];
+    ex_id *def = &s->params[i].expr2; /* kept only with parameters as inputs */
     if (over) {
       /* No line to point to: the value came from the command line. */
       sc_entry fake = {NULL, NULL, 0, 0, NULL};
       snprintf(what, sizeof what, "--set %s=%s", over->name, over->value);
-      if (sc_parse_const(L, &fake, 0, over->value, what, &s->params[i].value) < 0)
+      if (sc_parse_const_node(L, &fake, 0, over->value, what, &s->params[i].value, def) < 0)
         return -1;
     } else {
       snprintf(what, sizeof what, "parameter '%s'", e->key);
-      if (sc_parse_const(L, e, 0, e->value, what, &s->params[i].value) < 0)
+      if (sc_parse_const_node(L, e, 0, e->value, what, &s->params[i].value, def) < 0)
         return -1;
     }
-    s->params[i].expr = ex_num(s->dag, s->params[i].value);
+    s->params[i].expr = s->params_as_inputs ? ex_slot(s->dag, 1 + 2 * s->n + i)
+                                            : ex_num(s->dag, s->params[i].value);
+    if (s->params[i].expr < 0) {
+      sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
+      return -1;
+    }
   }
   return 0;
 }
@@ -284,8 +297,10 @@ static int load_interval_integrand(sc_loader *L)
            "interval needs two values 'a, b', got %d", list.n);
     goto done;
   }
-  if (sc_parse_const(L, e, list.off[0], list.item[0], "interval start a", &s->a) < 0 ||
-      sc_parse_const(L, e, list.off[1], list.item[1], "interval end b", &s->b) < 0)
+  if (sc_parse_const_node(L, e, list.off[0], list.item[0], "interval start a", &s->a,
+                          &s->a_expr) < 0 ||
+      sc_parse_const_node(L, e, list.off[1], list.item[1], "interval end b", &s->b,
+                          &s->b_expr) < 0)
     goto done;
   if (!(s->a < s->b)) {
     sc_err(L->err, L->errlen, L->file, e->line,
@@ -302,8 +317,8 @@ done:
   return rc;
 }
 
-scene *scene_load_buffer(const char *text, size_t len, const char *name, int nset,
-                         const sc_set *set, char *err, size_t errlen)
+static scene *load_buffer(const char *text, size_t len, const char *name, int nset,
+                          const sc_set *set, int inputs, char *err, size_t errlen)
 {
   sc_loader L;
   memset(&L, 0, sizeof L);
@@ -316,6 +331,8 @@ scene *scene_load_buffer(const char *text, size_t len, const char *name, int nse
     return NULL;
   }
   s->F = -1;
+  s->params_as_inputs = inputs;
+  s->a_expr = s->b_expr = s->exact_action_expr = -1;
   L.s = s;
   L.file = s->file;
   L.err = err;
@@ -338,38 +355,14 @@ scene *scene_load_buffer(const char *text, size_t len, const char *name, int nse
   return s;
 }
 
-scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
-                       size_t errlen)
+scene *scene_load_buffer(const char *text, size_t len, const char *name, int nset,
+                         const sc_set *set, char *err, size_t errlen)
 {
-  if (err && errlen)
-    err[0] = '\0';
-  FILE *f = fopen(path, "rb");
-  if (!f) {
-    sc_err(err, errlen, path, 0, "cannot open: %s", strerror(errno));
-    return NULL;
-  }
-  size_t cap = 4096, len = 0;
-  char *buf = cv_malloc(cap);
-  while (buf) {
-    size_t k = fread(buf + len, 1, cap - len, f);
-    len += k;
-    if (len < cap)
-      break;
-    char *nb = cv_realloc(buf, cap *= 2);
-    if (!nb) {
-      cv_free(buf);
-      buf = NULL;
-    } else
-      buf = nb;
-  }
-  int bad = ferror(f);
-  fclose(f);
-  if (!buf || bad) {
-    cv_free(buf);
-    sc_err(err, errlen, path, 0, bad ? "read error" : "out of memory");
-    return NULL;
-  }
-  scene *s = scene_load_buffer(buf, len, path, nset, set, err, errlen);
-  cv_free(buf);
-  return s;
+  return load_buffer(text, len, name, nset, set, 0, err, errlen);
+}
+
+scene *scene_load_buffer_inputs(const char *text, size_t len, const char *name, int nset,
+                                const sc_set *set, char *err, size_t errlen)
+{
+  return load_buffer(text, len, name, nset, set, 1, err, errlen);
 }

@@ -70,6 +70,12 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
       snprintf(err, errlen, "a prime is only allowed on an unknown, not on '%s'", name);
       return -1;
     }
+    if (s->params_as_inputs) {
+      ex_id r = ex_slot(d, 1 + 2 * s->n + i); /* an input of the tape, not a number */
+      if (r < 0)
+        snprintf(err, errlen, "out of memory");
+      return r;
+    }
     return ex_num(d, s->params[i].value);
   }
   if (L->mode == SC_R_PARAM) {
@@ -122,8 +128,26 @@ ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const
     return -1;
   }
   ex_id r = ex_parse(L->s->dag, text, resolve, L, 0, msg, sizeof msg);
-  if (r >= 0)
-    return r;
+  if (r >= 0) {
+    /* A constant that is not finite (0/0, log(0), sqrt(-1)*0) is bad input, never a NaN
+     * carried into the solve (theory (EX-1)). */
+    ex_id bad = ex_nonfinite_const(L->s->dag, r);
+    if (bad == -1)
+      return r;
+    char sub[160] = "?";
+    double v = NAN;
+    if (bad >= 0) {
+      ex_print(L->s->dag, bad, NULL, sub, sizeof sub);
+      ex_eval_const(L->s->dag, bad, &v);
+    }
+    sc_entry_locate(e, off, &line, &col);
+    if (bad == -2)
+      sc_err(L->err, L->errlen, L->file, line, "%s: out of memory", what);
+    else
+      sc_err(L->err, L->errlen, L->file, line, "%s: the constant '%s' is not a finite number "
+             "(%s)", what, sub, isnan(v) ? "NaN" : v > 0 ? "+inf" : "-inf");
+    return -1;
+  }
   int c = 0, k = 0;
   if (sscanf(msg, "column %d: %n", &c, &k) >= 1 && k > 0 && c >= 1) {
     sc_entry_locate(e, off + c - 1, &line, &col);
@@ -137,26 +161,66 @@ ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const
 
 /* A constant expression (numbers, pi, parameters, definitions built from those), which
  * must be finite. Returns 0, or -1 with a message. */
+int sc_eval_params(const scene *s, ex_id e, double *value)
+{
+  int ns = 1 + 2 * s->n + s->nparams;
+  double *slots = cv_calloc((size_t)ns, sizeof *slots);
+  if (!slots)
+    return -1;
+  for (int i = 0; i < s->nparams; i++)
+    slots[1 + 2 * s->n + i] = s->params[i].value;
+  int rc = ex_eval(s->dag, e, slots, value);
+  cv_free(slots);
+  return rc;
+}
+
 int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
                    const char *what, double *value)
+{
+  ex_id node;
+  if (sc_parse_const_node(L, e, off, text, what, value, &node) < 0)
+    return -1;
+  /* A [mesh] or [solver] number: kept as a number even when it uses parameters (the
+   * batch refuses such a scene when a row sets one, docs/cli.md). */
+  if (L->s->params_as_inputs && !L->s->settings_line &&
+      sc_first_slot(L->s, node, 1 + 2 * L->s->n, 2 * L->s->n + L->s->nparams) >= 0)
+    L->s->settings_line = e->line ? e->line : -1;
+  return 0;
+}
+
+int sc_parse_const_node(sc_loader *L, const sc_entry *e, int off, const char *text,
+                        const char *what, double *value, ex_id *node)
 {
   char nb[128];
   int line, col;
   ex_id r = sc_parse(L, e, off, text, what);
+  if (node)
+    *node = -1;
   if (r < 0)
     return -1;
   sc_entry_locate(e, off, &line, &col);
   int slot = sc_first_slot(L->s, r, 0, 2 * L->s->n);
-  if (slot >= 0 || ex_eval_const(L->s->dag, r, value) != 0) {
+  int bad = slot >= 0;
+  if (!bad && L->s->params_as_inputs) {
+    if (sc_eval_params(L->s, r, value) < 0) {
+      sc_err(L->err, L->errlen, L->file, line, "out of memory");
+      return -1;
+    }
+  } else if (!bad) {
+    bad = ex_eval_const(L->s->dag, r, value) != 0;
+  }
+  if (bad) {
     sc_err(L->err, L->errlen, L->file, line,
            "%s must be a constant expression, but '%s' depends on '%s'", what, text,
            slot >= 0 ? sc_slot_name(L->s, slot, nb, sizeof nb) : "?");
     return -1;
   }
   if (!isfinite(*value)) {
-    sc_err(L->err, L->errlen, L->file, line, "%s '%s' is not a finite number (%g)", what,
-           text, *value);
+    sc_err(L->err, L->errlen, L->file, line, "%s '%s' is not a finite number (%s)", what,
+           text, isnan(*value) ? "NaN" : *value > 0 ? "+inf" : "-inf");
     return -1;
   }
+  if (node)
+    *node = r;
   return 0;
 }

@@ -229,12 +229,80 @@ with tempfile.TemporaryDirectory() as tmp:
         kinds = [s_["morse_index"] for s_ in out["solutions"]]
         check("mirage: two minima and a saddle", sorted(kinds) == [0, 0, 1], kinds)
 
+
+# ---- constraints. Integral: int y'^2/2 on [0, pi] with int y^2 = 1 is stationary on
+# y = +-sqrt(2/pi) sin(k x), action k^2/2, Morse index k - 1 (on the constraint's tangent
+# space). Pointwise: great-circle arcs on the unit sphere (x^2 + y^2 + z^2 = 1).
+def table(scene, *extra):
+    with tempfile.TemporaryDirectory() as tmp:
+        c = os.path.join(tmp, "t.csv")
+        r = run("solve", os.path.join(data, scene), "--all", "--json", "-", "--csv", c, *extra)
+        if r.returncode != 0:
+            return None, None
+        return json.loads(r.stdout), list(csv.reader(open(c)))
+
+
+out, rows = table("eigen_integral.scene", "--max", "6", "--work", "100")
+if out:
+    sols = out["solutions"]
+    check("eigen: six paths", len(sols) == 6, len(sols))
+    for k, s_ in enumerate(sols):
+        m = k // 2 + 1
+        pts = [(float(r_[1]), float(r_[2])) for r_ in rows[1:] if r_[0] == str(k + 1)]
+        sign = 1 if sum(y * math.sin(m * x) for x, y in pts) > 0 else -1
+        err = max(abs(y - sign * math.sqrt(2 / math.pi) * math.sin(m * x)) for x, y in pts)
+        check("eigen path %d: +-sqrt(2/pi) sin(%d x)" % (k + 1, m), err < 1e-8, err)
+        check("eigen path %d: action %d^2/2" % (k + 1, m), abs(s_["action"] - m * m / 2) < 1e-9,
+              s_["action"])
+        check("eigen path %d: Morse index %d" % (k + 1, m - 1), s_["morse_index"] == m - 1, s_)
+
+out, rows = table("sphere_arcs.scene")
+if out:
+    sols = out["solutions"]
+    check("sphere: both arcs", len(sols) == 2, len(sols))
+    for k, (ang, morse) in enumerate(((math.pi / 2, 0), (-3 * math.pi / 2, 1))):
+        if k >= len(sols):
+            break
+        pts = [[float(v) for v in r_[1:5]] for r_ in rows[1:] if r_[0] == str(k + 1)]
+        err = max(max(abs(x - math.cos(ang * t)), abs(y - math.sin(ang * t)), abs(z))
+                  for t, x, y, z in pts)
+        check("sphere arc %d: the great circle of angle %.4f" % (k + 1, ang), err < 1e-8, err)
+        check("sphere arc %d: action" % (k + 1), abs(sols[k]["action"] - ang * ang / 2) < 1e-9,
+              sols[k]["action"])
+        check("sphere arc %d: Morse index %d" % (k + 1, morse), sols[k]["morse_index"] == morse,
+              sols[k])
+
 # ---- a convex action: exactly one path
 out = with_nodes("convex.scene")
 if out:
     common(out, "convex")
     check("convex: exactly one path", len(out["solutions"]) == 1, len(out["solutions"]))
     check("convex: a minimum", out["solutions"][0]["stationary_kind"] == "minimum", out)
+
+
+# ---- nothing converged (Bratu has no solution beyond lambda = 3.51...): exit 1, a
+# sentence on stderr, a JSON with no solutions and the search record
+with tempfile.TemporaryDirectory() as tmp:
+    j = os.path.join(tmp, "none.json")
+    r = run("solve", os.path.join(data, "bratu.scene"), "--all", "--set", "lambda=4",
+            "--json", j, expect_rc=1)
+    check("no path: a sentence", "no converged stationary path" in r.stderr, r.stderr)
+    if os.path.exists(j):
+        d = json.load(open(j))
+        check("no path: empty list", d.get("solutions") == [] and d["search"]["found"] == 0, d)
+
+# ---- with --adapt: both catenaries, each on its own adapted mesh with its own estimate
+r = run("solve", os.path.join(data, "catenary_two.scene"), "--all", "--adapt", "1e-9",
+        "--elements", "8", "--degree", "4", "--json", "-")
+if r.returncode == 0:
+    sols = json.loads(r.stdout)["solutions"]
+    check("adapt: two paths", len(sols) == 2, len(sols))
+    check("adapt: Morse 0 and 1", [s_["morse_index"] for s_ in sols] == [0, 1], sols)
+    f = lambda c: c * math.cosh(1 / c) - 2
+    for s_, c in zip(sols, (bisect(f, 0.9, 5.0), bisect(f, 0.2, 0.85))):
+        area = c * (1 + c / 2 * math.sinh(2 / c))
+        check("adapt: estimate at most the tolerance", s_.get("error_estimate", 1) <= 1e-9, s_)
+        check("adapt: action", abs(s_["action"] - area) < 1e-8, (s_["action"], area))
 
 # ---- --max 1 returns the lowest-action path found
 for scene in ("bratu.scene", "pendulum_swings.scene", "catenary_two.scene"):

@@ -65,7 +65,9 @@ static void check_texts(void) {
   print_to(d, lt, buf, sizeof buf);
   CHECK(strcmp(buf, "if(x < y, 1, 0)") == 0, "comparison as a value: \"%s\"", buf);
   print_to(d, ex_binary(d, EX_ADD, ex_num(d, INFINITY), ex_slot(d, 0)), buf, sizeof buf);
-  CHECK(strcmp(buf, "x + (1/0)") == 0, "infinity: \"%s\"", buf);
+  /* a non-finite constant takes part in no rewriting rule (theory (EX-1)), not even the
+   * canonical order of a sum */
+  CHECK(strcmp(buf, "(1/0) + x") == 0, "infinity: \"%s\"", buf);
   /* Truncation: like snprintf. */
   char small[5];
   size_t n = ex_print(d, parse_ok(d, "sin(x) + cos(y)"), slot_names, small, sizeof small);

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "calcvar.h"
+#include "expr/expr.h"
 
 static int failures = 0;
 #define CHECK(cond, ...)                                                                     \
@@ -59,7 +60,8 @@ static cv_table *sample(int dim, int n, const double *lo, const double *hi, fn3 
 }
 
 static double cubic3(const double *u) {
-  return 1 + u[0] - 2 * u[0] * u[0] * u[0] + u[0] * u[1] * u[1] * u[1] - 0.5 * u[2] * u[2] * u[2] * u[1] +
+  return 1 + u[0] - 2 * u[0] * u[0] * u[0] + u[0] * u[1] * u[1] * u[1] -
+         0.5 * u[2] * u[2] * u[2] * u[1] +
          u[0] * u[0] * u[1] * u[2];
 }
 /* its exact partials: grad and a few second/third orders */
@@ -89,7 +91,8 @@ static void test_cubic_exact(void) {
     double worst = 0;
     for (int s = 0; s < 50; s++) {
       double u[3];
-      for (int k = 0; k < 3; k++) u[k] = lo[k] + (hi[k] - lo[k]) * fmod(0.6180339887 * (s + 1) * (k + 1.3), 1.0);
+      for (int k = 0; k < 3; k++)
+        u[k] = lo[k] + (hi[k] - lo[k]) * fmod(0.6180339887 * (s + 1) * (k + 1.3), 1.0);
       for (size_t j = 0; j < sizeof ords / sizeof ords[0]; j++) {
         double v;
         CHECK(cv_table_eval(t, u, ords[j], &v) == 0, "eval inside the grid failed");
@@ -175,7 +178,8 @@ typedef struct {
 static const ray_case cases[] = {
     {"1-D n(y)", 1, 1, -1.2, 1.2, {1.5}, {2.05}, n1, ray1, "y", "n(y)*sqrt(1 + y'^2)",
      "sqrt(1 + y'^2)/y"},
-    {"2-D n(x, y)", 2, 1, -0.8, 0.8, {-0.8, 0.2}, {0.8, 0.65}, n2, ray2, "y", "n(x, y)*sqrt(1 + y'^2)",
+    {"2-D n(x, y)", 2, 1, -0.8, 0.8, {-0.8, 0.2}, {0.8, 0.65}, n2, ray2, "y",
+     "n(x, y)*sqrt(1 + y'^2)",
      "2/(1 + x^2 + y^2)*sqrt(1 + y'^2)"},
     {"3-D n(x, y, z)", 3, 2, -0.8, 0.8, {-0.8, 0.2, 0.15}, {0.8, 0.52, 0.39}, n3, ray3, "y, z",
      "n(x, y, z)*sqrt(1 + y'^2 + z'^2)", "2/(1 + x^2 + y^2 + z^2)*sqrt(1 + y'^2 + z'^2)"},
@@ -263,7 +267,8 @@ static void test_outside(void) {
   cv_table *t = sample(2, 8, c->lo, c->hi, c->f, 0);
   char msg[700];
   int it;
-  double e = solve_ray(c, t, &it, msg, sizeof msg, 0.2); /* ends at y = 0.2, but the middle at 0.82 > 0.65 */
+  /* ends at y = 0.48, inside; the ray's middle would be at 0.82 > 0.65 */
+  double e = solve_ray(c, t, &it, msg, sizeof msg, 0.2);
   printf("outside the grid: %s\n", msg);
   CHECK(e < 0, "a solve with its ends outside the grid succeeded");
   CHECK(strstr(msg, "table 'n'") != NULL, "the message does not name the table: %s", msg);
@@ -304,7 +309,48 @@ static void test_api_errors(void) {
   cv_table_free(t);
 }
 
+/* Table calls in the DAG: printing parses back to the same node; d/dy of n(x, y) is the
+ * node n.2(x, y), of n(x, y^2) is 2*y*n.2(x, y^2); derivative orders above 3 are 0. */
+static ex_id xy(ex_dag *d, const char *name, int primes, void *user, char *err, size_t len) {
+  (void)user, (void)primes, (void)err, (void)len;
+  return strcmp(name, "x") == 0 ? ex_slot(d, 0) : strcmp(name, "y") == 0 ? ex_slot(d, 1) : -1;
+}
+static void test_dag(void) {
+  double lo[2] = {0, 0}, hi[2] = {1, 1};
+  cv_table *t = sample(2, 6, lo, hi, n2, 0);
+  ex_dag *d = ex_dag_new();
+  CHECK(ex_dag_add_table(d, "n", t) == 0, "ex_dag_add_table failed");
+  CHECK(ex_dag_add_table(d, "exp", t) < 0, "a table named like a function was accepted");
+  cv_table_free(t); /* the DAG keeps its own reference */
+  char err[200], buf[400];
+  const char *src = "n.12(x, y)*n(y, x) + n.2(x, 2*y)/n.111(0.5, y)";
+  ex_id e = ex_parse(d, src, xy, NULL, 0, err, sizeof err);
+  CHECK(e >= 0, "parse: %s", err);
+  const char *names[2] = {"x", "y"};
+  ex_print(d, e, names, buf, sizeof buf);
+  ex_id back = ex_parse(d, buf, xy, NULL, 0, err, sizeof err);
+  printf("printed: %s\n", buf);
+  CHECK(back == e, "'%s' printed as '%s' does not parse back to the same node", src, buf);
+  ex_id f = ex_parse(d, "n(x, y^2)", xy, NULL, 0, err, sizeof err);
+  ex_id df = ex_diff(d, f, 1);
+  ex_id expect = ex_parse(d, "n.2(x, y^2)*(2*y)", xy, NULL, 0, err, sizeof err);
+  double sl[2] = {0.3, 0.6}, v1, v2;
+  ex_eval(d, df, sl, &v1);
+  ex_eval(d, expect, sl, &v2);
+  CHECK(fabs(v1 - v2) < 1e-15 * fabs(v2), "d/dy n(x, y^2) = %.17g, expected %.17g", v1, v2);
+  ex_id d4 = ex_parse(d, "n.2222(x, y)", xy, NULL, 0, err, sizeof err);
+  CHECK(d4 >= 0 && ex_node_op(d, d4) == EX_NUM && ex_node_value(d, d4) == 0,
+        "a fourth derivative of the cubic is not 0");
+  ex_id c = ex_parse(d, "n(0.5, 0.25)", xy, NULL, 0, err, sizeof err);
+  double u[2] = {0.5, 0.25}, tv;
+  cv_table_eval(t, u, NULL, &tv); /* t is still alive: the DAG holds it */
+  CHECK(c >= 0 && ex_node_op(d, c) == EX_NUM && ex_node_value(d, c) == tv,
+        "a call at numbers inside the grid did not fold to the spline's value");
+  ex_dag_free(d);
+}
+
 int main(void) {
+  test_dag();
   test_cubic_exact();
   test_order_and_partials();
   test_rays();

@@ -2,11 +2,13 @@
  * whatever loads into the problem builder and the evaluators. Built by scripts/fuzz.sh
  * (clang -fsanitize=fuzzer,address,undefined), not by the default meson build.
  * SPDX-License-Identifier: MIT */
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "expr/expr.h"
 #include "scene/scene.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -24,6 +26,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
       abort();
     return 0;
   }
+  /* Constant folding keeps IEEE values and the loader refuses what is not finite: no
+   * expression of a loaded scene holds a non-finite constant (theory (EX-1)). */
+  if (ex_nonfinite_const(s->dag, s->F) != -1)
+    abort();
+  for (int i = 0; i < s->ndefs; i++)
+    if (ex_nonfinite_const(s->dag, s->defs[i].expr) != -1)
+      abort();
+  for (int i = 0; i < s->nparams; i++)
+    if (!isfinite(s->params[i].value))
+      abort();
   cv_problem *p = scene_problem_new(s, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, err,
                                     sizeof err);
   int n = s->n, m = 5;
