@@ -169,7 +169,6 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
       s->have && !s->disc.sing_a && !s->disc.sing_b && s->maxit >= 20) {
     char first[sizeof s->msg];
     memcpy(first, s->msg, sizeof first);
-    int csteps = s->csteps;
     s->near_sing[0] = s->near_sing[1] = 1;
     cv_status st2 = solve_once(s, p);
     s->near_sing[0] = s->near_sing[1] = 0;
@@ -186,7 +185,6 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
       cv_set_msg(s->msg, sizeof s->msg,
                  "%s; with the mesh graded towards both ends and both integrated as singular "
                  "it failed too (%s)", first, cv_strerror(st2));
-      (void)csteps;
       st = st2;
     }
   }
