@@ -18,6 +18,18 @@
  * solve runs CHOLMOD's symbolic analysis of the sparse pattern on one extra thread of its
  * own, which it joins before it returns; no user code runs there.
  *
+ * Array layouts (one per kind of array, the same in every call):
+ *  - values at the mesh nodes are node-major: y[j*n + i] is unknown i at node j
+ *    (cv_solver_get_values, cv_solver_set_start); so a node's n values are adjacent, and a
+ *    C array y[nodes][n] (numpy shape (nodes, n), C order) is this layout;
+ *  - one value per node (nodes, multiplier fields) is a plain array x[j], lambda[j];
+ *  - values at a batch of m points are unknown-major: y[i*m + k] (the integrand, guess and
+ *    constraint callbacks, cv_solver_get_qpoints, cv_solver_eval), so that each unknown's m
+ *    values are adjacent for vectorised evaluation.
+ *
+ * Only the names declared here are exported from libcalcvar.so (CVAR_API); everything else
+ * in the library is internal.
+ *
  * Minimal use (the catenary, see examples/catenary.c):
  * \code
  *   cv_status why;
@@ -85,14 +97,15 @@ CVAR_API void cv_version(int *major, int *minor, int *patch);
   X(CVAR_EDIVERGED, "the iteration diverged")                                                 \
   X(CVAR_ENOTMIN, "the stationary point is not a minimum")                                   \
   X(CVAR_EDEPENDENCY, "failure inside a dependency (CHOLMOD, NLopt)")                         \
-  X(CVAR_ESTATE, "no solution available (call cv_solve first)")
+  X(CVAR_ESTATE, "no solution available (call cv_solve first)")                              \
+  X(CVAR_ECANCELLED, "cancelled by the progress callback")
 
 /** Turns one CVAR_STATUS_LIST entry into an enumerator (undefined again below). */
 #define CVAR_ENUM_ITEM(name, msg) name,
 /** Result of every fallible call. CVAR_OK is 0; all other values are failures. The values,
  * in order, are those of CVAR_STATUS_LIST: CVAR_OK, CVAR_EINVAL, CVAR_ENOMEM, CVAR_ECALLBACK,
  * CVAR_ENONFINITE, CVAR_ESINGULAR, CVAR_EMAXITER, CVAR_ESTALL, CVAR_EDIVERGED, CVAR_ENOTMIN,
- * CVAR_EDEPENDENCY, CVAR_ESTATE; CVAR_NUM_STATUS counts them. */
+ * CVAR_EDEPENDENCY, CVAR_ESTATE, CVAR_ECANCELLED; CVAR_NUM_STATUS counts them. */
 typedef enum { CVAR_STATUS_LIST(CVAR_ENUM_ITEM) CVAR_NUM_STATUS } cv_status;
 #undef CVAR_ENUM_ITEM
 
@@ -100,6 +113,10 @@ typedef enum { CVAR_STATUS_LIST(CVAR_ENUM_ITEM) CVAR_NUM_STATUS } cv_status;
 CVAR_API const char *cv_strerror(cv_status s);
 /** The symbolic name of a status, e.g. "CVAR_EMAXITER"; never NULL. */
 CVAR_API const char *cv_status_name(cv_status s);
+/** The libraries linked into libcalcvar with their versions, as the libraries report them
+ * at run time, e.g. "CHOLMOD 3.0.14, NLopt 2.7.1, LAPACK 3.11.0, jansson 2.14, inih", into
+ * buf (len bytes; 160 is ample). CVAR_EINVAL when it does not fit. */
+CVAR_API cv_status cv_dependency_versions(char *buf, size_t len);
 /**@}*/
 
 /** \name Integrand callbacks */
@@ -222,7 +239,8 @@ CVAR_API cv_status cv_table_get_range(const cv_table *t, int k, double *lo, doub
 CVAR_API int cv_table_eval(const cv_table *t, const double *u, const int *order, double *value);
 /** Make t callable as `name(u)`, `name(u, v)` or `name(u, v, w)` (and its derivatives
  * `name.1(...)`, `name.12(...)`, docs/expressions.md) in the formulas given afterwards to
- * cv_problem_set_integrand_expr. The problem takes its own reference. The name must be an
+ * cv_problem_set_integrand_expr, cv_problem_add_constraint_expr and
+ * cv_problem_add_integral_expr. The problem takes its own reference. The name must be an
  * identifier that is not a function, pi, or a table already added (CVAR_EINVAL). When a
  * solve fails after the path left a table's grid, cv_solver_last_error() names the table. */
 CVAR_API cv_status cv_problem_add_table(cv_problem *p, const char *name, cv_table *t);
@@ -383,6 +401,32 @@ CVAR_API int cv_solver_get_adapt_rounds(const cv_solver *s);
  * the current mesh and degree); NULL returns to the problem's guess. Copied. */
 CVAR_API cv_status cv_solver_set_start(cv_solver *s, int len, const double *y);
 
+/** What a progress callback is told (cv_solver_set_progress). */
+typedef struct {
+  int kind;        /**< CVAR_PROGRESS_NEWTON after a Newton step, CVAR_PROGRESS_ROUND after
+                        an adaptive round's error estimate */
+  int iteration;   /**< Newton iteration of the current mesh solve, 1, 2, ... (NEWTON) */
+  double residual; /**< scaled Euler-Lagrange residual (theory N-3) of the iterate the step
+                        started from (NEWTON) */
+  double step;     /**< weighted RMS norm of the Newton step (theory N-4); <= 1 ends the
+                        iteration (NEWTON) */
+  double alpha;    /**< line-search factor of the step taken, 1 for a full step (NEWTON) */
+  double action;   /**< discrete action after the step (NEWTON) */
+  int round;       /**< adaptive refinement round, 1, 2, ...; 0 when not adaptive */
+  int elements;    /**< elements of the mesh being solved */
+  double estimate; /**< estimated max nodal error after the round (ROUND); NaN otherwise */
+} cv_progress;
+/** Values of cv_progress.kind. */
+enum { CVAR_PROGRESS_NEWTON = 0, CVAR_PROGRESS_ROUND = 1 };
+/** Progress callback: return 0 to go on, nonzero to cancel the solve (cv_solve then returns
+ * CVAR_ECANCELLED, and the results describe the last iterate). */
+typedef int (*cv_progress_fn)(const cv_progress *info, void *user);
+/** Call fn on the calling thread of cv_solve after every Newton step and every adaptive
+ * round (NLopt engines report nothing); NULL turns it off. Newton runs inside automatic
+ * continuation are reported like any other (their iteration count restarts); the reference
+ * solves of adaptive refinement are not. */
+CVAR_API cv_status cv_solver_set_progress(cv_solver *s, cv_progress_fn fn, void *user);
+
 /** Status of the last solve (CVAR_ESTATE before any). */
 CVAR_API cv_status cv_solver_get_status(const cv_solver *s);
 /** One sentence about the last failure or outcome; never NULL. */
@@ -488,6 +532,65 @@ CVAR_API cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *
 CVAR_API const char *cv_report_json(const cv_report *r);
 /** Release a report; NULL is a no-op. */
 CVAR_API void cv_report_free(cv_report *r);
+/**@}*/
+
+/** @name Many parameter sets on one compiled scene (the engine of `calcvar batch`)
+ * A scene file is read and compiled once, its [parameters] as inputs of the compiled
+ * expressions; each row (values of some parameters) is then solved as `calcvar solve
+ * SCENE --set name=value ...` would solve it, on several threads (docs/scale-out.md).
+ * @{ */
+/** A compiled scene and its per-thread solvers. */
+typedef struct cv_batch cv_batch;
+
+/** One solved row. outputs is the caller's: NULL, or room for cv_batch_num_outputs()
+ * values (the [report] integrals, then the [integrals] multipliers), NaN where absent. */
+typedef struct {
+  cv_status status;       /**< CVAR_OK only when converged */
+  int iterations;         /**< Newton (or minimiser) iterations */
+  double time_s;          /**< wall-clock seconds of this row */
+  int has_result;         /**< converged: action, morse_index, errors, outputs are set */
+  double action;          /**< the discrete action */
+  int morse_index;        /**< -1 when unknown (a method other than Newton) */
+  double error_max_nodal; /**< against [exact]; NaN without it */
+  double error_estimate;  /**< of an adaptive solve; NaN otherwise */
+  double *outputs;        /**< see above */
+  int warm;               /**< 1: started from the previous row's solution */
+  char message[400];      /**< the report's sentence */
+} cv_batch_result;
+
+/** Read and compile the scene file (exit-2 kind of problems come back NULL with
+ * "FILE:LINE: what is wrong" in err). */
+CVAR_API cv_batch *cv_batch_new(const char *scene_path, char *err, size_t errlen);
+/** Release; NULL is a no-op. */
+CVAR_API void cv_batch_free(cv_batch *b);
+/** The number of the scene's [parameters]. */
+CVAR_API int cv_batch_num_parameters(const cv_batch *b);
+/** Name of parameter i (file order), NULL when out of range. */
+CVAR_API const char *cv_batch_parameter_name(const cv_batch *b, int i);
+/** Result columns besides the fixed ones: [report] names, then "mu_" + integral name. */
+CVAR_API int cv_batch_num_outputs(const cv_batch *b);
+/** Name of output k, NULL when out of range. */
+CVAR_API const char *cv_batch_output_name(const cv_batch *b, int k);
+/** Which parameters a row gives, in order (default: none, i.e. the scene's values). Set
+ * before the first cv_batch_solve (CVAR_EINVAL after it). */
+CVAR_API cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names,
+                                        char *err, size_t errlen);
+/** Threads (default 1; 0 = the cores available). */
+CVAR_API cv_status cv_batch_set_threads(cv_batch *b, int nthreads);
+/** Start each row from the previous row's solution on the same thread (default off); a
+ * failed warm start is retried from the scene's guess and the row's message says so. */
+CVAR_API cv_status cv_batch_set_warm_start(cv_batch *b, int on);
+/** Override [mesh] elements and degree (0 keeps the scene's). */
+CVAR_API cv_status cv_batch_set_mesh(cv_batch *b, int elements, int degree);
+/** Check a row's values without solving: CVAR_EINVAL with a sentence when they make the
+ * scene invalid (e.g. an interval with a >= b). */
+CVAR_API cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err,
+                                      size_t errlen);
+/** Solve nrows rows (row r is rows[r*ncols .. r*ncols+ncols-1]); res[r] receives row r
+ * whatever order the threads took them in. CVAR_OK when the rows were all attempted (each
+ * has its own status), else an error for the whole call (e.g. CVAR_ENOMEM). */
+CVAR_API cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows,
+                                  cv_batch_result *res);
 /**@}*/
 
 /** \name Every stationary path: deflation (theory DF-1..DF-5) */

@@ -79,7 +79,8 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     memcpy(name, a, nl);
     name[nl] = '\0';
     int flag = strcmp(name, "--quiet") == 0 || strcmp(name, "--help") == 0 ||
-               strcmp(name, "-h") == 0 || strcmp(name, "--all") == 0;
+               strcmp(name, "-h") == 0 || strcmp(name, "--all") == 0 ||
+               strcmp(name, "--verbose") == 0 || strcmp(name, "-v") == 0;
     static const char *const valued[] = {
       "--elements", "--degree", "--method", "--tolerance", "--max-iterations", "--set",
       "--adapt", "--continue", "--json", "--csv", "--plot", "--max", "--work",
@@ -96,6 +97,8 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
         o->quiet = 1;
       else if (strcmp(name, "--all") == 0)
         o->all = 1;
+      else if (strcmp(name, "--verbose") == 0 || strcmp(name, "-v") == 0)
+        o->verbose = 1;
       else
         o->help = 1;
       continue;
@@ -192,10 +195,44 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
 }
 
 /* For commands that only read a scene (equations, modes): reject solve-only options. */
+int cli_scene_command_start(const char *cmd, int argc, char **argv, void (*usage)(FILE *),
+                            cli_opts *o, scene **s, cli_outfile *jf)
+{
+  char err[SC_ERRLEN] = "";
+  *s = NULL;
+  int rc = cli_args_parse(cmd, argc, argv, o);
+  if (rc != 0 || o->help) {
+    if (o->help)
+      usage(stdout);
+    return rc;
+  }
+  if ((rc = cli_only_scene_options(cmd, o)) != 0)
+    return rc;
+  if (!(*s = scene_load_file(o->scene_path, o->nset, o->set, err, sizeof err))) {
+    fprintf(stderr, "%s\n", err);
+    return EXIT_BADINPUT;
+  }
+  /* Output files are opened before the work: an unwritable path is bad input. */
+  if (o->json && cli_outfile_open(jf, o->json, o->scene_path) < 0)
+    return EXIT_BADINPUT;
+  return -1;
+}
+
+void cli_apply_solver_options(const cli_opts *o, scene *s)
+{
+  if (o->method >= 0)
+    s->method = (cv_method)o->method;
+  if (o->tolerance > 0)
+    s->tolerance = o->tolerance;
+  if (o->max_iterations)
+    s->max_iterations = o->max_iterations;
+}
+
 int cli_only_scene_options(const char *cmd, const cli_opts *o)
 {
   if (o->csv || o->plot || o->adapt > 0 || o->cont || o->elements || o->degree ||
-      o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all || o->max_elements) {
+      o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all || o->max_elements ||
+      o->verbose) {
     fprintf(stderr, "calcvar %s: only --set, --json and --quiet apply to %s\n", cmd, cmd);
     return EXIT_BADINPUT;
   }

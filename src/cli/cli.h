@@ -25,7 +25,7 @@ typedef struct {
   int nset;
   sc_set *set;
   const char *json, *csv, *plot;
-  int quiet, help;
+  int quiet, help, verbose;
   int all, max_paths; /* --all, --max K (0: default 8) */
   double work;        /* --work F: the search's work limit (0: default 8) */
 } cli_opts;
@@ -37,10 +37,21 @@ void cli_opts_free(cli_opts *o);
 /* For commands that only read a scene: EXIT_BADINPUT (after a message) if a solve-only
  * option was given, else 0. */
 int cli_only_scene_options(const char *cmd, const cli_opts *o);
+/* --method, --tolerance and --max-iterations, where given, override the scene's [solver]. */
+void cli_apply_solver_options(const cli_opts *o, scene *s);
+
+/* progress.c: --verbose lines and the terminal status line (see there). */
+void cli_progress_setup(int verbose);
+void cli_progress_attach(cv_solver *sv);
+void cli_progress_end(void);
 
 /* cli_continue.c: `solve --continue name=from:to` (see there). */
-int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver **svp,
-                       cv_status *stp, char *cont_msg, size_t cmlen, char *err, size_t errlen);
+/* s0: the scene, loaded once with parameters as inputs (scene_load_file_inputs) and
+ * owned from here on; it is compiled once. *bp owns it and *sp is its instance at the
+ * reported value: free *pp and *svp, then cv_batch_free(*bp). */
+int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene **sp,
+                       cv_problem **pp, cv_solver **svp, cv_status *stp, char *cont_msg,
+                       size_t cmlen, char *err, size_t errlen);
 
 int cli_report_csv(FILE *f, const cli_report *r);
 void cli_report_text(FILE *f, const cli_report *r);
@@ -66,6 +77,12 @@ int cli_outfile_finish(cli_outfile *o, int wrote);
 int cli_outfile_render_name(cli_outfile *o, const char **name);
 int cli_outfile_commit_rendered(cli_outfile *o);
 void cli_outfile_abandon(cli_outfile *o);
+/* args.c: the start of a command that reads one scene (equations, modes): parse the
+ * arguments (--help prints usage), accept only the scene options, load the scene into *s
+ * and open --json's file in *jf. Returns -1 to go on, else the exit status (after a
+ * message); the caller releases o, *s and *jf in either case. */
+int cli_scene_command_start(const char *cmd, int argc, char **argv, void (*usage)(FILE *),
+                            cli_opts *o, scene **s, cli_outfile *jf);
 
 /* plot.c: curves on panels stacked top to bottom, written with PLplot to the temporary
  * file of an open cli_outfile (.svg or .png by its path) and renamed into place. */
@@ -79,11 +96,19 @@ typedef struct {
 typedef struct {
   const char *title, *xlabel, *ylabel;
   int logx, logy;
+  int equal;        /* one unit is as long on both axes (a path) */
+  int xdown, ydown; /* the axis increases leftward / downward */
+  int no_legend;    /* the axis labels say it all (one curve) */
+  double vp[4];     /* x0, x1, y0, y1 of the axes on the page (0..1); all 0: stacked */
   int nlines;
   const cli_plot_line *lines;
 } cli_plot_panel;
 int cli_plot_path_ok(const char *path); /* ends in .svg or .png */
-int cli_plot_write(cli_outfile *o, int npanels, const cli_plot_panel *panels);
+/* Panels stacked top to bottom on a page 960 wide (the vp of each panel is set here). */
+int cli_plot_write(cli_outfile *o, int npanels, cli_plot_panel *panels);
+/* Panels where their vp says, on a page of width x height pixels. */
+int cli_plot_write_page(cli_outfile *o, int width, int height, int npanels,
+                        const cli_plot_panel *panels);
 
 int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv);
 
@@ -107,6 +132,7 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, doubl
 
 /* Subcommands. */
 int cli_converge(int argc, char **argv);
+int cli_batch(int argc, char **argv);     /* cli_batch.c */
 int cli_gallery(void);
 int cli_solve(int argc, char **argv);
 int cli_check(int argc, char **argv);

@@ -161,7 +161,7 @@ static int write_plot(cli_outfile *o, cli_report *r, const int *keep, int np, cv
       ln->x = xs;
       ln->y = yk + (size_t)i * NPLOT;
       ln->colour = num - 1;
-      ln->style = n > 1 ? i % 8 : 0;
+      ln->style = i > 0 ? 1 + i % 7 : 0; /* PLplot styles 0 and 1 are both solid */
       if (n > 1)
         snprintf(labels[nl], sizeof labels[nl], "%d %s: %s", num, s->unknowns[i],
                  r[k].kind ? r[k].kind : "?");

@@ -7,35 +7,30 @@
 #include <string.h>
 
 #include "cli/cli.h"
+#include "scene/scene_batch.h"
 
 #define FIRST_STEPS 10
 #define MIN_FRACTION (1.0 / 4096)
 
-/* Load the scene with the user's --set list plus name=value, build its problem. */
-static int load_at(const cli_opts *o, const char *name, double value, scene **s,
-                   cv_problem **p, const cli_opts *over, char *err, size_t errlen) {
-  char buf[64];
-  sc_set *set = malloc((size_t)(o->nset + 1) * sizeof *set);
-  if (!set) {
-    snprintf(err, errlen, "calcvar solve: out of memory");
-    return -1;
+/* The scene (read once by the caller) compiled once, its parameters as inputs (issue 18):
+ * every step only sets the continued parameter and builds a problem over the compiled integrand. */
+static cv_batch *load_once(const cli_opts *o, scene *s, const char *name, char *err,
+                           size_t errlen) {
+  int found = 0;
+  for (int i = 0; i < s->nparams; i++) found |= strcmp(s->params[i].name, name) == 0;
+  if (!found) {
+    snprintf(err, errlen, "calcvar solve: --continue: '%s' is not a parameter of %s", name,
+             o->scene_path);
+    scene_free(s);
+    return NULL;
   }
-  int k = 0;
-  for (int i = 0; i < o->nset; i++)
-    if (strcmp(o->set[i].name, name) != 0) set[k++] = o->set[i];
-  snprintf(buf, sizeof buf, "%.17g", value);
-  set[k].name = name;
-  set[k].value = buf;
-  *s = scene_load_file(o->scene_path, k + 1, set, err, errlen);
-  free(set);
-  if (!*s) return -1;
-  if (over->elements) (*s)->elements = over->elements;
-  if (over->degree) (*s)->degree = over->degree;
-  if (over->method >= 0) (*s)->method = (cv_method)over->method;
-  if (over->tolerance > 0) (*s)->tolerance = over->tolerance;
-  if (over->max_iterations) (*s)->max_iterations = over->max_iterations;
-  *p = scene_problem_new(*s, scene_method_need((*s)->method), err, errlen);
-  return *p ? 0 : -1;
+  cv_batch *b = scene_batch_new(s, err, errlen);
+  const char *col[1] = {name};
+  if (b && cv_batch_set_columns(b, 1, col, err, errlen) != CVAR_OK) {
+    cv_batch_free(b);
+    return NULL;
+  }
+  return b;
 }
 
 /* Keep the mesh and nodal values of `from` as the mesh and start of `to`. */
@@ -62,8 +57,9 @@ static int carry_over(cv_solver *from, cv_solver *to, int n) {
 /* Solve by continuation. On return *sp, *pp, *svp hold the last scene, problem and solver
  * (the one to report); the return value is the status of the last solve, or -1 with err
  * set when the input is bad (exit 2). cont_msg receives what was done. */
-int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver **svp,
-                       cv_status *stp, char *cont_msg, size_t cmlen, char *err, size_t errlen) {
+int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene **sp,
+                       cv_problem **pp, cv_solver **svp, cv_status *stp, char *cont_msg, size_t cmlen,
+                       char *err, size_t errlen) {
   char name[128];
   const char *e = strchr(o->cont, '='), *c = strchr(e, ':');
   size_t ln = (size_t)(e - o->cont) < sizeof name ? (size_t)(e - o->cont) : sizeof name - 1;
@@ -72,42 +68,33 @@ int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver
   double from = strtod(e + 1, NULL), to = strtod(c + 1, NULL), v = from;
   double step = (to - from) / FIRST_STEPS, done_at = from;
   int steps = 0, failures = 0;
-  scene *s = NULL;
+  const scene *s = NULL;
   cv_problem *p = NULL;
   cv_solver *sv = NULL, *last = NULL;
   cv_status st = CVAR_OK;
+  cv_batch *b = load_once(o, s0, name, err, errlen);
+  if (!b) return -1;
   for (;;) {
-    scene *s2 = NULL;
-    cv_problem *p2 = NULL;
-    if (load_at(o, name, v, &s2, &p2, o, err, errlen) < 0) {
-      cv_problem_free(p2);
-      scene_free(s2);
-      goto bad;
-    }
-    int found = 0;
-    for (int i = 0; i < s2->nparams; i++) found |= strcmp(s2->params[i].name, name) == 0;
-    if (!found) {
-      snprintf(err, errlen, "calcvar solve: --continue: '%s' is not a parameter of %s", name,
-               o->scene_path);
-      cv_problem_free(p2);
-      scene_free(s2);
-      goto bad;
-    }
+    const scene *s2 = NULL;
+    /* p references the compiled clones only: free it before they change */
+    cv_problem_free(p);
+    p = NULL;
+    cv_problem *p2 = scene_batch_problem(b, &v, &s2, err, errlen);
+    if (!p2) goto bad;
     cv_solver *sv2 = cv_solver_new(NULL);
     if (!sv2 || scene_solver_configure(s2, sv2, err, errlen) != CVAR_OK ||
         (last && carry_over(last, sv2, s2->n) < 0)) {
       cv_solver_free(sv2);
       cv_problem_free(p2);
-      scene_free(s2);
       goto bad;
     }
+    cli_progress_attach(sv2);
     st = cv_solve(sv2, p2);
+    cv_problem_free(p2);
     if (st == CVAR_OK || !last) {
       /* accepted (or the very first solve, reported as it is if it failed) */
       cv_solver_free(sv);
-      cv_problem_free(p);
-      scene_free(s);
-      s = s2, p = p2, sv = sv2, last = sv2;
+      s = s2, sv = sv2, last = sv2;
       if (st != CVAR_OK) break;
       done_at = v;
       steps++;
@@ -117,8 +104,6 @@ int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver
       failures = 0;
     } else {
       cv_solver_free(sv2);
-      cv_problem_free(p2);
-      scene_free(s2);
       failures++;
       step *= 0.5;
       if (fabs(step) < fabs(to - from) * MIN_FRACTION) break;
@@ -141,11 +126,15 @@ int cli_continue_solve(const cli_opts *o, scene **sp, cv_problem **pp, cv_solver
   } else {
     *stp = CVAR_ESTALL; /* the target value was not reached */
   }
-  *sp = s, *pp = p, *svp = sv;
+  /* The problem to report on: the instance back at the accepted value (a rejected step
+   * may have set another). */
+  double acc = steps > 0 ? done_at : from;
+  if (!(p = scene_batch_problem(b, &acc, &s, err, errlen))) goto bad;
+  *bp = b, *sp = s, *pp = p, *svp = sv;
   return 0;
 bad:
   cv_solver_free(sv);
   cv_problem_free(p);
-  scene_free(s);
+  cv_batch_free(b);
   return -1;
 }

@@ -160,33 +160,15 @@ int cli_equations(int argc, char **argv)
 {
   cli_opts o;
   char err[SC_ERRLEN] = "";
-  int rc = cli_args_parse("equations", argc, argv, &o);
-  if (rc != 0 || o.help) {
-    if (o.help)
-      usage(stdout);
-    cli_opts_free(&o);
-    return rc;
-  }
-  if ((rc = cli_only_scene_options("equations", &o)) != 0) {
-    cli_opts_free(&o);
-    return rc;
-  }
-  scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
+  scene *s = NULL;
   mech_equations eq;
   texts t;
   cli_outfile jf = {0};
   memset(&eq, 0, sizeof eq);
   memset(&t, 0, sizeof t);
-  if (!s) {
-    fprintf(stderr, "%s\n", err);
-    rc = EXIT_BADINPUT;
+  int rc = cli_scene_command_start("equations", argc, argv, usage, &o, &s, &jf);
+  if (rc >= 0)
     goto done;
-  }
-  /* Output files are opened before the work: an unwritable path is bad input. */
-  if (o.json && cli_outfile_open(&jf, o.json, o.scene_path) < 0) {
-    rc = EXIT_BADINPUT;
-    goto done;
-  }
   if (scene_equations_new(s, &eq, err, sizeof err) != CVAR_OK || texts_make(&t, s, &eq) < 0) {
     fprintf(stderr, "%s\n", err[0] ? err : "calcvar equations: out of memory");
     rc = EXIT_UNSOLVED;

@@ -180,31 +180,13 @@ int cli_modes(int argc, char **argv)
 {
   cli_opts o;
   char err[SC_ERRLEN] = "";
-  int rc = cli_args_parse("modes", argc, argv, &o);
-  if (rc != 0 || o.help) {
-    if (o.help)
-      usage(stdout);
-    cli_opts_free(&o);
-    return rc;
-  }
-  if ((rc = cli_only_scene_options("modes", &o)) != 0) {
-    cli_opts_free(&o);
-    return rc;
-  }
-  scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
+  scene *s = NULL;
   mech_modes md;
   cli_outfile jf = {0};
   memset(&md, 0, sizeof md);
-  if (!s) {
-    fprintf(stderr, "%s\n", err);
-    rc = EXIT_BADINPUT;
+  int rc = cli_scene_command_start("modes", argc, argv, usage, &o, &s, &jf);
+  if (rc >= 0)
     goto done;
-  }
-  /* Output files are opened before the work: an unwritable path is bad input. */
-  if (o.json && cli_outfile_open(&jf, o.json, o.scene_path) < 0) {
-    rc = EXIT_BADINPUT;
-    goto done;
-  }
   cv_status st = scene_modes_new(s, &md, err, sizeof err);
   if (st != CVAR_OK) {
     fprintf(stderr, "%s\n", err);

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "cli/cli.h"
+#include "scene/scene_batch.h"
 
 static void usage(FILE *f)
 {
@@ -32,6 +33,8 @@ static void usage(FILE *f)
         "  --csv FILE           nodal table ('-' for stdout)\n"
         "  --plot FILE          picture of the solution (.png or .svg)\n"
         "  --quiet              no summary on stdout\n"
+        "  -v, --verbose        one line per Newton iteration and adaptive round on stderr\n"
+        "  -h, --help           this text\n"
         "exit status: 0 converged, 1 not solved, 2 bad input, 3 write error\n", f);
 }
 
@@ -83,9 +86,12 @@ int cli_solve(int argc, char **argv)
     cli_opts_free(&o);
     return rc;
   }
-  scene *s = scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
+  /* --continue: read once with the parameters as inputs, compiled once (issue 18) */
+  scene *s = o.cont ? scene_load_file_inputs(o.scene_path, o.nset, o.set, err, sizeof err)
+                    : scene_load_file(o.scene_path, o.nset, o.set, err, sizeof err);
   cv_problem *p = NULL;
   cv_solver *sv = NULL;
+  cv_batch *cb = NULL; /* --continue: the compiled scene */
   cli_outfile jf = {0}, cf = {0}, pf = {0};
   cli_report r;
   memset(&r, 0, sizeof r);
@@ -98,16 +104,11 @@ int cli_solve(int argc, char **argv)
     s->elements = o.elements;
   if (o.degree)
     s->degree = o.degree;
-  if (o.method >= 0)
-    s->method = (cv_method)o.method;
-  if (o.tolerance > 0)
-    s->tolerance = o.tolerance;
-  if (o.max_iterations)
-    s->max_iterations = o.max_iterations;
+  cli_apply_solver_options(&o, s);
   if ((rc = unsupported(&o, s)) != 0)
     goto done;
   cv_status why;
-  if (!(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err)) ||
+  if ((!o.cont && !(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err))) ||
       !(sv = cv_solver_new(&why)) || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK) {
     fprintf(stderr, "%s\n", err[0] ? err : "calcvar solve: out of memory");
     rc = EXIT_BADINPUT;
@@ -131,25 +132,30 @@ int cli_solve(int argc, char **argv)
   }
   cv_status st;
   char cont_msg[256] = "";
+  cli_progress_setup(o.verbose);
+  cli_progress_attach(sv);
   if (o.all) {
     rc = cli_all_run(&o, s, p, sv, adapt, &jf, &cf, &pf);
+    cli_progress_end();
     goto done;
   }
   if (o.cont) {
     /* continuation replaces scene, problem and solver by those of its last step */
     cv_solver_free(sv);
-    cv_problem_free(p);
-    scene_free(s);
-    s = NULL, p = NULL, sv = NULL;
-    if (cli_continue_solve(&o, &s, &p, &sv, &st, cont_msg, sizeof cont_msg, err,
+    scene *s0 = s;
+    s = NULL, sv = NULL;
+    const scene *si = NULL;
+    if (cli_continue_solve(&o, s0, &cb, &si, &p, &sv, &st, cont_msg, sizeof cont_msg, err,
                            sizeof err) < 0) {
       fprintf(stderr, "%s\n", err);
       rc = EXIT_BADINPUT;
       goto done;
     }
+    s = (scene *)si; /* the batch's instance: cb owns it (its DAG may grow for the report) */
   } else {
     st = cv_solve(sv, p);
   }
+  cli_progress_end();
   if (st == CVAR_EINVAL) {
     /* Input the core refused before solving (e.g. a dense NLopt Jacobian too large). */
     fprintf(stderr, "%s: %s\n", s->file, cv_solver_last_error(sv));
@@ -160,6 +166,19 @@ int cli_solve(int argc, char **argv)
     fprintf(stderr, "calcvar solve: out of memory while reporting\n");
     rc = EXIT_UNSOLVED;
     goto done;
+  }
+  double xs, alpha;
+  if (st == CVAR_OK && scene_interior_singularity(s, sv, &xs, &alpha) == 1) {
+    /* a finite discrete action of an infinite one: not a solution (theory (SG-1)) */
+    st = r.st = CVAR_ENONFINITE;
+    r.status = cli_status_string(st);
+    r.has_morse = 0;
+    r.kind = NULL;
+    snprintf(r.message, sizeof r.message,
+             "the integrand is singular at %s = %.6g inside the interval: along the path "
+             "|F| grows like |%s - %.6g|^(-%.2f), so the action is infinite and the discrete "
+             "answer (which changes with the mesh) is no stationary path; split the interval "
+             "there or remove the singularity", s->variable, xs, s->variable, xs, alpha);
   }
   if (cont_msg[0]) {
     size_t used = st == CVAR_OK ? strlen(r.message) : 0;
@@ -194,7 +213,9 @@ done:
   cli_report_free(&r);
   cv_solver_free(sv);
   cv_problem_free(p);
-  scene_free(s);
+  if (!cb)
+    scene_free(s);
+  cv_batch_free(cb);
   cli_opts_free(&o);
   return rc;
 }

@@ -74,6 +74,20 @@ static int fail(cli_outfile *o, const char *why)
   return -1;
 }
 
+/* A device, FIFO or socket: stream into it (opening a FIFO waits for its reader). */
+static int open_stream(cli_outfile *o, const char *path)
+{
+  int fd = open(path, O_WRONLY | O_NOCTTY);
+  if (fd < 0 || !(o->f = fdopen(fd, "w"))) {
+    int e = errno;
+    if (fd >= 0)
+      close(fd);
+    return fail(o, strerror(e));
+  }
+  o->stream = 1;
+  return 0;
+}
+
 int cli_outfile_open(cli_outfile *o, const char *path, const char *input)
 {
   memset(o, 0, sizeof *o);
@@ -87,9 +101,14 @@ int cli_outfile_open(cli_outfile *o, const char *path, const char *input)
     return fail(o, "empty file name");
   if (path[n - 1] == '/')
     return fail(o, "the name ends in '/' (a directory); give a file name");
+  struct stat st, si;
+  /* What the kernel reaches through the path (links, and /proc's "magic" links such as
+   * /dev/stdout on a pipe, which readlink cannot name): a device, FIFO or socket is a
+   * stream, whatever the path looks like. */
+  if (stat(path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
+    return open_stream(o, path);
   if (!(o->dest = follow_links(path)))
     return fail(o, strerror(errno));
-  struct stat st, si;
   int exists = stat(o->dest, &st) == 0;
   if (!exists && errno != ENOENT)
     return fail(o, strerror(errno));
@@ -100,18 +119,8 @@ int cli_outfile_open(cli_outfile *o, const char *path, const char *input)
   if (exists && have_in && si.st_dev == st.st_dev && si.st_ino == st.st_ino &&
       S_ISREG(st.st_mode))
     return fail(o, "it is the scene being read (the report would destroy it)");
-  if (exists && !S_ISREG(st.st_mode)) {
-    /* A device, FIFO or socket: stream into it (opening a FIFO waits for its reader). */
-    int fd = open(o->dest, O_WRONLY | O_NOCTTY);
-    if (fd < 0 || !(o->f = fdopen(fd, "w"))) {
-      int e = errno;
-      if (fd >= 0)
-        close(fd);
-      return fail(o, strerror(e));
-    }
-    o->stream = 1;
-    return 0;
-  }
+  if (exists && !S_ISREG(st.st_mode))
+    return open_stream(o, o->dest);
   size_t dn = strlen(o->dest);
   if (!(o->tmp = malloc(dn + 16)))
     return fail(o, "out of memory");

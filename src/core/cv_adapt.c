@@ -155,6 +155,16 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       cv_set_msg(s->msg, sizeof s->msg, "adaptive refinement: the error estimate is not finite");
       goto cleanup;
     }
+    if (s->progress) {
+      cv_progress info = {CVAR_PROGRESS_ROUND, s->iterations, s->gnorm, NAN, NAN, s->action,
+                          s->rounds, E, est};
+      if (s->progress(&info, s->progress_user) != 0) {
+        st = CVAR_ECANCELLED;
+        cv_set_msg(s->msg, sizeof s->msg, "cancelled by the progress callback after adaptive "
+                   "round %d (%d elements, estimated max nodal error %.2g)", s->rounds, E, est);
+        goto cleanup;
+      }
+    }
     if (est <= tol) {
       cv_set_msg(s->msg, sizeof s->msg,
                  "converged on an adapted mesh of %d elements after %d round%s, %d Newton "

@@ -57,6 +57,7 @@ void cv_pathset_free(struct cv_pathset *ps) {
 
 /* Move the solver's results into q (the solver holds none afterwards), and back. */
 static void path_take(cv_path *q, cv_solver *s) {
+  cv_solver_drop_factor(s); /* the factor belongs to the mesh that leaves */
   q->disc = s->disc;
   q->y = s->y;
   q->mult = s->mult;
@@ -70,6 +71,7 @@ static void path_take(cv_path *q, cv_solver *s) {
 }
 
 static void path_give(cv_solver *s, cv_path *q) {
+  cv_solver_drop_factor(s);
   cv_disc_free(&s->disc);
   cv_free(s->y);
   cv_free(s->mult);

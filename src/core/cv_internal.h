@@ -41,7 +41,8 @@ struct cv_problem {
   double *endval;  /* endval[2*k + end] */
   cv_guess_fn guess;
   void *guess_user;
-  cv_note_fn note;   /* the integrand's failure note (cv_table_internal.h), or NULL */
+  int nnotes;        /* failure notes of callbacks (cv_table_internal.h) */
+  cv_note_source *notes;
   int ntables;       /* tables added by cv_problem_add_table, each with a reference */
   char **table_name;
   cv_table **table;
@@ -246,6 +247,8 @@ struct cv_solver {
   int adapt_max, rounds;
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
+  cv_progress_fn progress;     /* cv_solver_set_progress; NULL: none */
+  void *progress_user;
   int near_sing[2];            /* ends found nearly singular after a solve */
   double search_work;          /* cv_solve_all's work limit (cv_deflation.c) */
   struct cv_pathset *paths;    /* the paths of the last cv_solve_all (cv_deflation.c) */

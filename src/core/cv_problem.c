@@ -37,6 +37,10 @@ cleanup:
 }
 
 static void release_integrand(cv_problem *p) {
+  int kept = 0; /* the integrand's notes go with it */
+  for (int k = 0; k < p->nnotes; k++)
+    if (!p->user || p->notes[k].user != p->user) p->notes[kept++] = p->notes[k];
+  p->nnotes = kept;
   if (p->release) p->release(p->user);
   p->release = NULL;
   p->user = NULL;
@@ -54,6 +58,7 @@ void cv_problem_free(cv_problem *p) {
     cv_free(p->table_name[k]);
     cv_table_free(p->table[k]);
   }
+  cv_free(p->notes);
   cv_free(p->table_name);
   cv_free(p->table);
   cv_free(p->pc);
@@ -70,7 +75,6 @@ cv_status cv_problem_set_integrand_owned(cv_problem *p, cv_integrand_fn F, void 
     return CVAR_EINVAL;
   }
   release_integrand(p);
-  p->note = NULL;
   p->F = F;
   p->user = user;
   p->release = release;
@@ -171,9 +175,12 @@ cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, void *user, 
 int cv_problem_get_num_constraints(const cv_problem *p) { return p ? p->nc : 0; }
 int cv_problem_get_num_integrals(const cv_problem *p) { return p ? p->ni : 0; }
 
-cv_status cv_problem_set_integrand_note(cv_problem *p, cv_note_fn note) {
-  if (!p) return CVAR_EINVAL;
-  p->note = note;
+cv_status cv_problem_add_note(cv_problem *p, cv_note_fn fn, void *user) {
+  if (!p || !fn) return CVAR_EINVAL;
+  cv_note_source *grown = cv_realloc(p->notes, ((size_t)p->nnotes + 1) * sizeof *grown);
+  if (!grown) return CVAR_ENOMEM;
+  p->notes = grown;
+  p->notes[p->nnotes++] = (cv_note_source){fn, user};
   return CVAR_OK;
 }
 

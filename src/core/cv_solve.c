@@ -255,12 +255,14 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   s->paths = NULL;
   s->err_est = NAN;
   s->rounds = 0;
-  if (p && p->note) p->note(p->user, 1);
+  for (int k = 0; p && k < p->nnotes; k++) p->notes[k].fn(p->notes[k].user, 1);
   cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
   s->status = st;
   /* A failure the integrand can explain (a table's grid left): the cause first, then what
    * the engine saw. */
-  const char *note = st != CVAR_OK && p && p->note ? p->note(p->user, 0) : NULL;
+  const char *note = NULL;
+  for (int k = 0; st != CVAR_OK && p && k < p->nnotes && !(note && note[0]); k++)
+    note = p->notes[k].fn(p->notes[k].user, 0);
   if (note && note[0]) {
     char m[2 * sizeof s->msg];
     snprintf(m, sizeof m, "%s%s%s", note, s->msg[0] ? "; " : "", s->msg);

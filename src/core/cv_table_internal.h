@@ -22,9 +22,16 @@ int cv_table_eval_multi(const cv_table *t, const double *u, int nord, const int 
 int cv_problem_num_tables(const cv_problem *p);
 const char *cv_problem_table_name(const cv_problem *p, int i);
 const cv_table *cv_problem_table(const cv_problem *p, int i);
-/* A note on the integrand's last failure ("the path left the grid of table 'c' ..."), put
- * by cv_solve at the front of its message when a solve fails; `reset` nonzero clears it
- * (called when a solve starts). Returns the note or NULL. */
+/* A note on the last failure of a callback's evaluation ("the path left the grid of table
+ * 'c' ..."): fn(user, 1) clears it (cv_solve calls it when a solve starts), fn(user, 0)
+ * returns it ("" or NULL when none). When a solve fails, cv_solve puts the first non-empty
+ * note of the problem's sources at the front of its message. `user` is the user data of
+ * the integrand, a constraint or an integral; a source whose user is the integrand's is
+ * dropped when the integrand is replaced or released. */
 typedef const char *(*cv_note_fn)(void *user, int reset);
-cv_status cv_problem_set_integrand_note(cv_problem *p, cv_note_fn note);
+typedef struct {
+  cv_note_fn fn;
+  void *user;
+} cv_note_source;
+cv_status cv_problem_add_note(cv_problem *p, cv_note_fn fn, void *user);
 #endif

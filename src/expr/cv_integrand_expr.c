@@ -209,16 +209,17 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
     goto cleanup;
   }
   /* The problem owns g from here on, also when the call fails (it releases it). */
-  if (kind == FORMULA_INTEGRAND) {
+  if (kind == FORMULA_INTEGRAND)
     st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
-    if (st == CVAR_OK) st = cv_problem_set_integrand_note(p, ex_integrand_note);
-  } else if (kind == FORMULA_CONSTRAINT) {
+  else if (kind == FORMULA_CONSTRAINT)
     st = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g,
                                          ex_integrand_release, index);
-  } else {
+  else
     st = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release, c_rhs,
                                        index);
-  }
+  /* names the table whose grid a failing solve left (g lives as long as the problem) */
+  if (st == CVAR_OK && ex_integrand_has_tables(g))
+    st = cv_problem_add_note(p, ex_integrand_note, g);
   if (st != CVAR_OK) msg(err, errlen, "%s", cv_strerror(st));
   goto cleanup;
 nomem:

@@ -1,5 +1,5 @@
 /* src/expr/ex_build.c — simplifying constructors: constant folding, 0/1 rules, canonical
- * operand order, sign normalisation. SPDX-License-Identifier: MIT
+ * operand order, sign normalisation (docs/theory.md (X-1)). SPDX-License-Identifier: MIT
  * Every rule replaces a node by one that is equal as a real function; none changes the
  * floating-point value except where noted (x - x = 0, 0*x = 0 also at x = inf).
  * Constants keep IEEE semantics (theory (EX-1)): a constant whose value is not finite

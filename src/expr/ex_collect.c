@@ -1,5 +1,5 @@
 /* src/expr/ex_collect.c — a normal form for display: sums of monomials c·Π bᵢ^pᵢ with
- * like terms and like factors collected. SPDX-License-Identifier: MIT
+ * like terms and like factors collected (docs/theory.md (X-5)). SPDX-License-Identifier: MIT
  *
  * The constructors of ex_build.c simplify one node at a time, so th'^2 - 0.5*th'^2,
  * a'*(b'*s) - b'*(a'*s) or (36*th')/2 stay as written. This pass looks through whole

@@ -1,5 +1,5 @@
 /* src/expr/ex_diff.c — symbolic partial derivatives on the DAG (chain rule, one pass in
- * topological order). SPDX-License-Identifier: MIT */
+ * topological order: docs/theory.md (X-2), kinks (X-3)). SPDX-License-Identifier: MIT */
 #include <stdlib.h>
 
 #include "expr/ex_internal.h"
@@ -14,10 +14,10 @@
 #define FN(op, p) ex_unary(d, (op), (p))
 #define SQ(p) POW((p), NUM(2.0))
 
-/* d(node id)/d slot given the derivatives da, db, dc of its operands. The derivative of
+/* d(node id)/d slot given the derivatives da, db, dc of its operands (X-2). The derivative of
  * a node reuses the node itself where the rule allows (exp, sqrt, tan, tanh, a^b, a/b), so
  * value and derivative share work in the compiled tape. At kinks the branch taken by the
- * value is differentiated: abs' = 1 at 0, min picks a on ties (see ex_apply). */
+ * value is differentiated (X-3): abs' = 1 at 0, min picks a on ties (see ex_apply). */
 static ex_id rule(ex_dag *d, ex_id id, ex_node nd, int slot, ex_id da, ex_id db, ex_id dc) {
   ex_id a = nd.a, b = nd.b;
   switch (nd.op) {

@@ -1,5 +1,5 @@
 /* src/expr/ex_integrand.c — partials of F(x, y, y') compiled to tapes, evaluated through
- * the core's integrand callback. SPDX-License-Identifier: MIT */
+ * the core's integrand callback (docs/theory.md (X-4)). SPDX-License-Identifier: MIT */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,6 +8,10 @@
 
 struct ex_integrand {
   int n;
+  int np;           /* parameters: tape slots 2n+1 .. 2n+np */
+  int owns_tapes;   /* 0 for a clone (ex_integrand_clone) */
+  double *pbuf;     /* np batches, each filled with one parameter's value */
+  unsigned char *used; /* used[j]: the expression reads parameter j (shared by clones) */
   unsigned max_need;
   ex_tape *tape[3]; /* level 0: F; 1: F, Fy, Fp; 2: also Fyy (upper), Fyp, Fpp (upper) */
   int nout[3];
@@ -23,12 +27,56 @@ static void set_err(char *err, size_t errlen, const char *msg) {
   if (err && errlen) snprintf(err, errlen, "%s", msg);
 }
 
-/* Upper-triangle index of (i, j), i <= j, in row-major order. */
+/* Upper-triangle index of (i, j), i <= j, in row-major order. */
 static int tri(int n, int i, int j) { return i * n - i * (i - 1) / 2 + (j - i); }
+
+/* Work buffers of g (tapes and sizes already set). 0, or -1 on allocation failure. */
+static int alloc_buffers(ex_integrand *g) {
+  size_t work = 0;
+  for (int l = 0; l < 3; l++)
+    if (g->tape[l]) {
+      size_t w = ex_tape_work_size(g->tape[l], EX_INTEGRAND_BATCH);
+      if (w > work) work = w;
+    }
+  int nout = g->nout[2] ? g->nout[2] : g->nout[1] ? g->nout[1] : 1;
+  g->work = cv_malloc((work ? work : 1) * sizeof *g->work);
+  g->scratch = cv_malloc((size_t)nout * EX_INTEGRAND_BATCH * sizeof *g->scratch);
+  g->in = cv_malloc((size_t)(2 * g->n + 1 + g->np) * sizeof *g->in);
+  g->outp = cv_malloc((size_t)nout * sizeof *g->outp);
+  g->pbuf = cv_calloc((size_t)(g->np ? g->np : 1) * EX_INTEGRAND_BATCH, sizeof *g->pbuf);
+  return g->work && g->scratch && g->in && g->outp && g->pbuf ? 0 : -1;
+}
 
 ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, char *err,
                                size_t errlen) {
-  if (!d || n < 1 || F < 0 || F >= ex_dag_num_nodes(d) || n > 1000) {
+  return ex_integrand_new_params(d, n, 0, F, max_need, err, errlen);
+}
+
+ex_integrand *ex_integrand_clone(const ex_integrand *g) {
+  ex_integrand *c = g ? cv_malloc(sizeof *c) : NULL;
+  if (!c) return NULL;
+  *c = *g;
+  c->owns_tapes = 0;
+  c->work = c->scratch = c->pbuf = NULL;
+  c->in = NULL;
+  c->outp = NULL;
+  if (alloc_buffers(c) < 0) {
+    ex_integrand_free(c);
+    return NULL;
+  }
+  return c;
+}
+
+void ex_integrand_set_params(ex_integrand *g, const double *p) {
+  for (int j = 0; j < g->np; j++)
+    if (g->used[j])
+      for (int k = 0; k < EX_INTEGRAND_BATCH; k++)
+        g->pbuf[(size_t)j * EX_INTEGRAND_BATCH + k] = p[j];
+}
+
+ex_integrand *ex_integrand_new_params(ex_dag *d, int n, int np, ex_id F, unsigned max_need,
+                                      char *err, size_t errlen) {
+  if (!d || n < 1 || np < 0 || F < 0 || F >= ex_dag_num_nodes(d) || n > 1000) {
     set_err(err, errlen, "invalid argument to ex_integrand_new");
     return NULL;
   }
@@ -39,6 +87,11 @@ ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, cha
   ex_id *outs = cv_malloc((size_t)nout * sizeof *outs);
   if (!g || !outs) goto nomem;
   g->n = n;
+  g->np = np;
+  g->owns_tapes = 1;
+  /* the partials read no slot that F does not */
+  if (!(g->used = cv_calloc((size_t)np + 1, 1))) goto nomem;
+  for (int j = 0; j < np; j++) g->used[j] = (unsigned char)ex_depends_on(d, F, 1 + 2 * n + j);
   g->max_need = max_need | CVAR_NEED_F;
   for (int i = 0; i < n; i++) g->depends_on_dy |= ex_depends_on(d, F, 1 + n + i);
   outs[0] = F;
@@ -67,18 +120,11 @@ ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, cha
   g->nout[0] = 1;
   g->nout[1] = 1 + 2 * n;
   g->nout[2] = nout;
-  size_t work = 0;
   for (int l = 0; l <= level; l++) {
-    g->tape[l] = ex_tape_new(d, 2 * n + 1, g->nout[l], outs);
+    g->tape[l] = ex_tape_new(d, 2 * n + 1 + np, g->nout[l], outs);
     if (!g->tape[l]) goto nomem;
-    size_t w = ex_tape_work_size(g->tape[l], EX_INTEGRAND_BATCH);
-    if (w > work) work = w;
   }
-  g->work = cv_malloc((work ? work : 1) * sizeof *g->work);
-  g->scratch = cv_malloc((size_t)nout * EX_INTEGRAND_BATCH * sizeof *g->scratch);
-  g->in = cv_malloc((size_t)(2 * n + 1) * sizeof *g->in);
-  g->outp = cv_malloc((size_t)nout * sizeof *g->outp);
-  if (!g->work || !g->scratch || !g->in || !g->outp) goto nomem;
+  if (alloc_buffers(g) < 0) goto nomem;
   cv_free(outs);
   return g;
 nomem:
@@ -90,7 +136,11 @@ nomem:
 
 void ex_integrand_free(ex_integrand *g) {
   if (!g) return;
-  for (int l = 0; l < 3; l++) ex_tape_free(g->tape[l]);
+  if (g->owns_tapes) {
+    for (int l = 0; l < 3; l++) ex_tape_free(g->tape[l]);
+    cv_free(g->used);
+  }
+  cv_free(g->pbuf);
   cv_free(g->work);
   cv_free(g->scratch);
   cv_free(g->in);
@@ -99,6 +149,12 @@ void ex_integrand_free(ex_integrand *g) {
 }
 
 void ex_integrand_release(void *g) { ex_integrand_free(g); }
+
+int ex_integrand_has_tables(const ex_integrand *g) {
+  int any = 0;
+  for (int l = 0; g && l < 3; l++) any |= ex_tape_num_tables(g->tape[l]) > 0;
+  return any;
+}
 
 const char *ex_integrand_note(void *user, int reset) {
   ex_integrand *g = user;
@@ -131,6 +187,8 @@ static int eval_into(ex_integrand *g, int m, const double *x, const double *y,
       g->in[1 + i] = y + i * M + k0;
       g->in[1 + n + i] = dy ? dy + i * M + k0 : NULL; /* NULL: a constraint G(x, y) */
     }
+    for (int j = 0; j < g->np; j++)
+      g->in[1 + 2 * n + j] = g->pbuf + (size_t)j * EX_INTEGRAND_BATCH;
     g->outp[0] = dest(g, F, (size_t)k0, 0);
     if (level >= 1) {
       for (int i = 0; i < n; i++) {

@@ -28,6 +28,20 @@ typedef struct ex_integrand ex_integrand;
 ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, char *err,
                                size_t errlen);
 
+/* The same with np parameters as tape inputs (slots 2n+1 .. 2n+np, see scene.h): the
+ * tapes read them like the variable, so one compiled object serves any parameter values
+ * (set with ex_integrand_set_params; all zero until then). np = 0 is ex_integrand_new. */
+ex_integrand *ex_integrand_new_params(ex_dag *d, int n, int np, ex_id F, unsigned max_need,
+                                      char *err, size_t errlen);
+
+/* A second evaluator over the same compiled tapes: its own work buffers and parameter
+ * values, the tapes shared read-only (so one object per thread, compiled once). The
+ * clone must be freed before the object it was cloned from. NULL on allocation failure. */
+ex_integrand *ex_integrand_clone(const ex_integrand *g);
+
+/* Parameter values p[0..np-1] for the following evaluations. */
+void ex_integrand_set_params(ex_integrand *g, const double *p);
+
 /* A cv_integrand_fn: user is the ex_integrand. Fills every requested group (NULL members
  * of out are groups not asked for), including both triangles of Fyy and Fpp. Values are
  * written as computed; the core checks finiteness. Returns 0, or -1 when `need` asks for
@@ -52,5 +66,7 @@ void ex_integrand_release(void *g);
 /* A cv_note_fn (core/cv_table_internal.h): the sentence of the last evaluation that failed
  * because a table was called outside its grid ("" if none); reset clears it. */
 const char *ex_integrand_note(void *user, int reset);
+/* Whether the expression calls a table (only then can ex_integrand_note say anything). */
+int ex_integrand_has_tables(const ex_integrand *g);
 
 #endif /* CV_EX_INTEGRAND_H */

@@ -317,33 +317,26 @@ static ex_id parse_unary(parser *p) {
   return e;
 }
 
-static ex_id parse_term(parser *p) {
-  ex_id a = parse_unary(p);
+/* One left-associative level of binary operators: operand {op operand}, op the character
+ * c1 (operation o1) or c2 (o2). */
+static ex_id parse_level(parser *p, ex_id (*operand)(parser *), char c1, ex_op o1, char c2,
+                         ex_op o2) {
+  ex_id a = operand(p);
   while (a >= 0) {
     skip_ws(p);
     char c = p->s[p->pos];
-    if (c != '*' && c != '/') break;
+    if (c != c1 && c != c2) break;
     p->pos++;
-    ex_id b = parse_unary(p);
+    ex_id b = operand(p);
     if (b < 0) return -1;
-    a = built(p, ex_binary(p->d, c == '*' ? EX_MUL : EX_DIV, a, b));
+    a = built(p, ex_binary(p->d, c == c1 ? o1 : o2, a, b));
   }
   return a;
 }
 
-static ex_id parse_sum(parser *p) {
-  ex_id a = parse_term(p);
-  while (a >= 0) {
-    skip_ws(p);
-    char c = p->s[p->pos];
-    if (c != '+' && c != '-') break;
-    p->pos++;
-    ex_id b = parse_term(p);
-    if (b < 0) return -1;
-    a = built(p, ex_binary(p->d, c == '+' ? EX_ADD : EX_SUB, a, b));
-  }
-  return a;
-}
+static ex_id parse_term(parser *p) { return parse_level(p, parse_unary, '*', EX_MUL, '/', EX_DIV); }
+
+static ex_id parse_sum(parser *p) { return parse_level(p, parse_term, '+', EX_ADD, '-', EX_SUB); }
 
 ex_id ex_parse(ex_dag *d, const char *src, ex_resolve_fn resolve, void *user,
                int allow_second, char *err, size_t errlen) {

@@ -103,42 +103,32 @@ static int k_capable(ex_op op) {
   return op == EX_ADD || op == EX_SUB || op == EX_MUL || op == EX_DIV || op == EX_POW;
 }
 
-ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
-  if (!d || nslots < 0 || nout < 0 || (nout > 0 && !outs)) return NULL;
-  int top = -1;
-  for (int o = 0; o < nout; o++) {
-    if (outs[o] < 0 || outs[o] >= d->n) return NULL;
-    if (outs[o] > top) top = outs[o];
-  }
-  int nn = top + 1;
-  ex_tape *t = cv_calloc(1, sizeof *t);
-  cnode *cn = cv_calloc((size_t)(nn > 0 ? nn : 1), sizeof *cn);
-  int *freeregs = NULL, nfree = 0;
-  /* At most one instruction per node plus one per output (copies and fills). */
-  instr *ins = cv_malloc(((size_t)nn + (size_t)nout + 1) * sizeof *ins);
-  if (!t || !cn || !ins) goto fail;
-  t->nslots = nslots;
-  t->nout = nout;
-
-  /* Reachability; constant subtrees are not entered (they become scalars). */
+/* Reachability from the outputs; constant subtrees are not entered (they become scalars,
+ * their values computed here). Returns -1 if a slot is out of range or a constant fails. */
+static int mark_live(const ex_dag *d, cnode *cn, int nn, int nslots, int nout,
+                     const ex_id *outs) {
   for (int o = 0; o < nout; o++) cn[outs[o]].live = 1;
   for (int id = nn - 1; id >= 0; id--) {
     if (!cn[id].live) continue;
     const ex_node *nd = &d->nodes[id];
     if (nd->dep == 0) {
       cn[id].konst = 1;
-      if (ex_eval_const(d, id, &cn[id].cval) != 0) goto fail;
+      if (ex_eval_const(d, id, &cn[id].cval) != 0) return -1;
       continue;
     }
     if (nd->op == EX_SLOT) {
-      if (nd->a >= nslots) goto fail;
+      if (nd->a >= nslots) return -1;
       continue;
     }
     if (nd->a >= 0) cn[nd->a].live = 1;
     if (nd->b >= 0) cn[nd->b].live = 1;
     if (nd->c >= 0) cn[nd->c].live = 1;
   }
-  /* Which constants need a register, and the last reader of every vector value. */
+  return 0;
+}
+
+/* Which constants need a register, and the last reader of every vector value. */
+static void mark_readers(const ex_dag *d, cnode *cn, int nn) {
   for (int id = 0; id < nn; id++) {
     cn[id].last = -1;
     if (!cn[id].live || cn[id].konst || d->nodes[id].op == EX_SLOT) continue;
@@ -151,6 +141,172 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
       cn[ops[i]].last = id;
     }
   }
+}
+
+/* Registers of the work area: a free list, and the count ever used (t->nregs). */
+typedef struct {
+  int *free, nfree;
+} regpool;
+
+/* The lowest free register (keeps the live set compact), or a new one. */
+static int take_register(regpool *rp, ex_tape *t) {
+  if (rp->nfree == 0) return t->nregs++;
+  int best = 0;
+  for (int i = 1; i < rp->nfree; i++)
+    if (rp->free[i] < rp->free[best]) best = i;
+  int r = rp->free[best];
+  rp->free[best] = rp->free[--rp->nfree];
+  return r;
+}
+
+/* Free the registers of node id's operands that id reads last (each register once). */
+static void release_operands(regpool *rp, const cnode *cn, const ex_node *nd, int id) {
+  ex_id ops[3] = {nd->a, nd->b, nd->c};
+  for (int i = 0; i < 3; i++) {
+    ex_id o = ops[i];
+    if (o < 0 || cn[o].last != id || cn[o].home.space != L_REG) continue;
+    if ((i > 0 && o == ops[0]) || (i > 1 && o == ops[1])) continue; /* freed already */
+    rp->free[rp->nfree++] = cn[o].home.idx;
+  }
+}
+
+/* T_TABLE for table call id: the tape's reference to the table, and one call group with
+ * the later calls of the same table at the same arguments. Returns -1 on failure. */
+static int select_table(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id,
+                        regpool *rp, instr *in) {
+  const ex_node *nd = &d->nodes[id];
+  int index, ord[3];
+  ex_table_decode(nd->v, &index, ord);
+  if (index < 0 || index >= d->ntables) return -1;
+  in->op = T_TABLE;
+  in->tab = -1;
+  for (int j = 0; j < t->ntab; j++)
+    if (t->tab[j] == d->tabs[index]) in->tab = j;
+  if (in->tab < 0) {
+    cv_table **tabs = cv_realloc(t->tab, ((size_t)t->ntab + 1) * sizeof *tabs);
+    if (tabs) t->tab = tabs;
+    char **names = cv_realloc(t->tabname, ((size_t)t->ntab + 1) * sizeof *names);
+    if (names) t->tabname = names;
+    char *copy = cv_malloc(strlen(d->tab_name[index]) + 1);
+    if (!tabs || !names || !copy) {
+      cv_free(copy);
+      return -1;
+    }
+    strcpy(copy, d->tab_name[index]);
+    t->tab[t->ntab] = cv_table_ref(d->tabs[index]);
+    t->tabname[t->ntab] = copy;
+    in->tab = t->ntab++;
+  }
+  table_group *gr = cv_realloc(t->group, ((size_t)t->ngroup + 1) * sizeof *gr);
+  if (!gr) return -1;
+  t->group = gr;
+  gr = &t->group[t->ngroup];
+  in->multi = t->ngroup++;
+  gr->n = 1;
+  memcpy(gr->ord[0], ord, sizeof ord);
+  /* the later calls of this table at the same arguments join the instruction; their
+   * destinations are allocated now (after the operands', so never aliasing them) */
+  for (int j = id + 1; j < nn && gr->n < EX_TABLE_FUSE; j++) {
+    const ex_node *nj = &d->nodes[j];
+    if (!cn[j].live || cn[j].konst || nj->op != EX_TABLE || nj->a != nd->a ||
+        nj->b != nd->b || nj->c != nd->c)
+      continue;
+    int jindex, jord[3];
+    ex_table_decode(nj->v, &jindex, jord);
+    if (jindex != index) continue;
+    if (cn[j].home.space < 0) cn[j].home = (loc){L_REG, take_register(rp, t)};
+    cn[j].fused = 1;
+    gr->dst[gr->n] = cn[j].home;
+    memcpy(gr->ord[gr->n], jord, sizeof jord);
+    gr->n++;
+  }
+  return 0;
+}
+
+/* The instruction computing non-constant node id from its operands' homes: the variant
+ * taking a constant operand as the scalar k where there is one. Returns -1 for an
+ * operation the tape cannot run (or a table call that fails). */
+static int select_instr(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id,
+                        regpool *rp, instr *in) {
+  const ex_node *nd = &d->nodes[id];
+  ex_id a = nd->a, b = nd->b;
+  int kc = k_capable(nd->op);
+  int ka = kc && cn[a].konst, kb = kc && cn[b].konst;
+  if (a >= 0) in->a = cn[a].home;
+  if (b >= 0) in->b = cn[b].home;
+  if (nd->c >= 0) in->c = cn[nd->c].home;
+  switch (nd->op) {
+  case EX_ADD: case EX_MUL: /* commutative: the constant goes to k */
+    in->op = nd->op == EX_ADD ? (ka || kb ? T_ADD_KV : T_ADD_VV)
+                              : (ka || kb ? T_MUL_KV : T_MUL_VV);
+    if (ka) in->k = cn[a].cval, in->a = in->b;
+    else if (kb) in->k = cn[b].cval;
+    if (ka || kb) in->b = in->a;
+    break;
+  case EX_SUB:
+    in->op = ka ? T_SUB_KV : kb ? T_SUB_VK : T_SUB_VV;
+    if (ka) in->k = cn[a].cval, in->a = in->b;
+    if (kb) in->k = cn[b].cval;
+    break;
+  case EX_DIV:
+    in->op = ka ? T_DIV_KV : kb ? T_DIV_VK : T_DIV_VV;
+    if (ka) in->k = cn[a].cval, in->a = in->b;
+    if (kb) in->k = cn[b].cval;
+    break;
+  case EX_POW:
+    if (ka) {
+      in->op = T_POW_KV;
+      in->k = cn[a].cval;
+      in->a = in->b;
+    } else if (kb) {
+      /* Small integer and half-integer exponents by multiplication and sqrt: exact
+       * or within an ulp of pow(), and several times faster. */
+      double e = cn[b].cval;
+      in->op = e == 2 ? T_SQR : e == 3 ? T_CUBE : e == 4 ? T_POW4 : e == -1 ? T_RECIP
+             : e == -2 ? T_RECIP2 : e == 0.5 ? T_SQRT : e == -0.5 ? T_RSQRT : T_POW_VK;
+      in->k = e;
+    } else {
+      in->op = T_POW_VV;
+    }
+    break;
+  case EX_NEG: in->op = T_NEG; break;
+  case EX_SQRT: in->op = T_SQRT; break;
+  case EX_ABS: in->op = T_ABS; break;
+  case EX_ATAN2: in->op = T_ATAN2; break;
+  case EX_MIN: in->op = T_MIN; break;
+  case EX_MAX: in->op = T_MAX; break;
+  case EX_LT: in->op = T_LT; break;
+  case EX_LE: in->op = T_LE; break;
+  case EX_GT: in->op = T_GT; break;
+  case EX_GE: in->op = T_GE; break;
+  case EX_IF: in->op = T_IF; break;
+  case EX_TABLE: return select_table(d, t, cn, nn, id, rp, in);
+  default:
+    in->op = T_FN1;
+    in->fn = unary_fn(nd->op);
+    if (!in->fn) return -1;
+  }
+  return 0;
+}
+
+ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
+  if (!d || nslots < 0 || nout < 0 || (nout > 0 && !outs)) return NULL;
+  int top = -1;
+  for (int o = 0; o < nout; o++) {
+    if (outs[o] < 0 || outs[o] >= d->n) return NULL;
+    if (outs[o] > top) top = outs[o];
+  }
+  int nn = top + 1;
+  ex_tape *t = cv_calloc(1, sizeof *t);
+  cnode *cn = cv_calloc((size_t)(nn > 0 ? nn : 1), sizeof *cn);
+  regpool rp = {NULL, 0};
+  /* At most one instruction per node plus one per output (copies and fills). */
+  instr *ins = cv_malloc(((size_t)nn + (size_t)nout + 1) * sizeof *ins);
+  if (!t || !cn || !ins) goto fail;
+  t->nslots = nslots;
+  t->nout = nout;
+  if (mark_live(d, cn, nn, nslots, nout, outs) < 0) goto fail;
+  mark_readers(d, cn, nn);
   /* Homes: an output node is computed straight into the caller's buffer (its first
    * output); slots are read where the caller keeps them; the rest live in registers. */
   for (int id = 0; id < nn; id++) cn[id].home.space = -1;
@@ -159,8 +315,8 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
     if (c->home.space < 0 && !c->konst && d->nodes[outs[o]].op != EX_SLOT)
       c->home = (loc){L_OUT, o};
   }
-  freeregs = cv_malloc(((size_t)nn + 1) * sizeof *freeregs);
-  if (!freeregs) goto fail;
+  rp.free = cv_malloc(((size_t)nn + 1) * sizeof *rp.free);
+  if (!rp.free) goto fail;
 
   int n = 0;
   for (int id = 0; id < nn; id++) {
@@ -172,158 +328,24 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
       continue;
     }
     if (c->konst && !c->needv) continue; /* used only as a scalar (or output: filled later) */
-    if (c->fused) goto free_operands;
-    instr in;
-    memset(&in, 0, sizeof in);
-    if (c->konst) {
-      in.op = T_FILL;
-      in.k = c->cval;
-    } else {
-      ex_id a = nd->a, b = nd->b;
-      int kc = k_capable(nd->op);
-      int ka = kc && cn[a].konst, kb = kc && cn[b].konst;
-      if (a >= 0) in.a = cn[a].home;
-      if (b >= 0) in.b = cn[b].home;
-      if (nd->c >= 0) in.c = cn[nd->c].home;
-      switch (nd->op) {
-      case EX_ADD: case EX_MUL: /* commutative: the constant goes to k */
-        in.op = nd->op == EX_ADD ? (ka || kb ? T_ADD_KV : T_ADD_VV)
-                                 : (ka || kb ? T_MUL_KV : T_MUL_VV);
-        if (ka) in.k = cn[a].cval, in.a = in.b;
-        else if (kb) in.k = cn[b].cval;
-        if (ka || kb) in.b = in.a;
-        break;
-      case EX_SUB:
-        in.op = ka ? T_SUB_KV : kb ? T_SUB_VK : T_SUB_VV;
-        if (ka) in.k = cn[a].cval, in.a = in.b;
-        if (kb) in.k = cn[b].cval;
-        break;
-      case EX_DIV:
-        in.op = ka ? T_DIV_KV : kb ? T_DIV_VK : T_DIV_VV;
-        if (ka) in.k = cn[a].cval, in.a = in.b;
-        if (kb) in.k = cn[b].cval;
-        break;
-      case EX_POW:
-        if (ka) {
-          in.op = T_POW_KV;
-          in.k = cn[a].cval;
-          in.a = in.b;
-        } else if (kb) {
-          /* Small integer and half-integer exponents by multiplication and sqrt: exact
-           * or within an ulp of pow(), and several times faster. */
-          double e = cn[b].cval;
-          in.op = e == 2 ? T_SQR : e == 3 ? T_CUBE : e == 4 ? T_POW4 : e == -1 ? T_RECIP
-                : e == -2 ? T_RECIP2 : e == 0.5 ? T_SQRT : e == -0.5 ? T_RSQRT : T_POW_VK;
-          in.k = e;
-        } else {
-          in.op = T_POW_VV;
-        }
-        break;
-      case EX_NEG: in.op = T_NEG; break;
-      case EX_SQRT: in.op = T_SQRT; break;
-      case EX_ABS: in.op = T_ABS; break;
-      case EX_ATAN2: in.op = T_ATAN2; break;
-      case EX_MIN: in.op = T_MIN; break;
-      case EX_MAX: in.op = T_MAX; break;
-      case EX_LT: in.op = T_LT; break;
-      case EX_LE: in.op = T_LE; break;
-      case EX_GT: in.op = T_GT; break;
-      case EX_GE: in.op = T_GE; break;
-      case EX_IF: in.op = T_IF; break;
-      case EX_TABLE: {
-        int index, ord[3];
-        ex_table_decode(nd->v, &index, ord);
-        if (index < 0 || index >= d->ntables) goto fail;
-        in.op = T_TABLE;
-        in.tab = -1;
-        for (int j = 0; j < t->ntab; j++)
-          if (t->tab[j] == d->tabs[index]) in.tab = j;
-        if (in.tab < 0) {
-          cv_table **tabs = cv_realloc(t->tab, ((size_t)t->ntab + 1) * sizeof *tabs);
-          if (tabs) t->tab = tabs;
-          char **names = cv_realloc(t->tabname, ((size_t)t->ntab + 1) * sizeof *names);
-          if (names) t->tabname = names;
-          char *copy = cv_malloc(strlen(d->tab_name[index]) + 1);
-          if (!tabs || !names || !copy) {
-            cv_free(copy);
-            goto fail;
-          }
-          strcpy(copy, d->tab_name[index]);
-          t->tab[t->ntab] = cv_table_ref(d->tabs[index]);
-          t->tabname[t->ntab] = copy;
-          in.tab = t->ntab++;
-        }
-        table_group *gr = cv_realloc(t->group, ((size_t)t->ngroup + 1) * sizeof *gr);
-        if (!gr) goto fail;
-        t->group = gr;
-        gr = &t->group[t->ngroup];
-        in.multi = t->ngroup++;
-        gr->n = 1;
-        memcpy(gr->ord[0], ord, sizeof ord);
-        /* the later calls of this table at the same arguments join the instruction; their
-         * destinations are allocated now (after the operands', so never aliasing them) */
-        for (int j = id + 1; j < nn && gr->n < EX_TABLE_FUSE; j++) {
-          const ex_node *nj = &d->nodes[j];
-          if (!cn[j].live || cn[j].konst || nj->op != EX_TABLE || nj->a != nd->a ||
-              nj->b != nd->b || nj->c != nd->c)
-            continue;
-          int jindex, jord[3];
-          ex_table_decode(nj->v, &jindex, jord);
-          if (jindex != index) continue;
-          if (cn[j].home.space < 0) {
-            int r;
-            if (nfree > 0) {
-              int best = 0;
-              for (int i = 1; i < nfree; i++)
-                if (freeregs[i] < freeregs[best]) best = i;
-              r = freeregs[best];
-              freeregs[best] = freeregs[--nfree];
-            } else {
-              r = t->nregs++;
-            }
-            cn[j].home = (loc){L_REG, r};
-          }
-          cn[j].fused = 1;
-          gr->dst[gr->n] = cn[j].home;
-          memcpy(gr->ord[gr->n], jord, sizeof jord);
-          gr->n++;
-        }
-        break;
+    if (!c->fused) { /* a fused table call was computed by an earlier call's instruction */
+      instr in;
+      memset(&in, 0, sizeof in);
+      if (c->konst) {
+        in.op = T_FILL;
+        in.k = c->cval;
+      } else if (select_instr(d, t, cn, nn, id, &rp, &in) < 0) {
+        goto fail;
       }
-      default:
-        in.op = T_FN1;
-        in.fn = unary_fn(nd->op);
-        if (!in.fn) goto fail;
-      }
+      /* Destination first, operands freed after: the destination never aliases an
+       * operand, which keeps every kernel free of overlap (and vectorisable with
+       * restrict). */
+      if (c->home.space < 0) c->home = (loc){L_REG, take_register(&rp, t)};
+      in.dst = c->home;
+      if (in.op == T_TABLE) t->group[in.multi].dst[0] = c->home;
+      ins[n++] = in;
     }
-    /* Destination first, operands freed after: the destination never aliases an operand,
-     * which keeps every kernel free of overlap (and vectorisable with restrict). */
-    if (c->home.space < 0) {
-      int r;
-      if (nfree > 0) {
-        int best = 0; /* lowest free register: keeps the live set compact */
-        for (int i = 1; i < nfree; i++)
-          if (freeregs[i] < freeregs[best]) best = i;
-        r = freeregs[best];
-        freeregs[best] = freeregs[--nfree];
-      } else {
-        r = t->nregs++;
-      }
-      c->home = (loc){L_REG, r};
-    }
-    in.dst = c->home;
-    if (in.op == T_TABLE) t->group[in.multi].dst[0] = c->home;
-    ins[n++] = in;
-  free_operands:
-    if (!c->konst) {
-      ex_id ops[3] = {nd->a, nd->b, nd->c};
-      for (int i = 0; i < 3; i++) {
-        ex_id o = ops[i];
-        if (o < 0 || cn[o].last != id || cn[o].home.space != L_REG) continue;
-        if ((i > 0 && o == ops[0]) || (i > 1 && o == ops[1])) continue; /* freed already */
-        freeregs[nfree++] = cn[o].home.idx;
-      }
-    }
+    if (!c->konst) release_operands(&rp, cn, nd, id);
   }
   /* Outputs not computed in place: constants, slots, repeated nodes. */
   for (int o = 0; o < nout; o++) {
@@ -344,11 +366,11 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
   t->ins = ins;
   t->nins = n;
   cv_free(cn);
-  cv_free(freeregs);
+  cv_free(rp.free);
   return t;
 fail:
   cv_free(cn);
-  cv_free(freeregs);
+  cv_free(rp.free);
   cv_free(ins);
   if (t) t->ins = NULL;
   ex_tape_free(t);
@@ -470,6 +492,8 @@ void ex_tape_eval(const ex_tape *t, int m, const double *const *in, double *cons
     else run(p, m, D, A, B, C);
   }
 }
+
+int ex_tape_num_tables(const ex_tape *t) { return t ? t->ntab : 0; }
 
 int ex_tape_fault(const ex_tape *t, int m, const double *work, char *msg, size_t len) {
   if (!t || !t->ntab || m <= 0 || !work) return 0;

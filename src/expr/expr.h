@@ -107,15 +107,19 @@ void ex_tape_free(ex_tape *t);
 size_t ex_tape_work_size(const ex_tape *t, int m);
 /* Evaluate at m points: in[s][k] is slot s at point k (in[s] may be NULL for a slot the
  * outputs do not use); out[o][k] receives output o. work has ex_tape_work_size(t, m)
- * doubles. Non-finite results are written as they come (the caller checks). */
+ * doubles. Non-finite results are written as they come (the caller checks). The in[],
+ * out[] and work arrays must not overlap one another (the kernels are compiled with
+ * restrict so they vectorise). */
 void ex_tape_eval(const ex_tape *t, int m, const double *const *in, double *const *out,
                   double *work);
 int ex_tape_num_instructions(const ex_tape *t);
 /* After ex_tape_eval with the same m and work: 1 when a table call met a point outside its
  * grid (the outputs there are NaN), with a sentence naming the table in msg; else 0. */
 int ex_tape_fault(const ex_tape *t, int m, const double *work, char *msg, size_t len);
+/* Number of distinct tables the tape calls. */
+int ex_tape_num_tables(const ex_tape *t);
 
-/* Additions (not in the first version of this header). */
+/* The DAG node by node, and reference evaluation. */
 /* Number of nodes in d; valid ids are 0 .. ex_dag_num_nodes(d) - 1. */
 int ex_dag_num_nodes(const ex_dag *d);
 /* Operand i (0, 1, 2) of node e, or -1 when the node has fewer operands. Operands always
@@ -125,9 +129,6 @@ ex_id ex_node_arg(const ex_dag *d, ex_id e, int i);
  * read). Reference evaluation (straight from the DAG, libm for every operation); for many
  * points compile a tape. Returns 0, or -1 on allocation failure. */
 int ex_eval(const ex_dag *d, ex_id e, const double *slots, double *value);
-/* Precondition of ex_tape_eval, stated here without changing its declaration: the
- * caller's in[], out[] and work arrays must not overlap one another (the kernels are
- * compiled with restrict so they vectorise). */
 
 /* Collect like terms (ex_collect.c): every sum in e becomes sum_k c_k t_k + c0 with each
  * distinct term once, numeric factors peeled off (2*t, t/2, -t). For display: combining

@@ -45,6 +45,7 @@ typedef struct {
   double value[2]; /* at a and at b; meaningful where not free */
   int free_end[2]; /* nonzero: natural boundary condition dF/dy' = 0 there */
   int line;
+  ex_id expr[2];   /* parameters as inputs: the value as an expression of them, else -1 */
 } sc_boundary;
 
 typedef struct scene {
@@ -83,6 +84,20 @@ typedef struct scene {
   int method_line;     /* 0 when not given */
   double tolerance;    /* default 1e-10 */
   int max_iterations;  /* default 50 */
+
+  /* Parameters as inputs (scene_load_*_inputs, docs/scale-out.md): parameter i is slot
+   * 2n+1+i of every expression instead of a folded number, params[i].expr is that slot,
+   * params[i].expr2 its definition (an expression of earlier parameters) and
+   * params[i].value its current value. Values that are constant expressions of
+   * parameters keep their expressions (a_expr, b_expr, bc[].expr, ints[].expr2,
+   * exact_action_expr) so that scene_set_parameters re-evaluates them. */
+  int params_as_inputs;
+  ex_id a_expr, b_expr, exact_action_expr;
+  int settings_line;   /* a [mesh]/[solver] value that uses a parameter: its line, else 0 */
+  int is_instance;     /* made by scene_instance_new: shares the rest with its scene */
+  /* [plot] (an addition, docs/scenes.md): slots 0 = the variable, 1..n = the unknowns */
+  int plot_path[2];    /* path = U, V: V drawn against U; -1, -1 when not given */
+  int *plot_down;      /* [n + 1]: nonzero for a name drawn increasing downward */
 } scene;
 
 /** Load a scene file. `name` for messages is the path itself; the path "-" reads standard
@@ -95,6 +110,33 @@ scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
  * messages (e.g. "gallery:catenary"). */
 scene *scene_load_buffer(const char *text, size_t len, const char *name, int nset,
                          const sc_set *set, char *err, size_t errlen);
+/** After a solve: a point x* strictly inside (a, b) where the integrand along the solution
+ * grows like |x - x*|^(-alpha) with alpha >= 0.85 (the action is then infinite, theory
+ * (SG-1)). Returns 1 with *xs and *alpha, 0 when there is none, -1 when out of memory. */
+int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double *alpha);
+
+/** The same, with the parameters as inputs of every compiled expression (see the fields
+ * above): one load and one compilation serve any parameter values. */
+scene *scene_load_file_inputs(const char *path, int nset, const sc_set *set, char *err,
+                              size_t errlen);
+scene *scene_load_buffer_inputs(const char *text, size_t len, const char *name, int nset,
+                                const sc_set *set, char *err, size_t errlen);
+
+/** Parameters as inputs only: set parameter values and re-evaluate what depends on them.
+ * given[i] nonzero: parameter i takes vals[i] (as `--set` would); else its definition is
+ * evaluated with the values before it. Then the interval, the end values, the [integrals]
+ * constants and the exact action. Returns 0, or -1 with "FILE: what is wrong" in err (a
+ * non-finite value, a >= b); the scene is then unusable until a successful call. */
+int scene_set_parameters(scene *s, const unsigned char *given, const double *vals,
+                         char *err, size_t errlen);
+
+/** A copy of s that shares its expressions, names and settings but owns its parameter
+ * values, interval, end values and [integrals] constants: one per thread, each set with
+ * scene_set_parameters, while s stays unchanged. Only the evaluators below (which read
+ * the DAG without changing it) may be used on an instance from several threads; free it
+ * (scene_free) before s. NULL on allocation failure. */
+scene *scene_instance_new(const scene *s);
+
 /** Release a scene; NULL is a no-op. */
 void scene_free(scene *s);
 

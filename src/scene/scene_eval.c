@@ -3,6 +3,7 @@
  * SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "scene/scene_internal.h"
 
@@ -15,15 +16,22 @@ enum { BATCH = 256 };
 int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const double *x,
                   const double *y, const double *dy, double *out)
 {
-  int n = s->n, ns = 1 + 2 * n, rc = -1;
+  int n = s->n, np = s->params_as_inputs ? s->nparams : 0, ns = 1 + 2 * n + np, rc = -1;
   if (nout == 0 || m == 0)
     return 0;
   ex_tape *t = ex_tape_new(s->dag, ns, nout, outs);
   const double **in = cv_malloc((size_t)ns * sizeof *in);
   double **o = cv_malloc((size_t)nout * sizeof *o);
   double *work = t ? cv_malloc((ex_tape_work_size(t, BATCH) + 1) * sizeof *work) : NULL;
-  if (!t || !in || !o || !work)
+  /* parameters as inputs: one batch per parameter filled with its value */
+  double *pb = cv_malloc(((size_t)np * BATCH + 1) * sizeof *pb);
+  if (!t || !in || !o || !work || !pb)
     goto done;
+  for (int j = 0; j < np; j++) {
+    for (int k = 0; k < BATCH; k++)
+      pb[(size_t)j * BATCH + k] = s->params[j].value;
+    in[1 + 2 * n + j] = pb + (size_t)j * BATCH;
+  }
   for (int k0 = 0; k0 < m; k0 += BATCH) {
     int b = m - k0 < BATCH ? m - k0 : BATCH;
     in[0] = x + k0;
@@ -37,6 +45,7 @@ int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const doub
   }
   rc = 0;
 done:
+  cv_free(pb);
   cv_free(work);
   cv_free(o);
   cv_free(in);
@@ -104,4 +113,82 @@ int scene_eval_reports(scene *s, int m, const double *x, const double *y, const 
   rc = sc_eval_exprs(s, nr, outs, m, x, y, dy, out);
   cv_free(outs);
   return rc;
+}
+
+/* Parameters as inputs: the values and everything computed from them, in the order the
+ * loader computed them (scene.h). */
+int scene_set_parameters(scene *s, const unsigned char *given, const double *vals,
+                         char *err, size_t errlen)
+{
+  if (err && errlen)
+    err[0] = '\0';
+  if (!s->params_as_inputs) {
+    sc_err(err, errlen, s->file, 0, "the scene was loaded with its parameters folded");
+    return -1;
+  }
+  for (int i = 0; i < s->nparams; i++) {
+    double v = vals && given && given[i] ? vals[i] : NAN;
+    if (!(given && given[i]) && sc_eval_params(s, s->params[i].expr2, &v) < 0)
+      goto nomem;
+    if (!isfinite(v)) {
+      sc_err(err, errlen, s->file, 0, "parameter '%s' is not a finite number (%g)",
+             s->params[i].name, v);
+      return -1;
+    }
+    s->params[i].value = v;
+  }
+  if (sc_eval_params(s, s->a_expr, &s->a) < 0 || sc_eval_params(s, s->b_expr, &s->b) < 0)
+    goto nomem;
+  if (!(s->a < s->b)) { /* also false for NaN */
+    sc_err(err, errlen, s->file, 0, "interval needs a < b, got a = %.17g, b = %.17g", s->a,
+           s->b);
+    return -1;
+  }
+  for (int i = 0; i < s->n; i++)
+    for (int end = 0; end < 2; end++) {
+      if (s->bc[i].free_end[end])
+        continue;
+      if (sc_eval_params(s, s->bc[i].expr[end], &s->bc[i].value[end]) < 0)
+        goto nomem;
+      if (!isfinite(s->bc[i].value[end])) {
+        sc_err(err, errlen, s->file, s->bc[i].line, "[boundary] %s at %s is not a finite "
+               "number", s->unknowns[i], end ? "b" : "a");
+        return -1;
+      }
+    }
+  for (int k = 0; k < s->nints; k++) {
+    if (sc_eval_params(s, s->ints[k].expr2, &s->ints[k].value) < 0)
+      goto nomem;
+    if (!isfinite(s->ints[k].value)) {
+      sc_err(err, errlen, s->file, s->ints[k].line, "[integrals] %s: the value c is not a "
+             "finite number", s->ints[k].name);
+      return -1;
+    }
+  }
+  if (s->has_exact_action && sc_eval_params(s, s->exact_action_expr, &s->exact_action) < 0)
+    goto nomem;
+  return 0;
+nomem:
+  sc_err(err, errlen, s->file, 0, "out of memory");
+  return -1;
+}
+
+scene *scene_instance_new(const scene *s)
+{
+  scene *c = cv_malloc(sizeof *c);
+  if (!c)
+    return NULL;
+  *c = *s;
+  c->is_instance = 1;
+  c->params = cv_malloc(((size_t)s->nparams + 1) * sizeof *c->params);
+  c->bc = cv_malloc(((size_t)s->n + 1) * sizeof *c->bc);
+  c->ints = cv_malloc(((size_t)s->nints + 1) * sizeof *c->ints);
+  if (!c->params || !c->bc || !c->ints) {
+    scene_free(c);
+    return NULL;
+  }
+  memcpy(c->params, s->params, (size_t)s->nparams * sizeof *c->params);
+  memcpy(c->bc, s->bc, (size_t)s->n * sizeof *c->bc);
+  memcpy(c->ints, s->ints, (size_t)s->nints * sizeof *c->ints);
+  return c;
 }

@@ -71,9 +71,11 @@ static char *read_all(int fd, const char *name, size_t *len, char *err, size_t e
   return buf;
 }
 
-scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
-                       size_t errlen)
+static scene *load_file(const char *path, int nset, const sc_set *set, int inputs,
+                        char *err, size_t errlen)
 {
+  scene *(*from_buffer)(const char *, size_t, const char *, int, const sc_set *, char *,
+                        size_t) = inputs ? scene_load_buffer_inputs : scene_load_buffer;
   if (err && errlen)
     err[0] = '\0';
   size_t len = 0;
@@ -87,7 +89,7 @@ scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
     name = STDIN_NAME;
     if (!stdin_text && !(stdin_text = read_all(STDIN_FILENO, name, &stdin_len, err, errlen)))
       return NULL;
-    return scene_load_buffer(stdin_text, stdin_len, name, nset, set, err, errlen);
+    return from_buffer(stdin_text, stdin_len, name, nset, set, err, errlen);
   } else {
     /* Refuse what is not a regular file before opening it: opening a FIFO blocks. */
     struct stat st;
@@ -117,7 +119,19 @@ scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
   }
   if (!buf)
     return NULL;
-  scene *s = scene_load_buffer(buf, len, name, nset, set, err, errlen);
+  scene *s = from_buffer(buf, len, name, nset, set, err, errlen);
   cv_free(buf);
   return s;
+}
+
+scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
+                       size_t errlen)
+{
+  return load_file(path, nset, set, 0, err, errlen);
+}
+
+scene *scene_load_file_inputs(const char *path, int nset, const sc_set *set, char *err,
+                              size_t errlen)
+{
+  return load_file(path, nset, set, 1, err, errlen);
 }

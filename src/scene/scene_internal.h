@@ -30,7 +30,7 @@ typedef struct {
 
 typedef enum {
   SEC_SCENE, SEC_PARAMETERS, SEC_DEFINITIONS, SEC_BOUNDARY, SEC_GUESS, SEC_CONSTRAINTS,
-  SEC_INTEGRALS, SEC_EXACT, SEC_REPORT, SEC_MESH, SEC_SOLVER, SEC_TABLES, SEC_COUNT
+  SEC_INTEGRALS, SEC_EXACT, SEC_REPORT, SEC_MESH, SEC_SOLVER, SEC_TABLES, SEC_PLOT, SEC_COUNT
 } sc_section;
 
 /* A logical line: a section header or a key line (with its continuations). */
@@ -98,6 +98,13 @@ typedef struct {
 ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what);
 int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
                    const char *what, double *value);
+/* The same, also giving the expression (an expression of the parameters when they are
+ * inputs; node may be NULL). */
+int sc_parse_const_node(sc_loader *L, const sc_entry *e, int off, const char *text,
+                        const char *what, double *value, ex_id *node);
+/* Value of a constant expression of the parameters at their current values (0, or -1 on
+ * allocation failure). */
+int sc_eval_params(const scene *s, ex_id e, double *value);
 const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap);
 int sc_first_slot(const scene *s, ex_id e, int from, int to);
 

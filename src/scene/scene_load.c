@@ -16,6 +16,7 @@ int sc_load_constraints(sc_loader *L);
 int sc_load_report(sc_loader *L);
 int sc_load_mesh(sc_loader *L);
 int sc_load_solver(sc_loader *L);
+int sc_load_plot(sc_loader *L);
 
 static void items_free(sc_item *it, int n)
 {
@@ -28,12 +29,20 @@ void scene_free(scene *s)
 {
   if (!s)
     return;
+  if (s->is_instance) { /* only what scene_instance_new copied */
+    cv_free(s->params);
+    cv_free(s->bc);
+    cv_free(s->ints);
+    cv_free(s);
+    return;
+  }
   cv_free(s->file);
   cv_free(s->title);
   cv_free(s->variable);
   for (int i = 0; i < s->n; i++)
     cv_free(s->unknowns[i]);
   cv_free(s->unknowns);
+  cv_free(s->plot_down);
   cv_free(s->bc);
   cv_free(s->guess);
   cv_free(s->exact);
@@ -217,18 +226,24 @@ static int load_parameters(sc_loader *L, int nset, const sc_set *set)
         over = &set[k]; /* the last --set of a name wins */
     L->limit = i;
     char what[160];
+    ex_id *def = &s->params[i].expr2; /* kept only with parameters as inputs */
     if (over) {
       /* No line to point to: the value came from the command line. */
       sc_entry fake = {NULL, NULL, 0, 0, NULL};
       snprintf(what, sizeof what, "--set %s=%s", over->name, over->value);
-      if (sc_parse_const(L, &fake, 0, over->value, what, &s->params[i].value) < 0)
+      if (sc_parse_const_node(L, &fake, 0, over->value, what, &s->params[i].value, def) < 0)
         return -1;
     } else {
       snprintf(what, sizeof what, "parameter '%s'", e->key);
-      if (sc_parse_const(L, e, 0, e->value, what, &s->params[i].value) < 0)
+      if (sc_parse_const_node(L, e, 0, e->value, what, &s->params[i].value, def) < 0)
         return -1;
     }
-    s->params[i].expr = ex_num(s->dag, s->params[i].value);
+    s->params[i].expr = s->params_as_inputs ? ex_slot(s->dag, 1 + 2 * s->n + i)
+                                            : ex_num(s->dag, s->params[i].value);
+    if (s->params[i].expr < 0) {
+      sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
+      return -1;
+    }
   }
   return 0;
 }
@@ -284,8 +299,10 @@ static int load_interval_integrand(sc_loader *L)
            "interval needs two values 'a, b', got %d", list.n);
     goto done;
   }
-  if (sc_parse_const(L, e, list.off[0], list.item[0], "interval start a", &s->a) < 0 ||
-      sc_parse_const(L, e, list.off[1], list.item[1], "interval end b", &s->b) < 0)
+  if (sc_parse_const_node(L, e, list.off[0], list.item[0], "interval start a", &s->a,
+                          &s->a_expr) < 0 ||
+      sc_parse_const_node(L, e, list.off[1], list.item[1], "interval end b", &s->b,
+                          &s->b_expr) < 0)
     goto done;
   if (!(s->a < s->b)) {
     sc_err(L->err, L->errlen, L->file, e->line,
@@ -302,8 +319,8 @@ done:
   return rc;
 }
 
-scene *scene_load_buffer(const char *text, size_t len, const char *name, int nset,
-                         const sc_set *set, char *err, size_t errlen)
+static scene *load_buffer(const char *text, size_t len, const char *name, int nset,
+                          const sc_set *set, int inputs, char *err, size_t errlen)
 {
   sc_loader L;
   memset(&L, 0, sizeof L);
@@ -316,6 +333,8 @@ scene *scene_load_buffer(const char *text, size_t len, const char *name, int nse
     return NULL;
   }
   s->F = -1;
+  s->params_as_inputs = inputs;
+  s->a_expr = s->b_expr = s->exact_action_expr = -1;
   L.s = s;
   L.file = s->file;
   L.err = err;
@@ -329,11 +348,23 @@ scene *scene_load_buffer(const char *text, size_t len, const char *name, int nse
       load_definitions(&L) < 0 || load_interval_integrand(&L) < 0 ||
       sc_load_boundary(&L) < 0 || sc_load_guess_exact(&L) < 0 ||
       sc_load_constraints(&L) < 0 || sc_load_report(&L) < 0 || sc_load_mesh(&L) < 0 ||
-      sc_load_solver(&L) < 0) {
+      sc_load_solver(&L) < 0 || sc_load_plot(&L) < 0) {
     sc_raw_free(&L.raw);
     scene_free(s);
     return NULL;
   }
   sc_raw_free(&L.raw);
   return s;
+}
+
+scene *scene_load_buffer(const char *text, size_t len, const char *name, int nset,
+                         const sc_set *set, char *err, size_t errlen)
+{
+  return load_buffer(text, len, name, nset, set, 0, err, errlen);
+}
+
+scene *scene_load_buffer_inputs(const char *text, size_t len, const char *name, int nset,
+                                const sc_set *set, char *err, size_t errlen)
+{
+  return load_buffer(text, len, name, nset, set, 1, err, errlen);
 }

@@ -70,6 +70,12 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
       snprintf(err, errlen, "a prime is only allowed on an unknown, not on '%s'", name);
       return -1;
     }
+    if (s->params_as_inputs) {
+      ex_id r = ex_slot(d, 1 + 2 * s->n + i); /* an input of the tape, not a number */
+      if (r < 0)
+        snprintf(err, errlen, "out of memory");
+      return r;
+    }
     return ex_num(d, s->params[i].value);
   }
   if (L->mode == SC_R_PARAM) {
@@ -155,17 +161,55 @@ ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const
 
 /* A constant expression (numbers, pi, parameters, definitions built from those), which
  * must be finite. Returns 0, or -1 with a message. */
+int sc_eval_params(const scene *s, ex_id e, double *value)
+{
+  int ns = 1 + 2 * s->n + s->nparams;
+  double *slots = cv_calloc((size_t)ns, sizeof *slots);
+  if (!slots)
+    return -1;
+  for (int i = 0; i < s->nparams; i++)
+    slots[1 + 2 * s->n + i] = s->params[i].value;
+  int rc = ex_eval(s->dag, e, slots, value);
+  cv_free(slots);
+  return rc;
+}
+
 int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
                    const char *what, double *value)
+{
+  ex_id node;
+  if (sc_parse_const_node(L, e, off, text, what, value, &node) < 0)
+    return -1;
+  /* A [mesh] or [solver] number: kept as a number even when it uses parameters (the
+   * batch refuses such a scene when a row sets one, docs/cli.md). */
+  if (L->s->params_as_inputs && !L->s->settings_line &&
+      sc_first_slot(L->s, node, 1 + 2 * L->s->n, 2 * L->s->n + L->s->nparams) >= 0)
+    L->s->settings_line = e->line ? e->line : -1;
+  return 0;
+}
+
+int sc_parse_const_node(sc_loader *L, const sc_entry *e, int off, const char *text,
+                        const char *what, double *value, ex_id *node)
 {
   char nb[128];
   int line, col;
   ex_id r = sc_parse(L, e, off, text, what);
+  if (node)
+    *node = -1;
   if (r < 0)
     return -1;
   sc_entry_locate(e, off, &line, &col);
   int slot = sc_first_slot(L->s, r, 0, 2 * L->s->n);
-  if (slot >= 0 || ex_eval_const(L->s->dag, r, value) != 0) {
+  int bad = slot >= 0;
+  if (!bad && L->s->params_as_inputs) {
+    if (sc_eval_params(L->s, r, value) < 0) {
+      sc_err(L->err, L->errlen, L->file, line, "out of memory");
+      return -1;
+    }
+  } else if (!bad) {
+    bad = ex_eval_const(L->s->dag, r, value) != 0;
+  }
+  if (bad) {
     sc_err(L->err, L->errlen, L->file, line,
            "%s must be a constant expression, but '%s' depends on '%s'", what, text,
            slot >= 0 ? sc_slot_name(L->s, slot, nb, sizeof nb) : "?");
@@ -176,5 +220,7 @@ int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
            text, isnan(*value) ? "NaN" : *value > 0 ? "+inf" : "-inf");
     return -1;
   }
+  if (node)
+    *node = r;
   return 0;
 }

@@ -13,6 +13,26 @@ static int guess_cb(int m, const double *x, double *y, void *user)
   return scene_eval_guess(user, m, x, y) < 0 ? -1 : 0;
 }
 
+/* An integrand object for e; with parameters as inputs they are set to their values. */
+static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *msg,
+                             size_t len)
+{
+  int np = s->params_as_inputs ? s->nparams : 0;
+  ex_integrand *g = ex_integrand_new_params(s->dag, s->n, np, e, max_need, msg, len);
+  if (g && np) {
+    double *v = malloc((size_t)np * sizeof *v);
+    if (!v) {
+      ex_integrand_free(g);
+      return NULL;
+    }
+    for (int i = 0; i < np; i++)
+      v[i] = s->params[i].value;
+    ex_integrand_set_params(g, v);
+    free(v);
+  }
+  return g;
+}
+
 cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size_t errlen)
 {
   cv_status why;
@@ -24,14 +44,14 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
     sc_err(err, errlen, s->file, 0, "cannot create the problem: %s", cv_strerror(why));
     return NULL;
   }
-  ex_integrand *ig = ex_integrand_new(s->dag, s->n, s->F, max_need, msg, sizeof msg);
+  ex_integrand *ig = compile(s, s->F, max_need, msg, sizeof msg);
   if (!ig) {
     sc_err(err, errlen, s->file, s->F_line, "integrand: %s", msg[0] ? msg : "out of memory");
     goto fail;
   }
   why = cv_problem_set_integrand_owned(p, ex_integrand_eval, ig, ex_integrand_release);
-  if (why == CVAR_OK) /* names a table whose grid the path left, when a solve fails */
-    why = cv_problem_set_integrand_note(p, ex_integrand_note);
+  if (why == CVAR_OK && ex_integrand_has_tables(ig)) /* names a table whose grid was left */
+    why = cv_problem_add_note(p, ex_integrand_note, ig);
   if (why != CVAR_OK) {
     sc_err(err, errlen, s->file, s->F_line, "integrand: %s", cv_strerror(why));
     goto fail;
@@ -50,7 +70,7 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
    * the derivatives the method needs. */
   for (int k = 0; k < s->ncons; k++) {
     const sc_item *it = &s->cons[k];
-    ex_integrand *g = ex_integrand_new(s->dag, s->n, it->expr, max_need, msg, sizeof msg);
+    ex_integrand *g = compile(s, it->expr, max_need, msg, sizeof msg);
     if (!g) {
       sc_err(err, errlen, s->file, it->line, "[constraints] %s: %s", it->name,
              msg[0] ? msg : "out of memory");
@@ -58,6 +78,8 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
     }
     why = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g,
                                           ex_integrand_release, NULL);
+    if (why == CVAR_OK && ex_integrand_has_tables(g))
+      why = cv_problem_add_note(p, ex_integrand_note, g);
     if (why != CVAR_OK) {
       sc_err(err, errlen, s->file, it->line, "[constraints] %s: %s", it->name, cv_strerror(why));
       goto fail;
@@ -65,7 +87,7 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
   }
   for (int k = 0; k < s->nints; k++) {
     const sc_item *it = &s->ints[k];
-    ex_integrand *g = ex_integrand_new(s->dag, s->n, it->expr, max_need, msg, sizeof msg);
+    ex_integrand *g = compile(s, it->expr, max_need, msg, sizeof msg);
     if (!g) {
       sc_err(err, errlen, s->file, it->line, "[integrals] %s: %s", it->name,
              msg[0] ? msg : "out of memory");
@@ -73,6 +95,8 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
     }
     why = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release,
                                         it->value, NULL);
+    if (why == CVAR_OK && ex_integrand_has_tables(g))
+      why = cv_problem_add_note(p, ex_integrand_note, g);
     if (why != CVAR_OK) {
       sc_err(err, errlen, s->file, it->line, "[integrals] %s: %s", it->name, cv_strerror(why));
       goto fail;

@@ -71,6 +71,8 @@ int sc_load_boundary(sc_loader *L)
   s->bc = cv_calloc((size_t)s->n, sizeof *s->bc);
   if (!s->bc)
     return nomem(L, 0);
+  for (int k = 0; k < s->n; k++)
+    s->bc[k].expr[0] = s->bc[k].expr[1] = -1;
   for (int i = 0; i < L->raw.ne[SEC_BOUNDARY]; i++) {
     const sc_entry *e = &L->raw.e[SEC_BOUNDARY][i];
     int k = unknown_index(s, e->key);
@@ -105,7 +107,8 @@ int sc_load_boundary(sc_loader *L)
         return -1;
       }
       snprintf(what, sizeof what, "[boundary] %s at %s", e->key, end ? "b" : "a");
-      if (sc_parse_const(L, e, list.off[end], t, what, &s->bc[k].value[end]) < 0) {
+      if (sc_parse_const_node(L, e, list.off[end], t, what, &s->bc[k].value[end],
+                              &s->bc[k].expr[end]) < 0) {
         ex_list_free(&list);
         return -1;
       }
@@ -159,7 +162,8 @@ int sc_load_guess_exact(sc_loader *L)
       char what[160];
       snprintf(what, sizeof what, "[%s] %s", sc_section_name(sec), e->key);
       if (sec == SEC_EXACT && strcmp(e->key, "action") == 0) {
-        if (sc_parse_const(L, e, 0, e->value, "[exact] action", &s->exact_action) < 0)
+        if (sc_parse_const_node(L, e, 0, e->value, "[exact] action", &s->exact_action,
+                                &s->exact_action_expr) < 0)
           return -1;
         s->has_exact_action = 1;
         continue;
@@ -183,7 +187,7 @@ int sc_load_guess_exact(sc_loader *L)
 static int load_named(sc_loader *L, int sec, sc_item **out, int *nout)
 {
   int ne = L->raw.ne[sec];
-  *out = calloc((size_t)ne + 1, sizeof **out);
+  *out = cv_calloc((size_t)ne + 1, sizeof **out);
   if (!*out)
     return nomem(L, 0);
   for (int i = 0; i < ne; i++) {
@@ -216,9 +220,10 @@ static int load_named(sc_loader *L, int sec, sc_item **out, int *nout)
              "[integrals] %s needs 'K, c' (the integral of K equals c), got %d values",
              e->key, list.n);
     else if ((it->expr = sc_parse(L, e, list.off[0], list.item[0], what)) >= 0 &&
-             sc_parse_const(L, e, list.off[1], list.item[1], "[integrals] value c",
-                            &it->value) == 0) {
-      it->expr2 = ex_num(L->s->dag, it->value);
+             sc_parse_const_node(L, e, list.off[1], list.item[1], "[integrals] value c",
+                                 &it->value, &it->expr2) == 0) {
+      if (!L->s->params_as_inputs)
+        it->expr2 = ex_num(L->s->dag, it->value);
       rc = 0;
     }
     ex_list_free(&list);

@@ -148,6 +148,25 @@ with tempfile.TemporaryDirectory() as tmp:
         expect("solve --plot link-to-/dev/full.svg", r, 3, "No space left")
         os.unlink(ln)
 
+    # --- /dev/stdout: a pipe (a /proc "magic" link readlink cannot name) and a file ------
+    if os.path.exists("/dev/stdout"):
+        r = run(["solve", scene, "--quiet", "--json", "/dev/stdout"], tmp)
+        expect("solve --json /dev/stdout (a pipe)", r, 0)
+        try:
+            json.loads(r.out)
+        except ValueError:
+            fail("--json /dev/stdout (a pipe)", "the JSON report on the pipe", r.out[:200])
+        red = os.path.join(tmp, "redirected.json")
+        with open(red, "wb") as f:
+            r = run(["solve", scene, "--quiet", "--json", "/dev/stdout"], tmp, stdout=f)
+        expect("solve --json /dev/stdout (a file)", r, 0)
+        with open(red) as f:
+            try:
+                json.load(f)
+            except ValueError:
+                fail("--json /dev/stdout (a file)", "the JSON report in the file", "not JSON")
+        os.unlink(red)
+
     # --- FIFOs: streamed into, never replaced -----------------------------------------
     for opt, name, head in [("--csv", "fifo.csv", b"x,"), ("--json", "fifo.json", b"{"),
                             ("--plot", "fifo.svg", b"<?xml")]:

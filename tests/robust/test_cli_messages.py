@@ -80,5 +80,39 @@ r = run(["solve", CAT, "--method", "lbfgs"])
 if "Newton step within" in r.stdout:
     fail("summary test line for lbfgs", "no Newton step line", r.stdout)
 
+# An integrand singular inside the interval: y'^2 + y^2/(x - 0.5) has an infinite action
+# (F ~ y(0.5)^2/|x - 0.5| along any path with y(0.5) != 0): never "converged", whatever
+# the mesh (even or odd element counts, degrees); integrable singularities (log, 1/sqrt)
+# and a singular point outside the interval stay converged.
+import tempfile
+with tempfile.TemporaryDirectory() as tmp:
+    def scene(name, integrand, interval="0, 1"):
+        path = os.path.join(tmp, name + ".scene")
+        with open(path, "w") as f:
+            f.write("[scene]\ninterval = %s\nunknowns = y\nintegrand = %s\n"
+                    "[boundary]\ny = 0, 1\n" % (interval, integrand))
+        return path
+    sing = scene("sing", "y'^2 + y^2/(x - 0.5)")
+    for extra in ([], ["--elements", "101"], ["--degree", "3", "--elements", "10"]):
+        r = run(["solve", sing, "--json", "-"] + extra)
+        j = json.loads(r.stdout) if r.stdout else {}
+        if r.returncode != 1 or j.get("status") != "diverged" or \
+                "singular at x = 0.5" not in j.get("message", "") or "morse_index" in j:
+            fail("interior singularity " + " ".join(extra),
+                 "exit 1, diverged, 'singular at x = 0.5', no Morse index",
+                 "%d: %s" % (r.returncode, r.stdout[:300] + r.stderr))
+    sing2 = scene("sing2", "y'^2 + y^2/(x^2 - 0.09)")  # zero at x = 0.3, a sign change
+    r = run(["solve", sing2, "--quiet"])
+    if r.returncode != 1 or "singular at x = 0.3" not in r.stderr:
+        fail("interior singularity at 0.3", "exit 1, 'singular at x = 0.3'",
+             "%d: %s" % (r.returncode, r.stderr))
+    for name, integrand in (("log", "y'^2 + y^2*log(abs(x - 0.5))"),
+                            ("sqrt", "y'^2 + y^2/sqrt(abs(x - 0.5))"),
+                            ("outside", "y'^2 + y^2/(x - 1.5)")):
+        r = run(["solve", scene(name, integrand), "--quiet"])
+        if r.returncode != 0:
+            fail("integrable or outside singularity (%s)" % name, "exit 0",
+                 "%d: %s" % (r.returncode, r.stderr))
+
 print("test_cli_messages: %d failures" % failures)
 sys.exit(1 if failures else 0)

@@ -175,5 +175,25 @@ with tempfile.TemporaryDirectory() as tmp:
         if "nan" in r.stdout.lower():
             fail(name + " report", "no NaN", r.stdout)
 
+    # an integral constraint that calls the table and forces the path out of its grid
+    # (mean height 0.75 > 0.65): exit 1, and the message names the table all the same
+    write(scene, """[scene]
+title = integral constraint through a table
+interval = -0.8, 0.8
+unknowns = y
+integrand = sqrt(1 + y'^2)
+[tables]
+n = data/n.csv
+[integrals]
+area = y + 1e-9*n(x, y), 1.2
+[boundary]
+y = 0.3, 0.3
+""")
+    r = run(["solve", scene, "--quiet"], tmp)
+    print("constraint_leaves: exit %d, %s" % (r.returncode, r.stderr.strip()[:200]))
+    if r.returncode != 1 or "table 'n'" not in r.stderr:
+        fail("constraint_leaves", "exit 1 naming table 'n'",
+             "%d %s" % (r.returncode, r.stderr.strip()))
+
 print("%d failure(s)" % failures if failures else "all table scene checks passed")
 sys.exit(1 if failures else 0)

@@ -1,0 +1,578 @@
+/* src/cli/cli_batch.c — `calcvar batch SCENE TABLE.csv [--out FILE] [--threads N]
+ * [--warm] [solve options]`: one solve per table row on one compiled scene (docs/cli.md).
+ * SPDX-License-Identifier: MIT
+ *
+ * Two passes over the table. The first checks all of it (header, every row's count and
+ * numbers, and that each row's values make a valid scene) before anything is written, so
+ * bad input is exit 2 with the table's FILE:LINE and no output. The second streams it:
+ * windows of rows are solved (threads inside a window, MPI ranks sharing it in blocks)
+ * and written in input order; memory depends on the window, not on the number of rows.
+ */
+#define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT, getline */
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <sched.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cli/cli.h"
+#include "cli/cli_batch.h"
+#include "scene/scene_batch.h"
+
+enum { ROWS_PER_THREAD = 32 }; /* window = threads x this (x ranks under MPI) */
+
+static void usage(FILE *f)
+{
+  fputs("usage: calcvar batch SCENE TABLE.csv [options]\n"
+        "  TABLE.csv            header of parameter names, one row of values per problem\n"
+        "  --out FILE           the result table (default stdout)\n"
+        "  --threads N          rows solved at once (default: the cores available)\n"
+        "  --warm               start each row from the previous row's solution\n"
+        "  --elements N, --degree P, --method M, --tolerance T, --max-iterations K,\n"
+        "  --set name=value, --adapt TOL   as for calcvar solve, for every row\n"
+        "Output: the input columns, status, action, iterations, time_s, morse_index,\n"
+        "error_max_nodal (with [exact]) or error_estimate (with --adapt), one column per\n"
+        "[report] entry and integral multiplier (mu_NAME), message.\n"
+        "exit status: 0 every row converged, 1 some did not, 2 bad input\n", f);
+}
+
+int cli_cores_available(void)
+{
+  cpu_set_t set;
+  if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0)
+    return CPU_COUNT(&set);
+  long c = sysconf(_SC_NPROCESSORS_ONLN);
+  return c > 0 ? (int)c : 1;
+}
+
+/* ---- the table ---------------------------------------------------------------------- */
+
+typedef struct {
+  const char *path;
+  FILE *f;
+  char *line;
+  size_t cap;
+  int lineno;
+  int ncols;
+  char **names;  /* header */
+  char **field;  /* fields of the current row (point into line) */
+} table;
+
+/* Next non-blank line split at commas into t->field; returns the field count, 0 at the
+ * end, -1 on a read error. Fields are trimmed of blanks; the line's end is removed. */
+static int next_line(table *t, int maxf)
+{
+  for (;;) {
+    ssize_t len = getline(&t->line, &t->cap, t->f);
+    if (len < 0)
+      return ferror(t->f) ? -1 : 0;
+    t->lineno++;
+    while (len > 0 && (t->line[len - 1] == '\n' || t->line[len - 1] == '\r'))
+      t->line[--len] = '\0';
+    char *p = t->line;
+    while (*p == ' ' || *p == '\t')
+      p++;
+    if (!*p)
+      continue; /* blank lines are skipped */
+    int k = 0;
+    for (;;) {
+      char *c = strchr(p, ',');
+      if (c)
+        *c = '\0';
+      while (*p == ' ' || *p == '\t')
+        p++;
+      char *e = p + strlen(p);
+      while (e > p && (e[-1] == ' ' || e[-1] == '\t'))
+        *--e = '\0';
+      if (k < maxf)
+        t->field[k] = p;
+      k++;
+      if (!c)
+        break;
+      p = c + 1;
+    }
+    return k;
+  }
+}
+
+static void table_close(table *t)
+{
+  if (t->f)
+    fclose(t->f);
+  for (int c = 0; t->names && c < t->ncols; c++)
+    free(t->names[c]);
+  free(t->names);
+  free(t->field);
+  free(t->line);
+  memset(t, 0, sizeof *t);
+}
+
+/* Open and read the header. 0, or EXIT_BADINPUT after a message. */
+static int table_open(table *t, const char *path, cv_batch *b)
+{
+  char err[512];
+  memset(t, 0, sizeof *t);
+  t->path = path;
+  if (!(t->f = fopen(path, "r"))) {
+    fprintf(stderr, "%s: cannot open: %s\n", path, strerror(errno));
+    return EXIT_BADINPUT;
+  }
+  int np = cv_batch_num_parameters(b), maxf = np + 1;
+  t->field = malloc((size_t)maxf * sizeof *t->field);
+  if (!t->field) {
+    fprintf(stderr, "calcvar batch: out of memory\n");
+    return EXIT_BADINPUT;
+  }
+  int k = next_line(t, maxf);
+  if (k <= 0) {
+    fprintf(stderr, "%s:%d: %s\n", path, t->lineno > 0 ? t->lineno : 1,
+            k < 0 ? "read error" : "the table is empty (it needs a header of parameter "
+                                   "names)");
+    return EXIT_BADINPUT;
+  }
+  if (k > np) {
+    fprintf(stderr, "%s:%d: the header has %d columns but %s has %d parameter%s\n", path,
+            t->lineno, k, scene_batch_scene(b)->file, np, np == 1 ? "" : "s");
+    return EXIT_BADINPUT;
+  }
+  t->names = calloc((size_t)k, sizeof *t->names);
+  if (!t->names)
+    return EXIT_BADINPUT;
+  t->ncols = k;
+  for (int c = 0; c < k; c++)
+    if (!(t->names[c] = strdup(t->field[c])))
+      return EXIT_BADINPUT;
+  if (cv_batch_set_columns(b, k, (const char *const *)t->names, err, sizeof err) != CVAR_OK) {
+    fprintf(stderr, "%s:%d: %s\n", path, t->lineno, err[0] ? err : "out of memory");
+    return EXIT_BADINPUT;
+  }
+  return 0;
+}
+
+/* Next row into vals (ncols numbers): 1, 0 at the end, or EXIT_BADINPUT (negated: -2)
+ * after a message. */
+static int table_row(table *t, double *vals)
+{
+  int k = next_line(t, t->ncols);
+  if (k == 0)
+    return 0;
+  if (k < 0) {
+    fprintf(stderr, "%s:%d: read error\n", t->path, t->lineno);
+    return -EXIT_BADINPUT;
+  }
+  if (k != t->ncols) {
+    fprintf(stderr, "%s:%d: %d value%s, but the header has %d column%s\n", t->path,
+            t->lineno, k, k == 1 ? "" : "s", t->ncols, t->ncols == 1 ? "" : "s");
+    return -EXIT_BADINPUT;
+  }
+  for (int c = 0; c < k; c++) {
+    char *end;
+    errno = 0;
+    vals[c] = strtod(t->field[c], &end);
+    if (end == t->field[c] || *end || !isfinite(vals[c])) {
+      fprintf(stderr, "%s:%d: column '%s': '%s' is not a finite number\n", t->path,
+              t->lineno, t->names[c], t->field[c]);
+      return -EXIT_BADINPUT;
+    }
+  }
+  return 1;
+}
+
+/* ---- one output row ----------------------------------------------------------------- */
+
+static void num(cli_buf *o, double v, const char *fmt)
+{
+  cli_buf_printf(o, ",");
+  if (isfinite(v))
+    cli_buf_printf(o, fmt, v);
+}
+
+/* The row's output line (input fields as given) appended to o. */
+static void format_row(cli_buf *o, const cli_batch_cols *cols, char *const *in,
+                       const cv_batch_result *r)
+{
+  for (int c = 0; c < cols->ncols; c++)
+    cli_buf_printf(o, "%s%s", c ? "," : "", in[c]);
+  cli_buf_printf(o, "%s%s", cols->ncols ? "," : "", cli_status_string(r->status));
+  num(o, r->has_result ? r->action : NAN, "%.17g");
+  cli_buf_printf(o, ",%d", r->iterations);
+  num(o, r->time_s, "%.6f");
+  cli_buf_printf(o, ",");
+  if (r->has_result && r->morse_index >= 0)
+    cli_buf_printf(o, "%d", r->morse_index);
+  if (cols->err_nodal)
+    num(o, r->has_result ? r->error_max_nodal : NAN, "%.3e");
+  if (cols->err_est)
+    num(o, r->has_result ? r->error_estimate : NAN, "%.3e");
+  for (int k = 0; k < cols->nout; k++)
+    num(o, r->has_result ? r->outputs[k] : NAN, "%.17g");
+  /* the message as one quoted CSV field */
+  cli_buf_printf(o, ",\"");
+  for (const char *m = r->message; *m; m++) {
+    if (*m == '"')
+      cli_buf_printf(o, "\"\"");
+    else if (*m != '\n' && *m != '\r')
+      cli_buf_printf(o, "%c", *m);
+  }
+  cli_buf_printf(o, "\"\n");
+}
+
+int cli_buf_printf(cli_buf *o, const char *fmt, ...)
+{
+  va_list ap;
+  for (;;) {
+    size_t room = o->cap - o->len;
+    va_start(ap, fmt);
+    int k = o->data ? vsnprintf(o->data + o->len, room, fmt, ap) : -1;
+    va_end(ap);
+    if (k >= 0 && (size_t)k < room) {
+      o->len += (size_t)k;
+      return 0;
+    }
+    size_t need = o->len + (k > 0 ? (size_t)k : 64) + 1;
+    size_t ncap = o->cap ? o->cap : 1024;
+    while (ncap < need)
+      ncap *= 2;
+    char *nd = realloc(o->data, ncap);
+    if (!nd) {
+      o->failed = 1;
+      return -1;
+    }
+    o->data = nd;
+    o->cap = ncap;
+  }
+}
+
+/* ---- the command -------------------------------------------------------------------- */
+
+static double wall(void)
+{
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Take batch's own options out of argv (the rest goes to the solve option parser).
+ * Returns 0, or EXIT_BADINPUT after a message. */
+static int own_args(int argc, char **argv, char **rest, int *nrest, const char **table_path,
+                    const char **out, int *threads, int *warm, int *help)
+{
+  int npos = 0;
+  *nrest = 0;
+  for (int i = 0; i < argc; i++) {
+    const char *a = argv[i];
+    if (strcmp(a, "--warm") == 0) {
+      *warm = 1;
+    } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+      *help = 1;
+    } else if (strncmp(a, "--out", 5) == 0 && (a[5] == '\0' || a[5] == '=')) {
+      if (!a[5] && i + 1 >= argc) {
+        fprintf(stderr, "calcvar batch: --out needs a value\n");
+        return EXIT_BADINPUT;
+      }
+      *out = a[5] ? a + 6 : argv[++i];
+    } else if (strncmp(a, "--threads", 9) == 0 && (a[9] == '\0' || a[9] == '=')) {
+      const char *v = a[9] ? a + 10 : (i + 1 < argc ? argv[++i] : NULL);
+      char *end;
+      long t = v ? strtol(v, &end, 10) : 0;
+      if (!v || !*v || *end || t < 1 || t > 1024) {
+        fprintf(stderr, "calcvar batch: --threads needs a whole number from 1 to 1024, got "
+                "'%s'\n", v ? v : "");
+        return EXIT_BADINPUT;
+      }
+      *threads = (int)t;
+    } else if (a[0] != '-' || strcmp(a, "-") == 0) {
+      if (npos++ == 1)
+        *table_path = a; /* the second positional argument; the first is the scene */
+      else
+        rest[(*nrest)++] = argv[i];
+    } else {
+      rest[(*nrest)++] = argv[i];
+      /* a valued solve option: keep its value with it */
+      if (!strchr(a, '=') && i + 1 < argc && strcmp(a, "--quiet") != 0)
+        rest[(*nrest)++] = argv[++i];
+    }
+  }
+  return 0;
+}
+
+int cli_batch(int argc, char **argv)
+{
+  cli_opts o;
+  memset(&o, 0, sizeof o);
+  char **rest = malloc(((size_t)argc + 1) * sizeof *rest);
+  const char *table_path = NULL, *out_path = NULL;
+  int threads = 0, warm = 0, help = 0, nrest = 0, rc;
+  if (!rest)
+    return EXIT_BADINPUT;
+  cli_mpi mpi;
+  cli_mpi_init(&mpi);
+  rc = own_args(argc, argv, rest, &nrest, &table_path, &out_path, &threads, &warm, &help);
+  if (rc == 0)
+    rc = cli_args_parse("batch", nrest, rest, &o);
+  free(rest);
+  if (rc != 0 || help || o.help) {
+    if (rc == 0 && mpi.rank == 0)
+      usage(stdout);
+    cli_opts_free(&o);
+    cli_mpi_finish(&mpi);
+    return rc;
+  }
+  if (!o.scene_path || !table_path) {
+    fprintf(stderr, "calcvar batch: needs a scene and a table: calcvar batch SCENE "
+            "TABLE.csv [options]\n");
+    cli_opts_free(&o);
+    cli_mpi_finish(&mpi);
+    return EXIT_BADINPUT;
+  }
+  if (o.cont || o.json || o.csv || o.plot) {
+    fprintf(stderr, "calcvar batch: --%s is an option of calcvar solve, not of batch\n",
+            o.cont ? "continue" : o.json ? "json" : o.csv ? "csv" : "plot");
+    cli_opts_free(&o);
+    cli_mpi_finish(&mpi);
+    return EXIT_BADINPUT;
+  }
+  rc = cli_batch_run(&o, table_path, out_path, threads, warm, &mpi);
+  cli_opts_free(&o);
+  cli_mpi_finish(&mpi);
+  return rc;
+}
+
+int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_path,
+                  int threads, int warm, cli_mpi *mpi)
+{
+  char err[SC_ERRLEN];
+  int rc = EXIT_BADINPUT;
+  table t;
+  memset(&t, 0, sizeof t);
+  cli_outfile of = {0};
+  cv_batch *b = NULL;
+  double *vals = NULL;
+  char **text = NULL;
+  cv_batch_result *res = NULL;
+  double *outs = NULL;
+  cli_buf buf = {0};
+  scene *s = scene_load_file_inputs(o->scene_path, o->nset, o->set, err, sizeof err);
+  if (!s) {
+    fprintf(stderr, "%s\n", err);
+    goto done;
+  }
+  if (o->elements)
+    s->elements = o->elements;
+  if (o->degree)
+    s->degree = o->degree;
+  if (o->method >= 0)
+    s->method = (cv_method)o->method;
+  if (o->tolerance > 0)
+    s->tolerance = o->tolerance;
+  if (o->max_iterations)
+    s->max_iterations = o->max_iterations;
+  if (o->adapt > 0)
+    s->adapt = o->adapt;
+  if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) &&
+      (s->ncons > 0 || s->nints > 0)) {
+    fprintf(stderr, "calcvar batch: method %s cannot impose constraints; use mma, ccsaq, "
+            "slsqp, auglag or newton\n", cv_method_name(s->method));
+    scene_free(s);
+    goto done;
+  }
+  int settings_line = s->settings_line;
+  const char *scene_file = o->scene_path;
+  if (!(b = scene_batch_new(s, err, sizeof err))) { /* b owns s from here */
+    fprintf(stderr, "%s\n", err);
+    goto done;
+  }
+  if ((rc = table_open(&t, table_path, b)) != 0)
+    goto done;
+  rc = EXIT_BADINPUT;
+  if (settings_line && t.ncols > 0) {
+    /* a [mesh]/[solver] number computed from a parameter: it would have to follow the
+     * row, which this build does not do (docs/cli.md) */
+    fprintf(stderr, "%s:%d: a [mesh] or [solver] value uses a parameter; calcvar batch "
+            "keeps one mesh and solver setting for every row\n", scene_file,
+            settings_line > 0 ? settings_line : 0);
+    goto done;
+  }
+  int nc = t.ncols;
+  vals = malloc(((size_t)nc + 1) * sizeof *vals);
+  if (!vals)
+    goto done;
+  /* Pass 1: the whole table is checked before anything is written. */
+  long nrows = 0;
+  for (;;) {
+    int k = table_row(&t, vals);
+    if (k < 0)
+      goto done;
+    if (k == 0)
+      break;
+    if (cv_batch_check_row(b, vals, err, sizeof err) != CVAR_OK) {
+      /* the scene's message names the scene; the row is where the values came from */
+      fprintf(stderr, "%s:%d: %s\n", t.path, t.lineno, err);
+      goto done;
+    }
+    nrows++;
+  }
+  if (nrows > INT_MAX / 2) {
+    fprintf(stderr, "%s: more than %d rows\n", t.path, INT_MAX / 2);
+    goto done;
+  }
+  table_close(&t);
+  if ((rc = table_open(&t, table_path, b)) != 0)
+    goto done;
+  rc = EXIT_BADINPUT;
+  if (threads == 0)
+    threads = cli_cores_available();
+  cv_batch_set_threads(b, threads);
+  cv_batch_set_warm_start(b, warm);
+  if (out_path && strcmp(out_path, table_path) == 0) {
+    fprintf(stderr, "calcvar batch: --out %s would overwrite the table being read\n",
+            out_path);
+    goto done;
+  }
+  if (mpi->rank == 0 && out_path && cli_outfile_open(&of, out_path, o->scene_path) < 0)
+    goto done;
+  FILE *f = mpi->rank == 0 ? (out_path ? of.f : stdout) : NULL;
+
+  cli_batch_cols cols = {nc, 0, 0, cv_batch_num_outputs(b)};
+  const scene *sc = scene_batch_scene(b);
+  for (int i = 0; i < sc->n; i++)
+    cols.err_nodal |= sc->exact[i] >= 0;
+  cols.err_est = !cols.err_nodal && sc->adapt > 0;
+  if (f) {
+    for (int c = 0; c < nc; c++)
+      fprintf(f, "%s,", t.names[c]);
+    fprintf(f, "status,action,iterations,time_s,morse_index");
+    if (cols.err_nodal)
+      fprintf(f, ",error_max_nodal");
+    if (cols.err_est)
+      fprintf(f, ",error_estimate");
+    for (int k = 0; k < cols.nout; k++)
+      fprintf(f, ",%s", cv_batch_output_name(b, k));
+    fprintf(f, ",message\n");
+  }
+
+  /* Pass 2: windows of W rows per rank; under MPI the ranks take consecutive blocks of
+   * one window of W * size rows, and rank 0 writes them in order. */
+  int W = threads * ROWS_PER_THREAD, wsz = W * mpi->size;
+  text = calloc((size_t)W * nc + 1, sizeof *text);
+  double *wvals = malloc(((size_t)W * nc + 1) * sizeof *wvals);
+  res = calloc((size_t)W, sizeof *res);
+  outs = malloc(((size_t)W * cols.nout + 1) * sizeof *outs);
+  char *store = NULL; /* the field texts of the rank's rows (a copy: lines are reused) */
+  if (!text || !wvals || !res || !outs) {
+    free(wvals);
+    goto done;
+  }
+  for (int r = 0; r < W; r++)
+    res[r].outputs = outs + (size_t)r * cols.nout;
+  long done_rows = 0, failures = 0;
+  int tty = mpi->rank == 0 && isatty(2);
+  double t0 = wall();
+  int ok = 1;
+  while (done_rows < nrows && ok) {
+    /* this window: rows [done_rows, done_rows + wsz); ours: a block of up to W */
+    long w0 = done_rows, wn = nrows - w0 < wsz ? nrows - w0 : wsz;
+    long m0 = w0 + (long)mpi->rank * W, mine = 0;
+    size_t slen = 0, scap = 0;
+    free(store);
+    store = NULL;
+    size_t *off = malloc(((size_t)W * nc + 1) * sizeof *off);
+    if (!off) {
+      ok = 0;
+      break;
+    }
+    for (long r = w0; r < w0 + wn; r++) {
+      int k = table_row(&t, vals);
+      if (k <= 0) { /* the file changed since pass 1 */
+        fprintf(stderr, "%s: the table changed while it was read\n", t.path);
+        ok = 0;
+        break;
+      }
+      if (r < m0 || r >= m0 + W)
+        continue;
+      for (int c = 0; c < nc; c++) {
+        size_t l = strlen(t.field[c]) + 1;
+        if (slen + l > scap) {
+          size_t ncap = scap ? 2 * scap : 4096;
+          while (ncap < slen + l)
+            ncap *= 2;
+          char *ns = realloc(store, ncap);
+          if (!ns) {
+            ok = 0;
+            break;
+          }
+          store = ns, scap = ncap;
+        }
+        memcpy(store + slen, t.field[c], l);
+        off[mine * nc + c] = slen;
+        slen += l;
+        wvals[mine * nc + c] = vals[c];
+      }
+      mine++;
+    }
+    if (!ok) {
+      free(off);
+      break;
+    }
+    for (long r = 0; r < mine; r++)
+      for (int c = 0; c < nc; c++)
+        text[r * nc + c] = store + off[r * nc + c];
+    free(off);
+    if (mine > 0 && cv_batch_solve(b, (int)mine, wvals, res) != CVAR_OK) {
+      fprintf(stderr, "calcvar batch: out of memory\n");
+      ok = 0;
+      break;
+    }
+    buf.len = 0;
+    for (long r = 0; r < mine; r++) {
+      format_row(&buf, &cols, text + r * nc, &res[r]);
+      failures += res[r].status != CVAR_OK;
+    }
+    if (buf.failed) {
+      ok = 0;
+      break;
+    }
+    if (cli_mpi_gather_write(mpi, f, &buf) < 0) {
+      ok = 0;
+      break;
+    }
+    done_rows += wn;
+    if (tty) {
+      double el = wall() - t0;
+      fprintf(stderr, "\rcalcvar batch: %ld/%ld rows, %.1f rows/s, %ld failed", done_rows,
+              nrows, el > 0 ? done_rows / el : 0.0, failures);
+    }
+  }
+  free(wvals);
+  free(store);
+  if (tty)
+    fputc('\n', stderr);
+  if (!ok) {
+    rc = EXIT_UNSOLVED;
+    goto done;
+  }
+  if (f && out_path && cli_outfile_commit(&of) < 0) {
+    fprintf(stderr, "calcvar batch: %s could not be written\n", out_path);
+    rc = EXIT_UNSOLVED;
+    goto done;
+  }
+  if (f && !out_path && fflush(stdout) != 0) {
+    rc = EXIT_UNSOLVED;
+    goto done;
+  }
+  rc = cli_mpi_reduce_failures(mpi, failures) == 0 ? EXIT_SOLVED : EXIT_UNSOLVED;
+done:
+  cli_outfile_abandon(&of);
+  free(buf.data);
+  free(outs);
+  free(res);
+  free(text);
+  free(vals);
+  table_close(&t);
+  cv_batch_free(b);
+  return rc;
+}
