@@ -25,6 +25,8 @@ static void usage(FILE *f)
         "  --set name=value     override a parameter (repeatable)\n"
         "  --adapt TOL          refine until the estimated max nodal error < TOL\n"
         "  --max-elements N     cap of adaptive refinement (default 2000000)\n"
+        "  --tol T              choose mesh and degrees until the estimated max nodal\n"
+        "                       error <= T (elements/degree, if given, are the start)\n"
         "  --continue name=from:to   continuation in a parameter\n"
         "  --all                every stationary path that can be found (deflation)\n"
         "  --max K              at most K paths with --all (default 8)\n"
@@ -33,6 +35,8 @@ static void usage(FILE *f)
         "  --csv FILE           nodal table ('-' for stdout)\n"
         "  --plot FILE          picture of the solution (.png or .svg)\n"
         "  --quiet              no summary on stdout\n"
+        "  -v, --verbose        one line per Newton iteration and adaptive round on stderr\n"
+        "  -h, --help           this text\n"
         "exit status: 0 converged, 1 not solved, 2 bad input, 3 write error\n", f);
 }
 
@@ -40,7 +44,13 @@ static void usage(FILE *f)
  * ignore a request. */
 static int unsupported(const cli_opts *o, const scene *s)
 {
-  if (o->cont && (o->adapt > 0 || s->adapt > 0)) {
+  if ((o->tol > 0 && s->adapt > 0) || (o->adapt > 0 && s->tol > 0)) {
+    fprintf(stderr, "%s:%d: [mesh] %s cannot be combined with %s\n", s->file,
+            s->tol > 0 ? s->tol_line : s->adapt_line, s->tol > 0 ? "tol" : "adapt",
+            s->tol > 0 ? "--adapt" : "--tol");
+    return EXIT_BADINPUT;
+  }
+  if (o->cont && (o->adapt > 0 || s->adapt > 0 || o->tol > 0 || s->tol > 0)) {
     fprintf(stderr, "calcvar solve: --continue and adaptive refinement cannot be combined "
             "(continuation keeps one mesh)\n");
     return EXIT_BADINPUT;
@@ -105,6 +115,14 @@ int cli_solve(int argc, char **argv)
   cli_apply_solver_options(&o, s);
   if ((rc = unsupported(&o, s)) != 0)
     goto done;
+  double tol = o.tol > 0 ? o.tol : s->tol;
+  if (tol > 0) { /* automatic accuracy: the scene's or the flags' mesh is only the start */
+    s->tol = tol;
+    if (!o.elements && !s->elements_line && s->grading <= 0)
+      s->elements = SCENE_TOL_START_ELEMENTS;
+    if (!o.degree && !s->degree_line)
+      s->degree = SCENE_TOL_START_DEGREE;
+  }
   cv_status why;
   if ((!o.cont && !(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err))) ||
       !(sv = cv_solver_new(&why)) || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK) {
@@ -130,8 +148,11 @@ int cli_solve(int argc, char **argv)
   }
   cv_status st;
   char cont_msg[256] = "";
+  cli_progress_setup(o.verbose);
+  cli_progress_attach(sv);
   if (o.all) {
     rc = cli_all_run(&o, s, p, sv, adapt, &jf, &cf, &pf);
+    cli_progress_end();
     goto done;
   }
   if (o.cont) {
@@ -150,13 +171,14 @@ int cli_solve(int argc, char **argv)
   } else {
     st = cv_solve(sv, p);
   }
+  cli_progress_end();
   if (st == CVAR_EINVAL) {
     /* Input the core refused before solving (e.g. a dense NLopt Jacobian too large). */
     fprintf(stderr, "%s: %s\n", s->file, cv_solver_last_error(sv));
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if (cli_report_build(&r, s, p, sv, st, adapt > 0) < 0) {
+  if (cli_report_build(&r, s, p, sv, st, tol > 0 ? 2 : adapt > 0) < 0) {
     fprintf(stderr, "calcvar solve: out of memory while reporting\n");
     rc = EXIT_UNSOLVED;
     goto done;

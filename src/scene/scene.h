@@ -76,6 +76,12 @@ typedef struct scene {
   double *breakpoints; /* sorted, inside (a, b) */
   double adapt;        /* 0: off */
   int adapt_line;
+  double tol;          /* [mesh] tol: automatic accuracy (hp), 0: off */
+  int tol_line;
+  int elements_line, degree_line; /* 0 when not given (--tol then picks its start) */
+#define SCENE_TOL_MAX_NODES 1000000 /* cap of --tol / [mesh] tol on the nodes */
+#define SCENE_TOL_START_ELEMENTS 4  /* --tol's starting mesh when the scene gives none */
+#define SCENE_TOL_START_DEGREE 4
   double grading;      /* 0: uniform; else the exponent k >= 1 (an addition, docs/scenes.md) */
   int graded_end;      /* CVAR_GRADE_A, CVAR_GRADE_B or CVAR_GRADE_BOTH */
 
@@ -95,6 +101,9 @@ typedef struct scene {
   ex_id a_expr, b_expr, exact_action_expr;
   int settings_line;   /* a [mesh]/[solver] value that uses a parameter: its line, else 0 */
   int is_instance;     /* made by scene_instance_new: shares the rest with its scene */
+  /* [plot] (an addition, docs/scenes.md): slots 0 = the variable, 1..n = the unknowns */
+  int plot_path[2];    /* path = U, V: V drawn against U; -1, -1 when not given */
+  int *plot_down;      /* [n + 1]: nonzero for a name drawn increasing downward */
 } scene;
 
 /** Load a scene file. `name` for messages is the path itself; the path "-" reads standard

@@ -77,14 +77,14 @@ static int load_breakpoints(sc_loader *L, const sc_entry *e)
 
 int sc_load_mesh(sc_loader *L)
 {
-  static const char *const keys[] = {"elements", "degree", "breakpoints", "adapt",
+  static const char *const keys[] = {"elements", "degree", "breakpoints", "adapt", "tol",
                                      "grading", "grading_at", NULL};
   scene *s = L->s;
   s->elements = 100;
   s->degree = 1;
   s->graded_end = CVAR_GRADE_A;
   if (sc_check_keys(L, SEC_MESH, keys,
-                 "elements, degree, breakpoints, adapt, grading, grading_at") < 0)
+                 "elements, degree, breakpoints, adapt, tol, grading, grading_at") < 0)
     return -1;
   for (int i = 0; i < L->raw.ne[SEC_MESH]; i++) {
     const sc_entry *e = &L->raw.e[SEC_MESH][i];
@@ -93,9 +93,11 @@ int sc_load_mesh(sc_loader *L)
       /* INT_MAX / 9: nodes = elements * degree + 1 must stay an int at degree 8. */
       if (parse_count(L, e, 1, INT_MAX / 9, &s->elements) < 0)
         return -1;
+      s->elements_line = e->line;
     } else if (strcmp(k, "degree") == 0) {
       if (parse_count(L, e, 1, 8, &s->degree) < 0)
         return -1;
+      s->degree_line = e->line;
     } else if (strcmp(k, "breakpoints") == 0) {
       if (load_breakpoints(L, e) < 0)
         return -1;
@@ -108,6 +110,15 @@ int sc_load_mesh(sc_loader *L)
         return -1;
       }
       s->adapt_line = e->line;
+    } else if (strcmp(k, "tol") == 0) {
+      if (sc_parse_const(L, e, 0, e->value, "tol", &s->tol) < 0)
+        return -1;
+      if (!(s->tol > 0)) {
+        sc_err(L->err, L->errlen, L->file, e->line,
+               "tol is the target max nodal error and must be > 0, got %g", s->tol);
+        return -1;
+      }
+      s->tol_line = e->line;
     } else if (strcmp(k, "grading") == 0) {
       if (sc_parse_const(L, e, 0, e->value, "grading", &s->grading) < 0)
         return -1;
@@ -130,6 +141,12 @@ int sc_load_mesh(sc_loader *L)
         return -1;
       }
     }
+  }
+  if (s->tol > 0 && s->adapt > 0) {
+    sc_err(L->err, L->errlen, L->file, s->tol_line > s->adapt_line ? s->tol_line : s->adapt_line,
+           "tol and adapt cannot both be given (tol chooses the mesh and the degrees, adapt "
+           "the mesh at one degree)");
+    return -1;
   }
   return 0;
 }
@@ -165,6 +182,67 @@ int sc_load_solver(sc_loader *L)
     } else if (parse_count(L, e, 1, INT_MAX, &s->max_iterations) < 0) {
       return -1;
     }
+  }
+  return 0;
+}
+
+/* The slot of a name in [plot]: 0 for the variable, 1 + i for unknown i, -1 otherwise. */
+static int plot_slot(const scene *s, const char *name)
+{
+  if (strcmp(name, s->variable) == 0)
+    return 0;
+  for (int i = 0; i < s->n; i++)
+    if (strcmp(name, s->unknowns[i]) == 0)
+      return 1 + i;
+  return -1;
+}
+
+/* [plot] (an addition): `path = U, V` draws V against U with equal scales (U and V the
+ * variable or unknowns, distinct); `downward = names` draws those names increasing
+ * downward (the brachistochrone's y is a depth). */
+int sc_load_plot(sc_loader *L)
+{
+  static const char *const keys[] = {"path", "downward", NULL};
+  scene *s = L->s;
+  s->plot_path[0] = s->plot_path[1] = -1;
+  if (!(s->plot_down = cv_calloc((size_t)s->n + 1, sizeof *s->plot_down))) {
+    sc_err(L->err, L->errlen, L->file, 0, "out of memory");
+    return -1;
+  }
+  if (sc_check_keys(L, SEC_PLOT, keys, "path, downward") < 0)
+    return -1;
+  for (int i = 0; i < L->raw.ne[SEC_PLOT]; i++) {
+    const sc_entry *e = &L->raw.e[SEC_PLOT][i];
+    ex_list list;
+    if (ex_list_split(e->value, &list) < 0) {
+      sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
+      return -1;
+    }
+    int is_path = strcmp(e->key, "path") == 0, rc = 0;
+    if (is_path && list.n != 2) {
+      sc_err(L->err, L->errlen, L->file, e->line, "path needs two names (horizontal, "
+             "vertical), got %d", list.n);
+      rc = -1;
+    }
+    for (int k = 0; k < list.n && rc == 0; k++) {
+      int slot = plot_slot(s, list.item[k]);
+      if (slot < 0) {
+        sc_err(L->err, L->errlen, L->file, e->line, "%s: '%s' is neither the variable nor "
+               "an unknown", e->key, list.item[k]);
+        rc = -1;
+      } else if (is_path) {
+        s->plot_path[k] = slot;
+      } else {
+        s->plot_down[slot] = 1;
+      }
+    }
+    if (rc == 0 && is_path && s->plot_path[0] == s->plot_path[1]) {
+      sc_err(L->err, L->errlen, L->file, e->line, "path: '%s' against itself", list.item[0]);
+      rc = -1;
+    }
+    ex_list_free(&list);
+    if (rc < 0)
+      return -1;
   }
   return 0;
 }

@@ -144,6 +144,10 @@ cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_
     what = "adapt"; /* [mesh] adapt; the command caps the mesh at 2e6 elements */
     st = cv_solver_set_adapt(sv, s->adapt, 2000000);
   }
+  if (st == CVAR_OK && s->tol > 0) {
+    what = "tol"; /* [mesh] tol or --tol: automatic accuracy, capped at 1e6 nodes */
+    st = cv_solver_set_tol(sv, s->tol, SCENE_TOL_MAX_NODES);
+  }
   if (st == CVAR_OK) {
     what = "method";
     st = cv_solver_set_method(sv, s->method);
