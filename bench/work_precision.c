@@ -211,7 +211,9 @@ static int draw(const char *dir, const char *name, const char *title, point pts[
   }
   char t[256];
   snprintf(t, sizeof t, "%s: work against precision", title);
-  cli_plot_panel pan = {t, "run time of one solve [s]", "max nodal error", 1, 1, nl, lines};
+  cli_plot_panel pan = {.title = t, .xlabel = "run time of one solve [s]",
+                        .ylabel = "max nodal error", .logx = 1, .logy = 1, .nlines = nl,
+                        .lines = lines};
   cli_outfile o;
   if (cli_outfile_open(&o, path, NULL) < 0)
     return -1;

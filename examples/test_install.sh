@@ -67,3 +67,24 @@ done
 "$exe" --version >"$dest/out" 2>&1 || fail "installed calcvar --version"
 "$exe" solve "$src/examples/scenes/catenary.scene" --quiet || fail "installed calcvar solve"
 echo "installed command: $(cat "$dest/out"); solves examples/scenes/catenary.scene"
+
+# The Python module: installed into site-packages (when meson found a Python with numpy),
+# importable from the staged tree with the staged library, and solving.
+pymod=$(find "$dest" -path '*/calcvar/__init__.py' | head -n 1)
+py=""
+for p in python3 /usr/bin/python3; do
+  if command -v "$p" >/dev/null 2>&1 && "$p" -c 'import numpy' 2>/dev/null; then py=$p; fi
+done
+if [ -n "$py" ]; then
+  [ -n "$pymod" ] || fail "the Python module was not installed"
+  [ -f "${pymod%/*}/_config.py" ] || fail "the Python module's _config.py was not installed"
+  if [ -z "$extra" ]; then  # an instrumented library cannot load into a plain interpreter
+    PYTHONPATH="${pymod%/calcvar/*}" CALCVAR_LIB="$shared" "$py" -c '
+import sys, calcvar
+s = calcvar.solve(sys.argv[1])
+assert s.success and s.report["error"]["max_nodal"] < 1e-10, s.message
+print("python  calcvar %s from %s: %s" % (calcvar.version(), calcvar.__file__, s.status))
+' "$src/examples/scenes/catenary.scene" || fail "the installed Python module"
+  fi
+  echo "python module: ${pymod#"$dest"}"
+fi

@@ -18,6 +18,18 @@
  * solve runs CHOLMOD's symbolic analysis of the sparse pattern on one extra thread of its
  * own, which it joins before it returns; no user code runs there.
  *
+ * Array layouts (one per kind of array, the same in every call):
+ *  - values at the mesh nodes are node-major: y[j*n + i] is unknown i at node j
+ *    (cv_solver_get_values, cv_solver_set_start); so a node's n values are adjacent, and a
+ *    C array y[nodes][n] (numpy shape (nodes, n), C order) is this layout;
+ *  - one value per node (nodes, multiplier fields) is a plain array x[j], lambda[j];
+ *  - values at a batch of m points are unknown-major: y[i*m + k] (the integrand, guess and
+ *    constraint callbacks, cv_solver_get_qpoints, cv_solver_eval), so that each unknown's m
+ *    values are adjacent for vectorised evaluation.
+ *
+ * Only the names declared here are exported from libcalcvar.so (CVAR_API); everything else
+ * in the library is internal.
+ *
  * Minimal use (the catenary, see examples/catenary.c):
  * \code
  *   cv_status why;
@@ -85,14 +97,15 @@ CVAR_API void cv_version(int *major, int *minor, int *patch);
   X(CVAR_EDIVERGED, "the iteration diverged")                                                 \
   X(CVAR_ENOTMIN, "the stationary point is not a minimum")                                   \
   X(CVAR_EDEPENDENCY, "failure inside a dependency (CHOLMOD, NLopt)")                         \
-  X(CVAR_ESTATE, "no solution available (call cv_solve first)")
+  X(CVAR_ESTATE, "no solution available (call cv_solve first)")                              \
+  X(CVAR_ECANCELLED, "cancelled by the progress callback")
 
 /** Turns one CVAR_STATUS_LIST entry into an enumerator (undefined again below). */
 #define CVAR_ENUM_ITEM(name, msg) name,
 /** Result of every fallible call. CVAR_OK is 0; all other values are failures. The values,
  * in order, are those of CVAR_STATUS_LIST: CVAR_OK, CVAR_EINVAL, CVAR_ENOMEM, CVAR_ECALLBACK,
  * CVAR_ENONFINITE, CVAR_ESINGULAR, CVAR_EMAXITER, CVAR_ESTALL, CVAR_EDIVERGED, CVAR_ENOTMIN,
- * CVAR_EDEPENDENCY, CVAR_ESTATE; CVAR_NUM_STATUS counts them. */
+ * CVAR_EDEPENDENCY, CVAR_ESTATE, CVAR_ECANCELLED; CVAR_NUM_STATUS counts them. */
 typedef enum { CVAR_STATUS_LIST(CVAR_ENUM_ITEM) CVAR_NUM_STATUS } cv_status;
 #undef CVAR_ENUM_ITEM
 
@@ -100,6 +113,10 @@ typedef enum { CVAR_STATUS_LIST(CVAR_ENUM_ITEM) CVAR_NUM_STATUS } cv_status;
 CVAR_API const char *cv_strerror(cv_status s);
 /** The symbolic name of a status, e.g. "CVAR_EMAXITER"; never NULL. */
 CVAR_API const char *cv_status_name(cv_status s);
+/** The libraries linked into libcalcvar with their versions, as the libraries report them
+ * at run time, e.g. "CHOLMOD 3.0.14, NLopt 2.7.1, LAPACK 3.11.0, jansson 2.14, inih", into
+ * buf (len bytes; 160 is ample). CVAR_EINVAL when it does not fit. */
+CVAR_API cv_status cv_dependency_versions(char *buf, size_t len);
 /**@}*/
 
 /** \name Integrand callbacks */
@@ -404,6 +421,32 @@ CVAR_API int cv_solver_get_adapt_rounds(const cv_solver *s);
 /** Start the next solve from nodal values y (node-major, length nodes*n as laid out by
  * the current mesh and degree); NULL returns to the problem's guess. Copied. */
 CVAR_API cv_status cv_solver_set_start(cv_solver *s, int len, const double *y);
+
+/** What a progress callback is told (cv_solver_set_progress). */
+typedef struct {
+  int kind;        /**< CVAR_PROGRESS_NEWTON after a Newton step, CVAR_PROGRESS_ROUND after
+                        an adaptive round's error estimate */
+  int iteration;   /**< Newton iteration of the current mesh solve, 1, 2, ... (NEWTON) */
+  double residual; /**< scaled Euler-Lagrange residual (theory N-3) of the iterate the step
+                        started from (NEWTON) */
+  double step;     /**< weighted RMS norm of the Newton step (theory N-4); <= 1 ends the
+                        iteration (NEWTON) */
+  double alpha;    /**< line-search factor of the step taken, 1 for a full step (NEWTON) */
+  double action;   /**< discrete action after the step (NEWTON) */
+  int round;       /**< adaptive refinement round, 1, 2, ...; 0 when not adaptive */
+  int elements;    /**< elements of the mesh being solved */
+  double estimate; /**< estimated max nodal error after the round (ROUND); NaN otherwise */
+} cv_progress;
+/** Values of cv_progress.kind. */
+enum { CVAR_PROGRESS_NEWTON = 0, CVAR_PROGRESS_ROUND = 1 };
+/** Progress callback: return 0 to go on, nonzero to cancel the solve (cv_solve then returns
+ * CVAR_ECANCELLED, and the results describe the last iterate). */
+typedef int (*cv_progress_fn)(const cv_progress *info, void *user);
+/** Call fn on the calling thread of cv_solve after every Newton step and every adaptive
+ * round (NLopt engines report nothing); NULL turns it off. Newton runs inside automatic
+ * continuation are reported like any other (their iteration count restarts); the reference
+ * solves of adaptive refinement are not. */
+CVAR_API cv_status cv_solver_set_progress(cv_solver *s, cv_progress_fn fn, void *user);
 
 /** Status of the last solve (CVAR_ESTATE before any). */
 CVAR_API cv_status cv_solver_get_status(const cv_solver *s);

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# scripts/deps.sh — install the Debian packages calcvar needs to build, test and plot.
+# scripts/deps.sh — install the Debian packages calcvar needs to build, test and plot
+# (python3-numpy, -pytest, -matplotlib: the Python module, its tests and its pictures).
 set -euo pipefail
 SUDO=""
 [ "$(id -u)" -eq 0 ] || SUDO="sudo"
@@ -9,6 +10,7 @@ $SUDO apt-get install -y -qq --no-install-recommends \
   build-essential meson ninja-build pkg-config \
   libsuitesparse-dev libnlopt-dev libinih-dev libjansson-dev liblapack-dev \
   libplplot-dev plplot-driver-cairo \
+  python3-numpy python3-pytest python3-matplotlib \
   doxygen groff-base \
   libopenmpi-dev openmpi-bin \
   g++ libgeographiclib-dev geographiclib-tools strace >/dev/null

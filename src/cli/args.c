@@ -79,7 +79,8 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     memcpy(name, a, nl);
     name[nl] = '\0';
     int flag = strcmp(name, "--quiet") == 0 || strcmp(name, "--help") == 0 ||
-               strcmp(name, "-h") == 0 || strcmp(name, "--all") == 0;
+               strcmp(name, "-h") == 0 || strcmp(name, "--all") == 0 ||
+               strcmp(name, "--verbose") == 0 || strcmp(name, "-v") == 0;
     static const char *const valued[] = {
       "--elements", "--degree", "--method", "--tolerance", "--max-iterations", "--set",
       "--adapt", "--tol", "--continue", "--json", "--csv", "--plot", "--max", "--work",
@@ -96,6 +97,8 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
         o->quiet = 1;
       else if (strcmp(name, "--all") == 0)
         o->all = 1;
+      else if (strcmp(name, "--verbose") == 0 || strcmp(name, "-v") == 0)
+        o->verbose = 1;
       else
         o->help = 1;
       continue;
@@ -234,7 +237,8 @@ void cli_apply_solver_options(const cli_opts *o, scene *s)
 int cli_only_scene_options(const char *cmd, const cli_opts *o)
 {
   if (o->csv || o->plot || o->adapt > 0 || o->tol > 0 || o->cont || o->elements || o->degree ||
-      o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all || o->max_elements) {
+      o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all || o->max_elements ||
+      o->verbose) {
     fprintf(stderr, "calcvar %s: only --set, --json and --quiet apply to %s\n", cmd, cmd);
     return EXIT_BADINPUT;
   }

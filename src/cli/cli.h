@@ -26,7 +26,7 @@ typedef struct {
   int nset;
   sc_set *set;
   const char *json, *csv, *plot;
-  int quiet, help;
+  int quiet, help, verbose;
   int all, max_paths; /* --all, --max K (0: default 8) */
   double work;        /* --work F: the search's work limit (0: default 8) */
 } cli_opts;
@@ -40,6 +40,11 @@ void cli_opts_free(cli_opts *o);
 int cli_only_scene_options(const char *cmd, const cli_opts *o);
 /* --method, --tolerance and --max-iterations, where given, override the scene's [solver]. */
 void cli_apply_solver_options(const cli_opts *o, scene *s);
+
+/* progress.c: --verbose lines and the terminal status line (see there). */
+void cli_progress_setup(int verbose);
+void cli_progress_attach(cv_solver *sv);
+void cli_progress_end(void);
 
 /* cli_continue.c: `solve --continue name=from:to` (see there). */
 /* s0: the scene, loaded once with parameters as inputs (scene_load_file_inputs) and
@@ -92,11 +97,19 @@ typedef struct {
 typedef struct {
   const char *title, *xlabel, *ylabel;
   int logx, logy;
+  int equal;        /* one unit is as long on both axes (a path) */
+  int xdown, ydown; /* the axis increases leftward / downward */
+  int no_legend;    /* the axis labels say it all (one curve) */
+  double vp[4];     /* x0, x1, y0, y1 of the axes on the page (0..1); all 0: stacked */
   int nlines;
   const cli_plot_line *lines;
 } cli_plot_panel;
 int cli_plot_path_ok(const char *path); /* ends in .svg or .png */
-int cli_plot_write(cli_outfile *o, int npanels, const cli_plot_panel *panels);
+/* Panels stacked top to bottom on a page 960 wide (the vp of each panel is set here). */
+int cli_plot_write(cli_outfile *o, int npanels, cli_plot_panel *panels);
+/* Panels where their vp says, on a page of width x height pixels. */
+int cli_plot_write_page(cli_outfile *o, int width, int height, int npanels,
+                        const cli_plot_panel *panels);
 
 int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv);
 

@@ -88,6 +88,7 @@ int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene 
       cv_problem_free(p2);
       goto bad;
     }
+    cli_progress_attach(sv2);
     st = cv_solve(sv2, p2);
     cv_problem_free(p2);
     if (st == CVAR_OK || !last) {

@@ -36,6 +36,7 @@ static void usage(FILE *f)
         "  --json FILE          the rows as an array of reports ('-' for stdout)\n"
         "  --method M, --tolerance T, --max-iterations K, --set name=value   as for solve\n"
         "  --quiet              no table on stdout\n"
+        "  -v, --verbose        one line per Newton iteration on stderr\n"
         "Errors are against [exact]; without it they are estimates from a finer mesh.\n"
         "exit status: 0 every mesh converged, 1 some did not, 2 bad input, 3 write error\n", f);
 }
@@ -176,7 +177,9 @@ static int solve_row(scene *s, const cv_problem *p, int any_exact, cli_conv_row 
       cv_solver_free(sv);
       break;
     }
+    cli_progress_attach(sv);
     cv_status sr = cv_solve(sv, p);
+    cli_progress_end();
     double t = cv_solver_get_time(sv);
     total += isfinite(t) ? t : 1;
     if (!best || t < tbest) {
@@ -264,6 +267,7 @@ int cli_converge(int argc, char **argv)
     usage(stdout);
     goto done;
   }
+  cli_progress_setup(o.verbose);
   const char *notmine = o.csv ? "--csv" : o.plot ? "--plot" : o.adapt > 0 ? "--adapt"
                         : o.tol > 0 ? "--tol" : o.cont ? "--continue"
                         : o.max_elements ? "--max-elements" : NULL;

@@ -35,6 +35,8 @@ static void usage(FILE *f)
         "  --csv FILE           nodal table ('-' for stdout)\n"
         "  --plot FILE          picture of the solution (.png or .svg)\n"
         "  --quiet              no summary on stdout\n"
+        "  -v, --verbose        one line per Newton iteration and adaptive round on stderr\n"
+        "  -h, --help           this text\n"
         "exit status: 0 converged, 1 not solved, 2 bad input, 3 write error\n", f);
 }
 
@@ -146,8 +148,11 @@ int cli_solve(int argc, char **argv)
   }
   cv_status st;
   char cont_msg[256] = "";
+  cli_progress_setup(o.verbose);
+  cli_progress_attach(sv);
   if (o.all) {
     rc = cli_all_run(&o, s, p, sv, adapt, &jf, &cf, &pf);
+    cli_progress_end();
     goto done;
   }
   if (o.cont) {
@@ -166,6 +171,7 @@ int cli_solve(int argc, char **argv)
   } else {
     st = cv_solve(sv, p);
   }
+  cli_progress_end();
   if (st == CVAR_EINVAL) {
     /* Input the core refused before solving (e.g. a dense NLopt Jacobian too large). */
     fprintf(stderr, "%s: %s\n", s->file, cv_solver_last_error(sv));

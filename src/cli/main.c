@@ -4,6 +4,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include <plplot.h>
+
 #include "cli/cli.h"
 
 static void usage(FILE *f)
@@ -16,7 +18,8 @@ static void usage(FILE *f)
         "  calcvar equations SCENE         momenta, Euler-Lagrange equations, Hamiltonian\n"
         "  calcvar modes SCENE             equilibrium and small-oscillation frequencies\n"
         "  calcvar batch SCENE TABLE.csv   one solve per table row (calcvar batch --help)\n"
-        "  calcvar --help | --version\n"
+        "  calcvar -h | --help             this text\n"
+        "  calcvar -V | --version          versions of calcvar and the libraries linked\n"
         "Scene files: docs/scenes.md (\"-\" reads one from standard input).\n"
         "Exit status: 0 solved, 1 not solved, 2 bad input, 3 an output could not be "
         "written.\n",
@@ -53,10 +56,13 @@ static int run(int argc, char **argv)
     usage(stdout);
     return EXIT_SOLVED;
   }
-  if (strcmp(cmd, "--version") == 0) {
+  if (strcmp(cmd, "--version") == 0 || strcmp(cmd, "-V") == 0) {
     int a, b, c;
+    char deps[256] = "", pl[80] = "";
     cv_version(&a, &b, &c);
-    printf("calcvar %d.%d.%d\n", a, b, c);
+    cv_dependency_versions(deps, sizeof deps);
+    plgver(pl); /* the pictures (--plot, --svg) */
+    printf("calcvar %d.%d.%d\nlinked with %s, PLplot %s\n", a, b, c, deps, pl);
     return EXIT_SOLVED;
   }
   if (strcmp(cmd, "solve") == 0)

@@ -26,6 +26,7 @@ enum { NPAL = (int)(sizeof pal_r / sizeof pal_r[0]), FIRST_LINE_COLOUR = 3 };
 
 #define MARK "#(728)" /* a filled circle, as a PLplot Hershey escape */
 
+static double chr_factor = 1.0; /* character scale of the page being drawn */
 static const char *exit_tmp; /* the temporary file to remove if PLplot gives up */
 
 static int plplot_exit(PLCHAR_VECTOR msg)
@@ -129,14 +130,70 @@ static void draw_line(const cli_plot_panel *p, const cli_plot_line *ln)
   free(y);
 }
 
+/* The inside corner of the axes where the legend covers the fewest drawn points: bits of
+ * PL_POSITION_* (TOP or BOTTOM with LEFT or RIGHT). The legend box is taken as 40% of the
+ * width and 7% of the height per line. */
+static PLINT legend_corner(const cli_plot_panel *p, double x0, double x1, double y0,
+                           double y1)
+{
+  static const PLINT corners[4] = {PL_POSITION_TOP | PL_POSITION_RIGHT,
+                                   PL_POSITION_TOP | PL_POSITION_LEFT,
+                                   PL_POSITION_BOTTOM | PL_POSITION_RIGHT,
+                                   PL_POSITION_BOTTOM | PL_POSITION_LEFT};
+  double bh = fmin(0.9, 0.05 + 0.07 * p->nlines), bw = 0.4;
+  long count[4] = {0, 0, 0, 0};
+  for (int l = 0; l < p->nlines; l++)
+    for (int k = 0; k < p->lines[l].n; k++) {
+      double u = (coord(p->lines[l].x[k], p->logx) - x0) / (x1 - x0);
+      double v = (coord(p->lines[l].y[k], p->logy) - y0) / (y1 - y0);
+      if (!isfinite(u) || !isfinite(v))
+        continue;
+      if (p->xdown)
+        u = 1 - u;
+      if (p->ydown)
+        v = 1 - v;
+      int right = u > 1 - bw, left = u < bw, top = v > 1 - bh, bottom = v < bh;
+      count[0] += top && right;
+      count[1] += top && left;
+      count[2] += bottom && right;
+      count[3] += bottom && left;
+    }
+  int best = 0;
+  for (int c = 1; c < 4; c++)
+    if (count[c] < count[best])
+      best = c;
+  return corners[best];
+}
+
+/* The decimals a linear axis over [lo, hi] needs when its values share leading digits
+ * (an offset far larger than the range), else -1: PLplot's own choice is right then. */
+static int axis_decimals(double lo, double hi)
+{
+  double range = fabs(hi - lo), mid = fmax(fabs(lo), fabs(hi));
+  if (!(range > 0) || mid < 100 * range)
+    return -1;
+  int d = (int)ceil(-log10(range / 5));
+  return d < 0 ? -1 : d > 12 ? 12 : d;
+}
+
 static void draw_panel(const cli_plot_panel *p)
 {
   double x0, x1, y0, y1;
   panel_range(p, 0, &x0, &x1);
   panel_range(p, 1, &y0, &y1);
-  pladv(0);
-  plvpor(0.09, 0.76, 0.13, 0.90); /* the legend goes to the right, outside */
-  plwind(x0, x1, y0, y1);
+  if (p->equal) {
+    /* equal scales: the same padding on both axes, the viewport shaped to the data */
+    double pad = 0.04 * fmax(x1 - x0, y1 - y0);
+    if (!p->logx && !p->logy) {
+      x0 -= pad;
+      x1 += pad;
+    }
+    plvpas(p->vp[0], p->vp[1], p->vp[2], p->vp[3], (y1 - y0) / (x1 - x0));
+  } else {
+    plvpor(p->vp[0], p->vp[1], p->vp[2], p->vp[3]);
+  }
+  PLINT corner = legend_corner(p, x0, x1, y0, y1);
+  plwind(p->xdown ? x1 : x0, p->xdown ? x0 : x1, p->ydown ? y1 : y0, p->ydown ? y0 : y1);
   char xo[16] = "bcnst", yo[16] = "bcnstv";
   if (p->logx)
     strcat(xo, "l");
@@ -145,14 +202,20 @@ static void draw_panel(const cli_plot_panel *p)
   plcol0(2);
   plbox("g", 0, 0, "g", 0, 0);
   plcol0(1);
-  plbox(xo, 0, 0, yo, 0, 0);
+  /* Labels with enough decimals to tell the ticks apart: PLplot's automatic precision
+   * prints 1.000 at every tick of a range of 1e-4 around 1 (a ray that hardly bends). */
+  plprec(axis_decimals(x0, x1) >= 0, axis_decimals(x0, x1));
+  plbox(xo, 0, 0, "", 0, 0);
+  plprec(axis_decimals(y0, y1) >= 0, axis_decimals(y0, y1));
+  plbox("", 0, 0, yo, 0, 0);
+  plprec(0, 0);
   pllab(p->xlabel, p->ylabel, p->title);
   for (int l = 0; l < p->nlines; l++)
     draw_line(p, &p->lines[l]);
 
-  /* legend: one entry per curve, line and (where drawn) symbol */
+  /* legend: one entry per curve, inside the axes in the emptiest corner */
   int n = p->nlines;
-  if (n <= 0)
+  if (n <= 0 || p->no_legend)
     return;
   PLINT *opt = calloc((size_t)n, sizeof *opt), *tc = calloc((size_t)n, sizeof *tc);
   PLINT *lc = calloc((size_t)n, sizeof *lc), *ls = calloc((size_t)n, sizeof *ls);
@@ -174,8 +237,9 @@ static void draw_panel(const cli_plot_panel *p)
     }
     PLFLT w, h;
     pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-             PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT, 0.02, 0.0, 0.06, 0, 1, 1, 0, 0, n, opt, 0.8, 0.85, 2.0, 0.0, tc, text, NULL, NULL,
-             NULL, NULL, lc, ls, lw, sc, ss, sn, sym);
+             corner | PL_POSITION_INSIDE | PL_POSITION_VIEWPORT, 0.02, 0.02, 0.05, 0, 1, 1,
+             0, 0, n, opt, 0.7 * chr_factor, 0.8 * chr_factor, 1.6, 0.0, tc, text, NULL, NULL, NULL, NULL, lc, ls, lw,
+             sc, ss, sn, sym);
   }
   free(opt);
   free(tc);
@@ -189,7 +253,22 @@ static void draw_panel(const cli_plot_panel *p)
   free(sym);
 }
 
-int cli_plot_write(cli_outfile *o, int npanels, const cli_plot_panel *panels)
+int cli_plot_write(cli_outfile *o, int npanels, cli_plot_panel *panels)
+{
+  /* stacked: panel k takes the k-th band from the top, with room for its labels */
+  for (int k = 0; k < npanels; k++) {
+    double top = 1.0 - (double)k / npanels, bot = 1.0 - (double)(k + 1) / npanels;
+    double m = 60.0 / (100 + 460 * npanels); /* a title or label line, in page units */
+    panels[k].vp[0] = 0.09;
+    panels[k].vp[1] = 0.97;
+    panels[k].vp[2] = bot + 1.4 * m;
+    panels[k].vp[3] = top - 0.9 * m;
+  }
+  return cli_plot_write_page(o, 960, 100 + 460 * npanels, npanels, panels);
+}
+
+int cli_plot_write_page(cli_outfile *o, int width, int height, int npanels,
+                        const cli_plot_panel *panels)
 {
   const char *name;
   if (npanels < 1 || cli_outfile_render_name(o, &name) < 0)
@@ -201,11 +280,16 @@ int cli_plot_write(cli_outfile *o, int npanels, const cli_plot_panel *panels)
   plsexit(plplot_exit);
   plsdev(svg ? "svg" : "pngcairo");
   plsfnam(name);
-  plspage(0, 0, 960, 100 + 460 * npanels, 0, 0);
+  plspage(0, 0, width, height, 0, 0);
   plscmap0(pal_r, pal_g, pal_b, NPAL);
-  plssub(1, npanels);
+  plssub(1, 1);
   plinit();
-  plschr(0, 0.95);
+  /* PLplot scales characters with the page height: on taller pages they are scaled back
+   * towards the size they have on a page of one panel (560 pixels); pllegend's text is
+   * scaled from the default height, so it gets the factor too */
+  chr_factor = height > 560 ? pow(560.0 / height, 0.7) : 1.0;
+  plschr(0, 0.95 * chr_factor);
+  pladv(0); /* one page; every panel draws into its own viewport on it */
   for (int k = 0; k < npanels; k++)
     draw_panel(&panels[k]);
   plend();

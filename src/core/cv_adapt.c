@@ -162,6 +162,19 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     st = cv_estimate_enriched(s, p, f, &est, NULL, &floor_, eta, sigma, where, why, sizeof why);
     iters_ref += f->iterations;
     if (st == CVAR_ENOMEM) goto cleanup;
+    if (s->progress) { /* one report per round; a non-zero return cancels */
+      double est_r = st ? NAN : est;
+      cv_progress info = {CVAR_PROGRESS_ROUND, s->iterations, s->gnorm, NAN, NAN, s->action,
+                          s->rounds, E, est_r};
+      if (s->progress(&info, s->progress_user) != 0) {
+        st = CVAR_ECANCELLED;
+        cv_set_msg(s->msg, sizeof s->msg,
+                   "cancelled by the progress callback after %s round %d (%d elements, "
+                   "estimated max nodal error %.2g)",
+                   s->hp ? "automatic-accuracy" : "adaptive", s->rounds, E, est_r);
+        goto cleanup;
+      }
+    }
     if (st) {
       /* HP-3: no bound from this mesh; halve every element and start the next round from
        * this solution. Three such rounds in a row end the search. */

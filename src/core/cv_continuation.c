@@ -69,7 +69,9 @@ cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, dou
     memcpy(Yt, Yc, nd);
     st = cv_newton_run(s, p, d, Yt, M, &h);
     total += s->iterations;
-    if (st == CVAR_ECALLBACK || st == CVAR_ENOMEM || st == CVAR_EINVAL) goto cleanup;
+    if (st == CVAR_ECALLBACK || st == CVAR_ENOMEM || st == CVAR_EINVAL ||
+        st == CVAR_ECANCELLED)
+      goto cleanup;
     if (st == CVAR_OK) {
       memcpy(Yc, Yt, nd);
       t = tn;

@@ -268,6 +268,8 @@ struct cv_solver {
   int hp;                      /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
+  cv_progress_fn progress;     /* cv_solver_set_progress; NULL: none */
+  void *progress_user;
   int near_sing[2];            /* ends found nearly singular after a solve */
   double search_work;          /* cv_solve_all's work limit (cv_deflation.c) */
   struct cv_pathset *paths;    /* the paths of the last cv_solve_all (cv_deflation.c) */

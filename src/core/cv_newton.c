@@ -493,6 +493,17 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     if (st) goto cleanup;
     double alpha = t.alpha;
     stale = t.stale;
+    if (s->progress) {
+      /* after the step: the residual is the one of the iterate it started from */
+      cv_progress info = {CVAR_PROGRESS_NEWTON, s->iterations, s->gnorm, wn, alpha, t.St,
+                          s->adapt_tol > 0 ? s->rounds : 0, d->E, NAN};
+      if (s->progress(&info, s->progress_user) != 0) {
+        st = CVAR_ECANCELLED;
+        cv_set_msg(s->msg, sizeof s->msg, "cancelled by the progress callback after iteration "
+                   "%d", s->iterations);
+        goto cleanup; /* the iterate the step started from stays the result */
+      }
+    }
     double *tmp = w.g;
     w.g = w.gt;
     w.gt = tmp;

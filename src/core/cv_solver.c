@@ -171,6 +171,13 @@ cv_status cv_solver_set_method(cv_solver *s, cv_method m) {
 
 cv_method cv_solver_get_method(const cv_solver *s) { return s ? s->method : CVAR_METHOD_NEWTON; }
 
+cv_status cv_solver_set_progress(cv_solver *s, cv_progress_fn fn, void *user) {
+  if (!s) return CVAR_EINVAL;
+  s->progress = fn;
+  s->progress_user = user;
+  return CVAR_OK;
+}
+
 cv_status cv_solver_set_max_iterations(cv_solver *s, int maxit) {
   if (!s || maxit < 1) return CVAR_EINVAL;
   s->maxit = maxit;

@@ -101,6 +101,9 @@ typedef struct scene {
   ex_id a_expr, b_expr, exact_action_expr;
   int settings_line;   /* a [mesh]/[solver] value that uses a parameter: its line, else 0 */
   int is_instance;     /* made by scene_instance_new: shares the rest with its scene */
+  /* [plot] (an addition, docs/scenes.md): slots 0 = the variable, 1..n = the unknowns */
+  int plot_path[2];    /* path = U, V: V drawn against U; -1, -1 when not given */
+  int *plot_down;      /* [n + 1]: nonzero for a name drawn increasing downward */
 } scene;
 
 /** Load a scene file. `name` for messages is the path itself; the path "-" reads standard

@@ -30,7 +30,7 @@ typedef struct {
 
 typedef enum {
   SEC_SCENE, SEC_PARAMETERS, SEC_DEFINITIONS, SEC_BOUNDARY, SEC_GUESS, SEC_CONSTRAINTS,
-  SEC_INTEGRALS, SEC_EXACT, SEC_REPORT, SEC_MESH, SEC_SOLVER, SEC_TABLES, SEC_COUNT
+  SEC_INTEGRALS, SEC_EXACT, SEC_REPORT, SEC_MESH, SEC_SOLVER, SEC_TABLES, SEC_PLOT, SEC_COUNT
 } sc_section;
 
 /* A logical line: a section header or a key line (with its continuations). */

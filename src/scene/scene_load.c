@@ -16,6 +16,7 @@ int sc_load_constraints(sc_loader *L);
 int sc_load_report(sc_loader *L);
 int sc_load_mesh(sc_loader *L);
 int sc_load_solver(sc_loader *L);
+int sc_load_plot(sc_loader *L);
 
 static void items_free(sc_item *it, int n)
 {
@@ -41,6 +42,7 @@ void scene_free(scene *s)
   for (int i = 0; i < s->n; i++)
     cv_free(s->unknowns[i]);
   cv_free(s->unknowns);
+  cv_free(s->plot_down);
   cv_free(s->bc);
   cv_free(s->guess);
   cv_free(s->exact);
@@ -346,7 +348,7 @@ static scene *load_buffer(const char *text, size_t len, const char *name, int ns
       load_definitions(&L) < 0 || load_interval_integrand(&L) < 0 ||
       sc_load_boundary(&L) < 0 || sc_load_guess_exact(&L) < 0 ||
       sc_load_constraints(&L) < 0 || sc_load_report(&L) < 0 || sc_load_mesh(&L) < 0 ||
-      sc_load_solver(&L) < 0) {
+      sc_load_solver(&L) < 0 || sc_load_plot(&L) < 0) {
     sc_raw_free(&L.raw);
     scene_free(s);
     return NULL;

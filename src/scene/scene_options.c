@@ -185,3 +185,64 @@ int sc_load_solver(sc_loader *L)
   }
   return 0;
 }
+
+/* The slot of a name in [plot]: 0 for the variable, 1 + i for unknown i, -1 otherwise. */
+static int plot_slot(const scene *s, const char *name)
+{
+  if (strcmp(name, s->variable) == 0)
+    return 0;
+  for (int i = 0; i < s->n; i++)
+    if (strcmp(name, s->unknowns[i]) == 0)
+      return 1 + i;
+  return -1;
+}
+
+/* [plot] (an addition): `path = U, V` draws V against U with equal scales (U and V the
+ * variable or unknowns, distinct); `downward = names` draws those names increasing
+ * downward (the brachistochrone's y is a depth). */
+int sc_load_plot(sc_loader *L)
+{
+  static const char *const keys[] = {"path", "downward", NULL};
+  scene *s = L->s;
+  s->plot_path[0] = s->plot_path[1] = -1;
+  if (!(s->plot_down = cv_calloc((size_t)s->n + 1, sizeof *s->plot_down))) {
+    sc_err(L->err, L->errlen, L->file, 0, "out of memory");
+    return -1;
+  }
+  if (sc_check_keys(L, SEC_PLOT, keys, "path, downward") < 0)
+    return -1;
+  for (int i = 0; i < L->raw.ne[SEC_PLOT]; i++) {
+    const sc_entry *e = &L->raw.e[SEC_PLOT][i];
+    ex_list list;
+    if (ex_list_split(e->value, &list) < 0) {
+      sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
+      return -1;
+    }
+    int is_path = strcmp(e->key, "path") == 0, rc = 0;
+    if (is_path && list.n != 2) {
+      sc_err(L->err, L->errlen, L->file, e->line, "path needs two names (horizontal, "
+             "vertical), got %d", list.n);
+      rc = -1;
+    }
+    for (int k = 0; k < list.n && rc == 0; k++) {
+      int slot = plot_slot(s, list.item[k]);
+      if (slot < 0) {
+        sc_err(L->err, L->errlen, L->file, e->line, "%s: '%s' is neither the variable nor "
+               "an unknown", e->key, list.item[k]);
+        rc = -1;
+      } else if (is_path) {
+        s->plot_path[k] = slot;
+      } else {
+        s->plot_down[slot] = 1;
+      }
+    }
+    if (rc == 0 && is_path && s->plot_path[0] == s->plot_path[1]) {
+      sc_err(L->err, L->errlen, L->file, e->line, "path: '%s' against itself", list.item[0]);
+      rc = -1;
+    }
+    ex_list_free(&list);
+    if (rc < 0)
+      return -1;
+  }
+  return 0;
+}
