@@ -376,12 +376,7 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     s->elements = o->elements;
   if (o->degree)
     s->degree = o->degree;
-  if (o->method >= 0)
-    s->method = (cv_method)o->method;
-  if (o->tolerance > 0)
-    s->tolerance = o->tolerance;
-  if (o->max_iterations)
-    s->max_iterations = o->max_iterations;
+  cli_apply_solver_options(o, s);
   if (o->adapt > 0)
     s->adapt = o->adapt;
   if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) &&

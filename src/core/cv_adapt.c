@@ -158,23 +158,11 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       goto cleanup;
     }
     double est, floor_ = 0.0;
+    int done = 0;
     char why[400];
     st = cv_estimate_enriched(s, p, f, &est, NULL, &floor_, eta, sigma, where, why, sizeof why);
     iters_ref += f->iterations;
     if (st == CVAR_ENOMEM) goto cleanup;
-    if (s->progress) { /* one report per round; a non-zero return cancels */
-      double est_r = st ? NAN : est;
-      cv_progress info = {CVAR_PROGRESS_ROUND, s->iterations, s->gnorm, NAN, NAN, s->action,
-                          s->rounds, E, est_r};
-      if (s->progress(&info, s->progress_user) != 0) {
-        st = CVAR_ECANCELLED;
-        cv_set_msg(s->msg, sizeof s->msg,
-                   "cancelled by the progress callback after %s round %d (%d elements, "
-                   "estimated max nodal error %.2g)",
-                   s->hp ? "automatic-accuracy" : "adaptive", s->rounds, E, est_r);
-        goto cleanup;
-      }
-    }
     if (st) {
       /* HP-3: no bound from this mesh; halve every element and start the next round from
        * this solution. Three such rounds in a row end the search. */
@@ -200,12 +188,24 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
                    E, s->disc.nodes, s->rounds, s->rounds == 1 ? "" : "s", iters, iters_ref,
                    est, tol);
         st = CVAR_OK;
-        goto cleanup;
+        done = 1; /* leaves after the progress report below */
       }
       if (est <= 0.5 * best) stalled = 0;
       else stalled++;
       if (est < best) best = est;
     }
+    if (s->progress) {
+      cv_progress info = {CVAR_PROGRESS_ROUND, s->iterations, s->gnorm, NAN, NAN, s->action,
+                          s->rounds, E, s->err_est};
+      if (s->progress(&info, s->progress_user) != 0) {
+        st = CVAR_ECANCELLED;
+        cv_set_msg(s->msg, sizeof s->msg, "cancelled by the progress callback after adaptive "
+                   "round %d (%d elements, estimated max nodal error %.2g)", s->rounds, E,
+                   s->err_est);
+        goto cleanup;
+      }
+    }
+    if (done) goto cleanup; /* converged (above), reported to the callback */
     double emax = 0.0;
     for (int e = 0; e < E; e++) emax = fmax(emax, eta[e]);
     /* mark: hp, the elements within a factor 4 of the largest surplus; --adapt, those above

@@ -20,7 +20,7 @@ static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *m
   int np = s->params_as_inputs ? s->nparams : 0;
   ex_integrand *g = ex_integrand_new_params(s->dag, s->n, np, e, max_need, msg, len);
   if (g && np) {
-    double *v = malloc((size_t)np * sizeof *v);
+    double *v = cv_malloc((size_t)np * sizeof *v);
     if (!v) {
       ex_integrand_free(g);
       return NULL;
@@ -28,7 +28,7 @@ static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *m
     for (int i = 0; i < np; i++)
       v[i] = s->params[i].value;
     ex_integrand_set_params(g, v);
-    free(v);
+    cv_free(v);
   }
   return g;
 }
