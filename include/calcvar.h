@@ -610,9 +610,9 @@ typedef struct cv_modes cv_modes;
 /** Find the equilibrium dL/dy = 0 (y' = 0; on the [constraints] G(y) = 0 with their
  * multipliers) by Newton from the scene's guess at the start of the interval, and the
  * modes there (theory (P-9), (P-10), (P-12), (P-13)). NULL on failure, with *why (may be
- * NULL) and a sentence "FILE:LINE: what is wrong" in err (may be NULL): CVAR_EINVAL when modes do not
- * apply (L or a constraint depends on the variable, integral constraints, as many
- * constraints as unknowns); CVAR_ENONFINITE, CVAR_EMAXITER (no equilibrium from the
+ * NULL) and a sentence "FILE:LINE: what is wrong" in err (may be NULL): CVAR_EINVAL
+ * when modes do not apply (L or a constraint depends on the variable, integral
+ * constraints, as many constraints as unknowns); CVAR_ENONFINITE, CVAR_EMAXITER (no equilibrium from the
  * guess), CVAR_ESINGULAR (M not positive definite, dependent constraints), CVAR_EDEPENDENCY
  * (LAPACK), CVAR_ENOMEM. */
 CVAR_API cv_modes *cv_modes_new(cv_scene *sc, cv_status *why, char *err, size_t errlen);

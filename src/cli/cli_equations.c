@@ -103,7 +103,8 @@ int cli_equations(int argc, char **argv)
   int rc = cli_scene_command_start("equations", argc, argv, usage, &o, &s, &jf);
   if (rc >= 0)
     goto done;
-  if (scene_equations_new(s, &eq, err, sizeof err) != CVAR_OK || scene_eq_texts_make(&t, s, &eq) < 0) {
+  if (scene_equations_new(s, &eq, err, sizeof err) != CVAR_OK ||
+      scene_eq_texts_make(&t, s, &eq) < 0) {
     fprintf(stderr, "%s\n", err[0] ? err : "calcvar equations: out of memory");
     rc = EXIT_UNSOLVED;
     goto done;
