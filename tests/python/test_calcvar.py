@@ -353,8 +353,11 @@ def test_double_pendulum_modes_exact(no_subprocess):
 
 def test_mechanics_equals_the_command():
     # the library and `calcvar equations|modes --json` share one builder: same document
+    # (with a constraint's multiplier and with gyroscopic terms too)
     for cmd, fn in (("equations", calcvar.equations), ("modes", calcvar.modes)):
-        for name in ("double_pendulum.scene", "pendulum_angle.scene"):
+        for name in ("double_pendulum.scene", "pendulum_angle.scene", "pendulum_cartesian.scene",
+                     os.path.abspath(os.path.join(SCENES, "..", "..", "physics", "data",
+                                                  "magnetic_trap.scene"))):
             r = subprocess.run([EXE, cmd, scene(name), "--json", "-"], capture_output=True,
                                text=True, check=True)
             assert fn(scene(name)) == json.loads(r.stdout)
