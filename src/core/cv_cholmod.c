@@ -24,6 +24,7 @@ struct cv_ldlt {
   int *colp;      /* column pointers of the envelope (A and U share them) */
   double *ax, *u; /* A, and U = L^T with D(j) in place of U(j,j), column by column */
   long minor;     /* first zero pivot, n if none */
+  long mono;      /* columns 0 .. mono - 1 have nondecreasing first rows */
 };
 
 /* Up to this many unknowns the skyline factor is used (tests may lower it to 0 to
@@ -86,6 +87,15 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
       return CVAR_ENOMEM;
     }
     L->minor = nfree;
+    L->mono = nfree;
+    for (int c = 1, f0 = 0; c < nfree; c++) {
+      int f = c + 1 - (L->colp[c + 1] - L->colp[c]);
+      if (f < f0) {
+        L->mono = c;
+        break;
+      }
+      f0 = f;
+    }
     *out = L;
     return CVAR_OK;
   }
@@ -315,15 +325,25 @@ static void sky_forward(const cv_ldlt *L, double *x) { /* x <- U^{-T} x */
   }
 }
 
-static void sky_backward(const cv_ldlt *L, int diag, double *x) { /* x <- U^{-1} D^{-1} x */
+/* x <- U^{-1} D^{-1} x (diag 1) or U^{-1} x, as a dot product over row j of U in
+ * increasing column order: the order of CHOLMOD's backward_Lt above, so that both give the
+ * same round-off (a Newton step next to a singular leading block amplifies it, and the
+ * deflation's search follows). Row j of U lies in the columns r > j whose first row
+ * f_r <= j: a range j + 1 .. e over the columns with nondecreasing f_r (the node blocks,
+ * e falling with j), then every later column (an integral multiplier's, f_r = 0). */
+static void sky_backward(const cv_ldlt *L, int diag, double *x) {
   const int *cp = L->colp;
-  if (diag)
-    for (long j = 0; j < L->n; j++) x[j] /= L->u[cp[j + 1] - 1];
-  for (long j = L->n - 1; j >= 0; j--) {
-    int fj = (int)j + 1 - (cp[j + 1] - cp[j]);
-    const double *uj = L->u + cp[j] - fj;
-    double xj = x[j];
-    for (int i = fj; i < j; i++) x[i] -= uj[i] * xj;
+  const double *u = L->u;
+  long n = L->n, mono = L->mono, e = mono - 1;
+  for (long j = n - 1; j >= 0; j--) {
+    double xj = diag ? x[j] / u[cp[j + 1] - 1] : x[j];
+    if (j < mono) {
+      while (e > j && e + 1 - (cp[e + 1] - cp[e]) > j) e--;
+      for (long r = j + 1; r <= e; r++) xj -= u[cp[r + 1] - 1 - (r - j)] * x[r];
+    }
+    for (long r = j + 1 > mono ? j + 1 : mono; r < n; r++)
+      if (r + 1 - (cp[r + 1] - cp[r]) <= j) xj -= u[cp[r + 1] - 1 - (r - j)] * x[r];
+    x[j] = xj;
   }
 }
 
