@@ -18,7 +18,7 @@ struct cv_ldlt {
   pthread_t th;  /* the symbolic analysis, started by cv_ldlt_new on large systems */
   int running;   /* th has to be joined */
   int analysed;  /* cholmod_analyze has run (L->L set, or NULL on its failure) */
-  /* Small systems: the skyline LDL^T of this file instead (theory N-8); then c, A and L
+  /* Small systems: the skyline LDL^T of this file instead (theory N-7); then c, A and L
    * are unused and the matrix, its factor and the pivots live here. */
   int sky;
   int *colp;      /* column pointers of the envelope (A and U share them) */
@@ -167,7 +167,7 @@ int cv_ldlt_matches(const cv_ldlt *L, const cv_disc *d, const int *gof) {
 
 /* Skyline (envelope) LDL^T, A = U^T D U with U unit upper triangular, in the envelope of
  * A: natural ordering of a matrix whose columns are contiguous from their first row fills
- * nothing outside it (theory N-8). Column j by the Crout (left-looking) rule:
+ * nothing outside it (theory N-7). Column j by the Crout (left-looking) rule:
  *   g_i = a_ij - sum_{k = max(f_i, f_j)}^{i-1} u_ki g_k,   u_ij = g_i / d_i,
  *   d_j = a_jj - sum_{i = f_j}^{j-1} u_ij g_i.
  * A zero pivot is treated as CHOLMOD treats it (N-5): the first sets minor, from there on

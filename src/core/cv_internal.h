@@ -178,7 +178,7 @@ void cv_ldlt_free(cv_ldlt *L);
 /* 1 when L (with its gof) is the matrix of disc's pattern: a new solve on the same mesh,
  * degrees, unknowns and constraints keeps the factor and its analysis. */
 int cv_ldlt_matches(const cv_ldlt *L, const cv_disc *d, const int *gof);
-/* Systems of up to this many unknowns use the skyline LDL^T (theory N-8), larger ones
+/* Systems of up to this many unknowns use the skyline LDL^T (theory N-7), larger ones
  * CHOLMOD; tests set it to compare the two. */
 extern int cv_ldlt_skyline_max;
 const int *cv_ldlt_colptr(const cv_ldlt *L); /* nfree + 1 column pointers */

@@ -1,4 +1,4 @@
-/* tests/core/test_skyline.c — the skyline LDL^T of small systems (theory N-8) against
+/* tests/core/test_skyline.c — the skyline LDL^T of small systems (theory N-7) against
  * CHOLMOD on the same matrices: block-banded Hessians, pointwise and integral multipliers,
  * definite and indefinite, and a matrix with an exactly zero pivot. Both factor without
  * pivoting in the natural order, so the pivots agree to round-off (1e-10 relative here, the
