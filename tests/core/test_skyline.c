@@ -121,7 +121,40 @@ out:
   cv_problem_free(pr);
 }
 
+/* The solver keeps its factor while the mesh's pattern stays, and replaces it when the
+ * pattern changes: y'^2/2 on [0, 1], y(0) = 0, y(1) = 1 has y = x, action 1/2 exactly; with
+ * the end at 1 free, y = 0, action 0. */
+static void keeps_factor(void) {
+  cv_problem *pr = cv_problem_new(1, 0, 1, NULL);
+  cv_solver *s = cv_solver_new(NULL);
+  cv_problem_set_integrand(pr, F2, NULL);
+  cv_problem_set_dirichlet(pr, 0, 0, 1);
+  cv_solver_set_elements(s, 3);
+  cv_solver_set_degree(s, 2);
+  CHECK(cv_solve(s, pr) == CVAR_OK && fabs(cv_solver_get_action(s) - 0.5) < 1e-13,
+        "first solve: action %.17g", cv_solver_get_action(s));
+  const void *f1 = s->ldlt;
+  CHECK(cv_solve(s, pr) == CVAR_OK && fabs(cv_solver_get_action(s) - 0.5) < 1e-13,
+        "second solve");
+  CHECK(f1 && s->ldlt == f1, "the second solve on the same mesh keeps the factor");
+  cv_solver_set_elements(s, 5); /* new pattern: the factor must be replaced */
+  cv_solver_set_degree(s, 3);
+  CHECK(cv_solve(s, pr) == CVAR_OK && fabs(cv_solver_get_action(s) - 0.5) < 1e-13,
+        "after a mesh change: action %.17g", cv_solver_get_action(s));
+  CHECK(cv_ldlt_matches(s->ldlt, &s->disc, s->gof), "factor of the new mesh");
+  cv_problem_set_free_end(pr, 0, 1); /* same mesh, one more unknown */
+  double y[16];
+  CHECK(cv_solve(s, pr) == CVAR_OK && fabs(cv_solver_get_action(s)) < 1e-13,
+        "free end: action %.17g", cv_solver_get_action(s));
+  cv_solver_get_values(s, y);
+  CHECK(fabs(y[15]) < 1e-12, "free end: y(1) = %g, not 0", y[15]);
+  CHECK(cv_ldlt_matches(s->ldlt, &s->disc, s->gof), "factor of the new unknowns");
+  cv_solver_free(s);
+  cv_problem_free(pr);
+}
+
 int main(void) {
+  keeps_factor();
   compare(1, 1, 1, 0, -1);
   compare(1, 6, 3, 0, -1);
   compare(3, 1, 8, 0, -1);
