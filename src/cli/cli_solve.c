@@ -30,7 +30,8 @@ static void usage(FILE *f)
         "  --continue name=from:to   continuation in a parameter\n"
         "  --all                every stationary path that can be found (deflation)\n"
         "  --max K              at most K paths with --all (default 8)\n"
-        "  --work F             --all's work limit: F times the first solve's (default 8)\n"
+        "  --work F             --all's work limit: F times the first solve's, renewed\n"
+        "                       by every path found (default 2)\n"
         "  --json FILE          JSON report ('-' for stdout)\n"
         "  --csv FILE           nodal table ('-' for stdout)\n"
         "  --plot FILE          picture of the solution (.png or .svg)\n"
@@ -151,7 +152,7 @@ int cli_solve(int argc, char **argv)
   cli_progress_setup(o.verbose);
   cli_progress_attach(sv);
   if (o.all) {
-    rc = cli_all_run(&o, s, p, sv, adapt, &jf, &cf, &pf);
+    rc = cli_all_run(&o, s, p, sv, tol > 0 ? 2 : adapt > 0, &jf, &cf, &pf);
     cli_progress_end();
     goto done;
   }
