@@ -104,10 +104,11 @@ static int stop_rule(cv_solver *s, double est, double best, double floor_, int s
 }
 
 /* Nodes (hp) or elements (--adapt) after refining d's elements with eta >= thresh. */
-static int next_size(const cv_disc *d, const double *eta, double thresh, int hp) {
+static int next_size(const cv_disc *d, const double *eta, const double *sigma, double thresh,
+                     double tol, int hp) {
   long size = hp ? d->nodes : d->E;
   for (long e = 0; e < d->E; e++)
-    if (eta[e] >= thresh) size += hp ? cv_disc_edeg(d, e) + 1 : 1;
+    if (cv_hp_marked(eta[e], sigma[e], thresh, tol, hp)) size += hp ? cv_disc_edeg(d, e) + 1 : 1;
   return size > 2000000000L ? 2000000000 : (int)size;
 }
 
@@ -208,10 +209,10 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     if (done) goto cleanup; /* converged (above), reported to the callback */
     double emax = 0.0;
     for (int e = 0; e < E; e++) emax = fmax(emax, eta[e]);
-    /* mark: hp, the elements within a factor 4 of the largest surplus; --adapt, those above
-     * tol / 4 (AD-1), and always the largest */
+    /* mark: hp, the elements within a factor 4 of the largest surplus and the smooth ones
+     * above tol (HP-4); --adapt, those above tol / 4 (AD-1), and always the largest */
     double thresh = s->hp ? 0.25 * emax : fmin(0.25 * tol, emax);
-    if (stop_rule(s, est, best, floor_, stalled, next_size(&s->disc, eta, thresh, s->hp))) {
+    if (stop_rule(s, est, best, floor_, stalled, next_size(&s->disc, eta, sigma, thresh, tol, s->hp))) {
       st = CVAR_EMAXITER;
       goto cleanup;
     }

@@ -30,11 +30,30 @@ static int predicted_degree(int p, double eta, double sigma, double target) {
   return k > CV_MAX_DEGREE ? CV_MAX_DEGREE : clamp_deg(p + (int)ceil(k));
 }
 
+/* HP-4: an element is refined when its surplus is within the marking threshold thresh (a
+ * quarter of the largest), or, under hp, when it is smooth and its surplus is above the
+ * target and above 1/100 of the largest: raising the degree of every smooth element that
+ * misses the target costs few nodes and saves the rounds that would raise them one at a
+ * time. Elements that are not smooth keep the factor-4 rule (a layer's neighbours are
+ * split only when the layer's own element no longer dominates). */
+int cv_hp_marked(double eta, double sigma, double thresh, double target, int hp) {
+  if (eta >= thresh) return 1;
+  return hp && sigma >= SMOOTH_RATE && eta > target && eta >= 0.04 * thresh;
+}
+
+/* HP-4: whether degree 8 is predicted to bring a smooth element's surplus eta (falling like
+ * e^(-sigma k)) below a tenth of the target with a degree to spare; if not, the element is
+ * halved as well as raised to 8 in the same round instead of one round later. */
+static int degree_suffices(int p, double eta, double sigma, double target) {
+  double k = log(eta / (0.1 * target)) / sigma;
+  return !(k > CV_MAX_DEGREE - p + 1);
+}
+
 cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
                        const double *where, double thresh, double target, int hp, int *Enew,
                        double **t, int **deg) {
   int E = d->E, F = 0;
-  for (int e = 0; e < E; e++) F += eta[e] >= thresh ? 2 : 1;
+  for (int e = 0; e < E; e++) F += cv_hp_marked(eta[e], sigma[e], thresh, target, hp) ? 2 : 1;
   *t = cv_malloc((size_t)(F + 1) * sizeof **t);
   *deg = cv_malloc((size_t)F * sizeof **deg);
   if (!*t || !*deg) {
@@ -53,8 +72,9 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
     double tm = split_at(x0, x1, 0.5 * (x0 + x1), a, L);
     double tl = split_at(x0, x1, x0 + GEOM_RATIO * (x1 - x0), a, L);
     double tr = split_at(x0, x1, x1 - GEOM_RATIO * (x1 - x0), a, L);
-    if (!(eta[e] >= thresh) || tm < 0 || tl < 0 || tr < 0) { /* unmarked, or too small */
-      (*deg)[k++] = eta[e] >= thresh ? clamp_deg(pe + 1) : pe;
+    int marked = cv_hp_marked(eta[e], sigma[e], thresh, target, hp);
+    if (!marked || tm < 0 || tl < 0 || tr < 0) { /* unmarked, or too small */
+      (*deg)[k++] = marked ? clamp_deg(pe + 1) : pe;
       continue;
     }
     if (!hp) { /* fixed degree (--adapt): bisect */
@@ -80,6 +100,12 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
       continue;
     }
     if (sigma[e] >= SMOOTH_RATE && pe < CV_MAX_DEGREE) { /* smooth: raise p (HP-4) */
+      if (!degree_suffices(pe, eta[e], sigma[e], target)) { /* and halve, in one round */
+        (*deg)[k++] = CV_MAX_DEGREE;
+        (*t)[k] = tm;
+        (*deg)[k++] = CV_MAX_DEGREE;
+        continue;
+      }
       (*deg)[k++] = predicted_degree(pe, eta[e], sigma[e], target);
       continue;
     }

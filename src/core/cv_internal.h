@@ -313,8 +313,9 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
                                double *eta, double *sigma, double *where,
                                char *msg, size_t len);
 /* HP-4, HP-5: the next mesh (on [0, 1], *t with *Enew + 1 entries, *deg with *Enew) from
- * d with the elements eta[e] >= thresh refined (hp = 0: bisected at their degree); target:
+ * d with the elements cv_hp_marked refined (hp = 0: bisected at their degree); target:
  * the tolerance, for the degree a smooth element is raised to. */
+int cv_hp_marked(double eta, double sigma, double thresh, double target, int hp);
 cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
                        const double *where, double thresh, double target, int hp, int *Enew,
                        double **t, int **deg);
