@@ -102,47 +102,58 @@ static int axis_init(tb_axis *a, int n, const double *x, char *msg, size_t len, 
 
 /* dst = second derivatives along one axis of the splines through src (TB-3), for every
  * line along that axis: element (o, i, k) at (o*n + i)*inner + k. The sweeps run over the
- * contiguous index k innermost, so strided axes stay cache friendly. */
+ * contiguous index k innermost, so strided axes stay cache friendly; a long k range is cut
+ * into blocks of columns whose n rows fit in the cache, so the back substitution and the
+ * ends re-read the forward sweep's output from the cache, not from memory. */
 static void axis_solve(const tb_axis *a, const double *src, double *dst, size_t outer,
                        size_t inner) {
   const int n = a->n;
   const double *h = a->h;
-  for (size_t o = 0; o < outer; o++) {
-    const double *f = src + o * (size_t)n * inner;
-    double *M = dst + o * (size_t)n * inner;
-    /* forward sweep: M_i = (rhs_i - l_i M_i-1) * r_i */
-    for (int i = 1; i <= n - 2; i++) {
-      double lr = a->lo[i];
-      double ia = 1.0 / h[i - 1], ib = 1.0 / h[i], r = a->r[i];
-      const double *fm = f + (size_t)(i - 1) * inner, *f0 = fm + inner, *fp = f0 + inner;
-      double *Mi = M + (size_t)i * inner;
-      const double *Mp = Mi - inner;
-      if (i == 1) /* no sub-diagonal (M_0 was eliminated): row 0 of M is not read */
-        for (size_t k = 0; k < inner; k++)
-          Mi[k] = 6.0 * ((fp[k] - f0[k]) * ib - (f0[k] - fm[k]) * ia) * r;
-      else
-        for (size_t k = 0; k < inner; k++) {
-          double rhs = 6.0 * ((fp[k] - f0[k]) * ib - (f0[k] - fm[k]) * ia);
-          Mi[k] = (rhs - lr * Mp[k]) * r;
-        }
+  /* about 256 KiB of src and dst rows per block (at least 64 columns) */
+  size_t blk = (size_t)16384 / (size_t)n;
+  if (blk < 64) blk = 64;
+  for (size_t o = 0; o < outer; o++)
+    for (size_t k0 = 0; k0 < inner; k0 += blk) {
+      const size_t kn = inner - k0 < blk ? inner - k0 : blk;
+      const double *f = src + o * (size_t)n * inner + k0;
+      double *M = dst + o * (size_t)n * inner + k0;
+      /* forward sweep: M_i = (rhs_i - l_i M_i-1) * r_i */
+      for (int i = 1; i <= n - 2; i++) {
+        double lr = a->lo[i];
+        double ia = 1.0 / h[i - 1], ib = 1.0 / h[i], r = a->r[i];
+        const double *fm = f + (size_t)(i - 1) * inner, *f0 = fm + inner, *fp = f0 + inner;
+        double *Mi = M + (size_t)i * inner;
+        const double *Mp = Mi - inner;
+        if (i == 1) /* no sub-diagonal (M_0 was eliminated): row 0 of M is not read */
+          for (size_t k = 0; k < kn; k++)
+            Mi[k] = 6.0 * ((fp[k] - f0[k]) * ib - (f0[k] - fm[k]) * ia) * r;
+        else
+          for (size_t k = 0; k < kn; k++) {
+            double rhs = 6.0 * ((fp[k] - f0[k]) * ib - (f0[k] - fm[k]) * ia);
+            Mi[k] = (rhs - lr * Mp[k]) * r;
+          }
+      }
+      /* back substitution: M_i -= c_i M_i+1 */
+      for (int i = n - 3; i >= 1; i--) {
+        double c = a->c[i];
+        double *Mi = M + (size_t)i * inner;
+        const double *Mn = Mi + inner;
+        for (size_t k = 0; k < kn; k++) Mi[k] -= c * Mn[k];
+      }
+      /* the not-a-knot ends (TB-3) */
+      double *M0 = M, *M1 = M + inner, *M2 = M + 2 * inner;
+      double *Me = M + (size_t)(n - 1) * inner, *Ma = Me - inner, *Mb = Ma - inner;
+      double h0 = h[0], h1 = h[1], hb = h[n - 2], ha = h[n - 3];
+      for (size_t k = 0; k < kn; k++) {
+        M0[k] = ((h0 + h1) * M1[k] - h0 * M2[k]) / h1;
+        Me[k] = ((hb + ha) * Ma[k] - hb * Mb[k]) / ha;
+      }
     }
-    /* back substitution: M_i -= c_i M_i+1 */
-    for (int i = n - 3; i >= 1; i--) {
-      double c = a->c[i];
-      double *Mi = M + (size_t)i * inner;
-      const double *Mn = Mi + inner;
-      for (size_t k = 0; k < inner; k++) Mi[k] -= c * Mn[k];
-    }
-    /* the not-a-knot ends (TB-3) */
-    double *M0 = M, *M1 = M + inner, *M2 = M + 2 * inner;
-    double *Me = M + (size_t)(n - 1) * inner, *Ma = Me - inner, *Mb = Ma - inner;
-    double h0 = h[0], h1 = h[1], hb = h[n - 2], ha = h[n - 3];
-    for (size_t k = 0; k < inner; k++) {
-      M0[k] = ((h0 + h1) * M1[k] - h0 * M2[k]) / h1;
-      Me[k] = ((hb + ha) * Ma[k] - hb * Mb[k]) / ha;
-    }
-  }
 }
+
+static cv_table *table_build(int dim, const int *n, const double *const *coords,
+                             const double *values, double *owned, cv_status *why, char *msg,
+                             size_t len);
 
 cv_table *cv_table_new(int dim, const int *n, const double *const *coords,
                        const double *values, cv_status *why) {
@@ -151,9 +162,23 @@ cv_table *cv_table_new(int dim, const int *n, const double *const *coords,
 
 cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords,
                            const double *values, cv_status *why, char *msg, size_t len) {
+  return table_build(dim, n, coords, values, NULL, why, msg, len);
+}
+
+cv_table *cv_table_new_owned(int dim, const int *n, const double *const *coords,
+                             double *values, cv_status *why, char *msg, size_t len) {
+  return table_build(dim, n, coords, NULL, values, why, msg, len);
+}
+
+/* The common body: the values are copied from `values`, or `owned` (cv_malloc'ed, in
+ * grid order) becomes G[0] itself, no copy; `owned` is released on every failure. */
+static cv_table *table_build(int dim, const int *n, const double *const *coords,
+                             const double *values, double *owned, cv_status *why, char *msg,
+                             size_t len) {
   cv_status st = CVAR_EINVAL;
   cv_table *t = NULL;
   if (msg && len) msg[0] = 0;
+  if (owned) values = owned;
   if (dim < 1 || dim > 3 || !n || !coords || !values) {
     cv_set_msg(msg, len, "a table needs 1, 2 or 3 coordinates, their values and the data");
     goto fail;
@@ -190,8 +215,14 @@ cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords,
   t->stride[dim - 1] = 1;
   for (int k = dim - 2; k >= 0; k--) t->stride[k] = t->stride[k + 1] * (size_t)n[k + 1];
   for (int mask = 0; mask < (1 << dim); mask++) {
+    if (mask == 0 && owned) {
+      t->G[0] = owned;
+      owned = NULL;
+      continue;
+    }
     t->G[mask] = cv_malloc(size * sizeof(double));
     if (!t->G[mask]) goto nomem;
+    cv_advise_huge(t->G[mask], size * sizeof(double));
     if (mask == 0) {
       memcpy(t->G[0], values, size * sizeof(double));
       continue;
@@ -208,6 +239,7 @@ nomem:
   st = CVAR_ENOMEM;
   cv_set_msg(msg, len, "out of memory");
 fail:
+  cv_free(owned);
   cv_table_free(t);
   if (why) *why = st;
   return NULL;
