@@ -1,11 +1,6 @@
 /* src/core/cv_memory.c — the one allocator of the library, with failure injection for tests.
  * SPDX-License-Identifier: MIT */
-#define _DEFAULT_SOURCE /* madvise, MADV_HUGEPAGE */
-#include <stdint.h>
 #include <stdlib.h>
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
 
 #include "cv_memory.h"
 
@@ -38,12 +33,3 @@ void *cv_realloc(void *ptr, size_t n) {
 
 void cv_free(void *ptr) { free(ptr); }
 
-void cv_advise_huge(void *p, size_t n) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  const uintptr_t huge = (uintptr_t)2 << 20;
-  uintptr_t a = ((uintptr_t)p + huge - 1) & ~(huge - 1), b = ((uintptr_t)p + n) & ~(huge - 1);
-  if (p && b > a) (void)madvise((void *)a, (size_t)(b - a), MADV_HUGEPAGE);
-#else
-  (void)p, (void)n;
-#endif
-}

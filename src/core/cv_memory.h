@@ -11,10 +11,6 @@ void *cv_calloc(size_t count, size_t size);
 /* Like realloc: on failure returns NULL and leaves ptr allocated. */
 void *cv_realloc(void *ptr, size_t n);
 void cv_free(void *ptr);
-/* A hint that the fresh block [p, p + n) (not yet touched) be backed by huge pages where
- * the system offers them on request (Linux THP "madvise"): one page fault per 2 MiB instead
- * of per 4 KiB when a large array is first written. Does nothing elsewhere. */
-void cv_advise_huge(void *p, size_t n);
 /* Fail the k-th allocation from now on (k >= 0); -1 disables. For tests only. */
 void cv_debug_fail_alloc_after(long k);
 

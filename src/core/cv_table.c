@@ -18,6 +18,7 @@ typedef struct {
   int n;
   double *x;     /* coordinates, strictly increasing */
   double *h;     /* h[i] = x[i+1] - x[i] */
+  double *ih;    /* 1 / h[i] */
   double *lo;    /* sub-diagonal of the reduced system for M_1 .. M_n-2 (TB-3) */
   double *c, *r; /* its Thomas factors: c = super-diagonal / pivot, r = 1 / pivot */
   int uniform;   /* equal spacing within round-off: the cell is found in O(1) */
@@ -36,6 +37,7 @@ struct cv_table {
 static void axis_free(tb_axis *a) {
   cv_free(a->x);
   cv_free(a->h);
+  cv_free(a->ih);
   cv_free(a->lo);
   cv_free(a->c);
   cv_free(a->r);
@@ -48,10 +50,11 @@ static int axis_init(tb_axis *a, int n, const double *x, char *msg, size_t len, 
   a->n = n;
   a->x = cv_malloc((size_t)n * sizeof *a->x);
   a->h = cv_malloc((size_t)n * sizeof *a->h);
+  a->ih = cv_malloc((size_t)n * sizeof *a->ih);
   a->c = cv_malloc((size_t)n * sizeof *a->c);
   a->r = cv_malloc((size_t)n * sizeof *a->r);
   a->lo = cv_malloc((size_t)n * sizeof *a->lo);
-  if (!a->x || !a->h || !a->c || !a->r || !a->lo) {
+  if (!a->x || !a->h || !a->ih || !a->c || !a->r || !a->lo) {
     cv_set_msg(msg, len, "out of memory");
     return -1;
   }
@@ -69,6 +72,7 @@ static int axis_init(tb_axis *a, int n, const double *x, char *msg, size_t len, 
   }
   for (int i = 0; i + 1 < n; i++) a->h[i] = x[i + 1] - x[i];
   a->h[n - 1] = a->h[n - 2];
+  for (int i = 0; i < n; i++) a->ih[i] = 1.0 / a->h[i];
   double span = x[n - 1] - x[0];
   a->h0 = span / (n - 1);
   a->ih0 = 1.0 / a->h0;
@@ -117,27 +121,25 @@ static void axis_solve(const tb_axis *a, const double *src, double *dst, size_t 
       const size_t kn = inner - k0 < blk ? inner - k0 : blk;
       const double *f = src + o * (size_t)n * inner + k0;
       double *M = dst + o * (size_t)n * inner + k0;
-      /* forward sweep: M_i = (rhs_i - l_i M_i-1) * r_i */
+      /* forward sweep: M_i = (rhs_i - l_i M_i-1) * r_i (rows of one array never overlap,
+       * hence restrict: the loops over k vectorise) */
       for (int i = 1; i <= n - 2; i++) {
-        double lr = a->lo[i];
-        double ia = 1.0 / h[i - 1], ib = 1.0 / h[i], r = a->r[i];
-        const double *fm = f + (size_t)(i - 1) * inner, *f0 = fm + inner, *fp = f0 + inner;
-        double *Mi = M + (size_t)i * inner;
-        const double *Mp = Mi - inner;
-        if (i == 1) /* no sub-diagonal (M_0 was eliminated): row 0 of M is not read */
-          for (size_t k = 0; k < kn; k++)
-            Mi[k] = 6.0 * ((fp[k] - f0[k]) * ib - (f0[k] - fm[k]) * ia) * r;
-        else
-          for (size_t k = 0; k < kn; k++) {
-            double rhs = 6.0 * ((fp[k] - f0[k]) * ib - (f0[k] - fm[k]) * ia);
-            Mi[k] = (rhs - lr * Mp[k]) * r;
-          }
+        const double lr = i == 1 ? 0.0 : a->lo[i]; /* row 1 has no sub-diagonal */
+        const double ia = a->ih[i - 1], ib = a->ih[i], r = a->r[i];
+        const double *restrict fm = f + (size_t)(i - 1) * inner;
+        const double *restrict f0 = fm + inner, *restrict fp = f0 + inner;
+        double *restrict Mi = M + (size_t)i * inner;
+        const double *restrict Mp = i == 1 ? f0 : Mi - inner; /* row 0 of M is not read */
+        for (size_t k = 0; k < kn; k++) {
+          double rhs = 6.0 * ((fp[k] - f0[k]) * ib - (f0[k] - fm[k]) * ia);
+          Mi[k] = (rhs - lr * Mp[k]) * r;
+        }
       }
       /* back substitution: M_i -= c_i M_i+1 */
       for (int i = n - 3; i >= 1; i--) {
-        double c = a->c[i];
-        double *Mi = M + (size_t)i * inner;
-        const double *Mn = Mi + inner;
+        const double c = a->c[i];
+        double *restrict Mi = M + (size_t)i * inner;
+        const double *restrict Mn = Mi + inner;
         for (size_t k = 0; k < kn; k++) Mi[k] -= c * Mn[k];
       }
       /* the not-a-knot ends (TB-3) */
@@ -204,7 +206,9 @@ static cv_table *table_build(int dim, const int *n, const double *const *coords,
   t->size = size;
   for (int k = 0; k < dim; k++)
     if (axis_init(&t->ax[k], n[k], coords[k], msg, len, k) != 0) {
-      if (!t->ax[k].x || !t->ax[k].r) goto nomem;
+      if (!t->ax[k].x || !t->ax[k].h || !t->ax[k].ih || !t->ax[k].c || !t->ax[k].r ||
+          !t->ax[k].lo)
+        goto nomem;
       goto fail;
     }
   for (size_t i = 0; i < size; i++)
@@ -222,14 +226,15 @@ static cv_table *table_build(int dim, const int *n, const double *const *coords,
     }
     t->G[mask] = cv_malloc(size * sizeof(double));
     if (!t->G[mask]) goto nomem;
-    cv_advise_huge(t->G[mask], size * sizeof(double));
     if (mask == 0) {
       memcpy(t->G[0], values, size * sizeof(double));
       continue;
     }
-    int k = 0; /* the highest axis in mask: G[mask] from G[mask without it] */
-    for (int b = 0; b < dim; b++)
-      if (mask & (1 << b)) k = b;
+    /* the lowest axis in mask: G[mask] from G[mask without it]. The axis with the longest
+     * contiguous lines (the first) then does most of the 2^d - 1 solves; the order does
+     * not matter otherwise, the per-axis operators commute (TB-2). */
+    int k = 0;
+    while (!(mask & (1 << k))) k++;
     size_t inner = t->stride[k], outer = size / (inner * (size_t)n[k]);
     axis_solve(&t->ax[k], t->G[mask & ~(1 << k)], t->G[mask], outer, inner);
   }

@@ -443,11 +443,8 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
         goto done;
       }
       double *nv = cv_realloc(vals, ncap * sizeof *nv);
-      if (nv) {
-        if (!vals)
-          cv_advise_huge(nv, ncap * sizeof *nv);
+      if (nv)
         vals = nv;
-      }
       uint32_t *ni = nv ? cv_realloc(ids, ncap * (size_t)dim * sizeof *ni) : NULL;
       if (!ni) {
         sc_err(err, errlen, shown, line, "out of memory");
@@ -565,7 +562,6 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
       sc_err(err, errlen, shown, 0, "out of memory");
       goto done;
     }
-    cv_advise_huge(grid, size * sizeof *grid);
     for (size_t r = 0; r < nrows; r++) {
       size_t idx = TB_INDEX(r);
       if (seen[idx >> 3] & (1u << (idx & 7))) {
