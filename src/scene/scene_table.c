@@ -170,6 +170,7 @@ typedef struct {
   const char *last; /* the previous row's text of this column and its id */
   size_t lastlen;
   uint32_t lastid;
+  int unsorted; /* a new text's value was not above every earlier one */
 } tcol;
 
 static uint64_t text_hash(const char *s, size_t len)
@@ -241,6 +242,8 @@ static long tcol_add(tcol *c, const char *s, size_t len, double v, uint64_t hh)
   while (c->slot[i])
     i = (i + 1) & mask;
   c->slot[i] = (uint32_t)c->n + 1;
+  if (c->n && !(v > c->v[c->n - 1]))
+    c->unsorted = 1;
   c->s[c->n] = s;
   c->len[c->n] = len;
   c->v[c->n] = v;
@@ -255,6 +258,44 @@ static void tcol_free(tcol *c)
   cv_free(c->v);
   cv_free(c->hash);
   cv_free(c->slot);
+}
+
+/* Whether the coordinate ids t of a row follow p, the previous row's, in the row-major
+ * enumeration of the ids (the last coordinate fastest), the radices rad (0 = not known
+ * yet: the digit has not wrapped around) being learnt on the way. Known radices are
+ * always those of the last coordinates (a digit wraps only when all after it do). */
+static int order_next(int dim, const uint32_t *p, const uint32_t *t, uint32_t *rad)
+{
+  int d = 0;
+  while (d < dim && t[d] == p[d])
+    d++;
+  if (d == dim || t[d] != p[d] + 1 || (rad[d] && t[d] >= rad[d]))
+    return 0;
+  for (int e = d + 1; e < dim; e++)
+    if (t[e] != 0 || (rad[e] && p[e] + 1 != rad[e]))
+      return 0;
+  for (int e = d + 1; e < dim; e++)
+    if (!rad[e])
+      rad[e] = p[e] + 1;
+  return 1;
+}
+
+/* The ids of the rows 0 .. nrows-1 when they were the enumeration of order_next: row r
+ * in mixed radix (an unknown radix takes what is left: the digits before it are 0). */
+static void decode_ids(int dim, const uint32_t *rad, size_t nrows, uint32_t *ids)
+{
+  for (size_t r = 0; r < nrows; r++) {
+    size_t q = r;
+    for (int e = dim - 1; e >= 0; e--) {
+      if (rad[e]) {
+        ids[r * (size_t)dim + (size_t)e] = (uint32_t)(q % rad[e]);
+        q /= rad[e];
+      } else {
+        ids[r * (size_t)dim + (size_t)e] = (uint32_t)q;
+        q = 0;
+      }
+    }
+  }
 }
 
 /* Index of x in the sorted distinct values c[0..n) (present by construction). */
@@ -410,7 +451,8 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
    * becomes the table's array without a copy. */
   const char *body = nl ? nl + 1 : end;
   p = body;
-  int lastline = 0;
+  int lastline = 0, inorder = 1;
+  uint32_t prev[3] = {0, 0, 0}, rad[3] = {0, 0, 0};
   while (p < end) {
     line++;
     nl = memchr(p, '\n', (size_t)(end - p));
@@ -445,15 +487,16 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
       double *nv = cv_realloc(vals, ncap * sizeof *nv);
       if (nv)
         vals = nv;
-      uint32_t *ni = nv ? cv_realloc(ids, ncap * (size_t)dim * sizeof *ni) : NULL;
-      if (!ni) {
+      uint32_t *ni = nv && ids ? cv_realloc(ids, ncap * (size_t)dim * sizeof *ni) : NULL;
+      if (!nv || (ids && !ni)) {
         sc_err(err, errlen, shown, line, "out of memory");
         goto done;
       }
-      ids = ni;
+      if (ni)
+        ids = ni;
       caprows = ncap;
     }
-    uint32_t *rid = ids + nrows * (size_t)dim;
+    uint32_t rid[3];
     for (int c = 0; c < dim; c++) {
       tcol *T = &tc[c];
       if (fl[c] == T->lastlen && memcmp(fs[c], T->last, fl[c]) == 0) {
@@ -495,6 +538,20 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
              (int)(fl[dim] < 40 ? fl[dim] : 40), fs[dim]);
       goto done;
     }
+    /* rows in the order of the grid need no ids: they follow from the row number */
+    if (inorder && nrows && !order_next(dim, prev, rid, rad)) {
+      inorder = 0;
+      ids = cv_malloc(caprows * (size_t)dim * sizeof *ids);
+      if (!ids) {
+        sc_err(err, errlen, shown, line, "out of memory");
+        goto done;
+      }
+      decode_ids(dim, rad, nrows, ids);
+    }
+    if (inorder)
+      memcpy(prev, rid, sizeof prev);
+    else
+      memcpy(ids + nrows * (size_t)dim, rid, (size_t)dim * sizeof *rid);
     nrows++;
     lastline = line;
     p = nl ? nl + 1 : end;
@@ -543,11 +600,22 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
    : dim == 2 ? (size_t)rank[0][ids[2 * (r)]] * stride[0] + rank[1][ids[2 * (r) + 1]]        \
               : (size_t)rank[0][ids[3 * (r)]] * stride[0] +                                 \
                     (size_t)rank[1][ids[3 * (r) + 1]] * stride[1] + rank[2][ids[3 * (r) + 2]])
-  size_t r0 = 0;
-  if (nrows == size)
-    while (r0 < nrows && TB_INDEX(r0) == r0)
-      r0++;
-  if (nrows == size && r0 == nrows) { /* in grid order: the values are the grid */
+  /* In the order of the grid: the ids are the enumeration of order_next, complete (as
+   * many rows as points), and each coordinate's values came in increasing order (an
+   * id is then the index in the sorted values). Otherwise the ids are needed. */
+  int identity = inorder && nrows == size;
+  for (int k = 0; k < dim; k++)
+    if (tc[k].unsorted || tc[k].n != (size_t)n[k])
+      identity = 0;
+  if (inorder && !identity) {
+    ids = cv_malloc(nrows * (size_t)dim * sizeof *ids);
+    if (!ids) {
+      sc_err(err, errlen, shown, 0, "out of memory");
+      goto done;
+    }
+    decode_ids(dim, rad, nrows, ids);
+  }
+  if (identity) { /* the values are the grid */
     grid = vals;
     vals = NULL;
     if (caprows > size) { /* give back the unused tail */
