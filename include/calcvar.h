@@ -342,6 +342,11 @@ CVAR_API cv_status cv_solver_set_mesh_graded(cv_solver *s, int elements, double 
 /** A user mesh on the reference interval [0, 1]: t[0] = 0 < t[1] < ... < t[E] = 1, mapped
  * affinely onto the problem's [a, b]. The array is copied; E >= 1. */
 CVAR_API cv_status cv_solver_set_mesh(cv_solver *s, int elements, const double *t);
+/** A user mesh as cv_solver_set_mesh with its own degree 1..8 for each element
+ * (degrees[0 .. elements-1], copied; theory HP-1). Nodes: 1 + the sum of the degrees.
+ * cv_solver_set_degree and the other mesh setters return to one degree for all. */
+CVAR_API cv_status cv_solver_set_mesh_hp(cv_solver *s, int elements, const double *t,
+                                         const int *degrees);
 /** Points in (a, b) at which the mesh must have nodes (where the integrand may jump), in
  * the problem's variable. The nearest element boundary is moved onto each breakpoint (the
  * mesh is split there when moving would tangle it). nb = 0 clears. */
@@ -386,14 +391,30 @@ CVAR_API cv_status cv_solver_set_continuation(cv_solver *s, int on);
 /** Continuation steps taken by the last solve (0 when Newton converged directly). */
 CVAR_API int cv_solver_get_continuation_steps(const cv_solver *s);
 
-/** Adaptive refinement (theory AD-1): solve, estimate the error of every element by a second
- * solve on the mesh with every element halved, bisect the elements whose estimate exceeds
- * tol / 4, and repeat until the estimated max nodal error is at most tol, or the mesh would
- * exceed max_elements (then CVAR_EMAXITER with a sentence). tol = 0 turns it off (default).
- * The starting mesh is the one set by the other mesh setters. */
+/** Adaptive refinement at a fixed degree (theory AD-1): solve, estimate the error with the
+ * enriched solve of cv_solver_estimate_error (HP-2), bisect the elements whose indicator
+ * exceeds tol / 4, and repeat until the estimated max nodal error is at most tol, or the
+ * mesh would exceed max_elements (then CVAR_EMAXITER with a sentence). tol = 0 turns it off
+ * (default). The starting mesh is the one set by the other mesh setters. Replaces a
+ * cv_solver_set_tol (the last one set wins). */
 CVAR_API cv_status cv_solver_set_adapt(cv_solver *s, double tol, int max_elements);
-/** Estimated max nodal error of the last adaptive solve (NaN when not adaptive). */
+/** Automatic accuracy (theory HP-1..HP-4): the solver chooses the mesh and the degree of
+ * each element (1..8) until its estimate of the max nodal error is at most tol (> 0), or it
+ * stops with CVAR_EMAXITER and a sentence saying why (the cap on unknowns, on rounds, or the
+ * round-off floor) and the estimate reached. tol = 0 turns it off (default). The starting
+ * mesh is the one set by the other setters. Cannot be combined with cv_solver_set_adapt
+ * (the last one set wins). */
+CVAR_API cv_status cv_solver_set_tol(cv_solver *s, double tol, int max_nodes);
+/** Estimated max nodal error of the last adaptive or --tol solve (NaN otherwise). */
 CVAR_API double cv_solver_get_error_estimate(const cv_solver *s);
+/** A-posteriori estimate of the max nodal error of the last (converged) solve on its own
+ * mesh, from a warm-started solve on the p-enriched mesh (theory HP-2): CVAR_OK with *est
+ * and (if est_vertex is not NULL) the max over the element boundaries alone, or an error
+ * with a sentence in msg (cv_solver_last_error is not changed) when the enriched solve
+ * failed or landed on another stationary path (theory HP-3): no bound then, NaN. */
+CVAR_API cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p,
+                                            double *est, double *est_vertex, char *msg,
+                                            size_t len);
 /** Refinement rounds of the last adaptive solve. */
 CVAR_API int cv_solver_get_adapt_rounds(const cv_solver *s);
 
@@ -435,8 +456,12 @@ CVAR_API const char *cv_solver_last_error(const cv_solver *s);
 CVAR_API int cv_solver_get_num_nodes(const cv_solver *s);
 /** Elements of the mesh of the last solve (breakpoints may have added some; 0 before any). */
 CVAR_API int cv_solver_get_num_elements(const cv_solver *s);
-/** Polynomial degree of the elements of the last solve (0 before any). */
+/** Polynomial degree of the elements of the last solve, the largest with per-element
+ * degrees (0 before any). */
 CVAR_API int cv_solver_get_degree(const cv_solver *s);
+/** Number of elements of the last solve; with degrees != NULL also writes the degree of
+ * each element (0 before any solve). */
+CVAR_API int cv_solver_get_degrees(const cv_solver *s, int *degrees);
 /** x[j] of node j, length cv_solver_get_num_nodes(). */
 CVAR_API cv_status cv_solver_get_nodes(const cv_solver *s, double *x);
 /** Nodal values, node-major: y[j*n + i] is unknown i at node j; length nodes*n. */

@@ -83,7 +83,7 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
                strcmp(name, "--verbose") == 0 || strcmp(name, "-v") == 0;
     static const char *const valued[] = {
       "--elements", "--degree", "--method", "--tolerance", "--max-iterations", "--set",
-      "--adapt", "--continue", "--json", "--csv", "--plot", "--max", "--work",
+      "--adapt", "--tol", "--continue", "--json", "--csv", "--plot", "--max", "--work",
       "--max-elements", NULL};
     int known = flag;
     for (int k = 0; valued[k]; k++)
@@ -143,6 +143,9 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     } else if (strcmp(name, "--adapt") == 0) {
       if (parse_pos_double(v, &o->adapt) < 0)
         return bad(cmd, "--adapt needs a target error > 0, got '%s'", v);
+    } else if (strcmp(name, "--tol") == 0) {
+      if (parse_pos_double(v, &o->tol) < 0)
+        return bad(cmd, "--tol needs a target max nodal error > 0, got '%s'", v);
     } else if (strcmp(name, "--set") == 0) {
       const char *e = strchr(v, '=');
       if (!e || e == v || !e[1])
@@ -185,6 +188,9 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     return 0;
   if (!o->scene_path)
     return bad(cmd, "a scene file is missing: calcvar %s SCENE [options]", cmd);
+  if (o->tol > 0 && o->adapt > 0)
+    return bad(cmd, "--tol and --adapt cannot be combined (--tol chooses the mesh and the "
+               "degrees, --adapt the mesh at one degree)");
   if ((o->max_paths || o->work > 0) && !o->all)
     return bad(cmd, "--max and --work belong to --all; give --all too");
   if (o->json && o->csv && strcmp(o->json, "-") == 0 && strcmp(o->csv, "-") == 0)
@@ -230,7 +236,7 @@ void cli_apply_solver_options(const cli_opts *o, scene *s)
 
 int cli_only_scene_options(const char *cmd, const cli_opts *o)
 {
-  if (o->csv || o->plot || o->adapt > 0 || o->cont || o->elements || o->degree ||
+  if (o->csv || o->plot || o->adapt > 0 || o->tol > 0 || o->cont || o->elements || o->degree ||
       o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all || o->max_elements ||
       o->verbose) {
     fprintf(stderr, "calcvar %s: only --set, --json and --quiet apply to %s\n", cmd, cmd);

@@ -20,6 +20,7 @@ typedef struct {
   int method; /* cv_method or -1 */
   double tolerance;
   double adapt;
+  double tol; /* --tol: automatic accuracy (hp) */
   int max_elements; /* --max-elements: the adaptive cap (0: 2e6) */
   const char *cont; /* --continue name=from:to */
   int nset;

@@ -293,7 +293,8 @@ static int own_args(int argc, char **argv, char **rest, int *nrest, const char *
     } else {
       rest[(*nrest)++] = argv[i];
       /* a valued solve option: keep its value with it */
-      if (!strchr(a, '=') && i + 1 < argc && strcmp(a, "--quiet") != 0)
+      if (!strchr(a, '=') && i + 1 < argc && strcmp(a, "--quiet") != 0 &&
+          strcmp(a, "--verbose") != 0 && strcmp(a, "-v") != 0 && strcmp(a, "--all") != 0)
         rest[(*nrest)++] = argv[++i];
     }
   }
@@ -329,9 +330,19 @@ int cli_batch(int argc, char **argv)
     cli_mpi_finish(&mpi);
     return EXIT_BADINPUT;
   }
-  if (o.cont || o.json || o.csv || o.plot) {
+  if (o.verbose) {
+    /* rows are solved on several threads (and ranks): per-iteration lines would interleave */
+    fprintf(stderr, "calcvar batch: --verbose is not available for batch yet; run calcvar "
+            "solve --verbose --set ... on a row to see its iterations\n");
+    cli_opts_free(&o);
+    cli_mpi_finish(&mpi);
+    return EXIT_BADINPUT;
+  }
+  if (o.cont || o.json || o.csv || o.plot || o.all || o.max_paths || o.work > 0 ||
+      o.max_elements > 0) {
     fprintf(stderr, "calcvar batch: --%s is an option of calcvar solve, not of batch\n",
-            o.cont ? "continue" : o.json ? "json" : o.csv ? "csv" : "plot");
+            o.cont ? "continue" : o.json ? "json" : o.csv ? "csv" : o.plot ? "plot"
+            : o.all ? "all" : o.max_paths ? "max" : o.work > 0 ? "work" : "max-elements");
     cli_opts_free(&o);
     cli_mpi_finish(&mpi);
     return EXIT_BADINPUT;
@@ -365,12 +376,7 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     s->elements = o->elements;
   if (o->degree)
     s->degree = o->degree;
-  if (o->method >= 0)
-    s->method = (cv_method)o->method;
-  if (o->tolerance > 0)
-    s->tolerance = o->tolerance;
-  if (o->max_iterations)
-    s->max_iterations = o->max_iterations;
+  cli_apply_solver_options(o, s);
   if (o->adapt > 0)
     s->adapt = o->adapt;
   if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) &&

@@ -88,7 +88,7 @@ static int parse_degrees(const char *v, conv_opts *c)
 static int split_args(int argc, char **argv, conv_opts *c, char **rest, int *nrest)
 {
   static const char *const valued[] = {"--elements", "--method", "--tolerance",
-                                       "--max-iterations", "--set", "--adapt", "--continue",
+                                       "--max-iterations", "--set", "--adapt", "--tol", "--continue",
                                        "--json", "--csv", "--plot", "--max-elements", NULL};
   static const char *const mine[] = {"--levels", "--degree", "--svg"};
   c->levels = 6;
@@ -196,6 +196,10 @@ static int solve_row(scene *s, const cv_problem *p, int any_exact, cli_conv_row 
   if (!best)
     return -1;
   int rc = cli_report_collect(&row->r, s, p, best, s->method, st);
+  double ea = NAN, ev = NAN;
+  char why[400];
+  if (rc == 0 && !any_exact && row->r.nodes > 0 && st == CVAR_OK)
+    rc = cli_estimate_error(best, p, &ea, &ev, why, sizeof why);
   cv_solver_free(best);
   if (rc < 0)
     return -1;
@@ -211,9 +215,6 @@ static int solve_row(scene *s, const cv_problem *p, int any_exact, cli_conv_row 
     row->has_err_v = isfinite(ev);
     row->err_v = ev;
   } else {
-    double ea, ev;
-    if (cli_estimate_error(s, p, r->nodes, r->degree, r->x, r->y, &ea, &ev) < 0)
-      return -1;
     row->estimated = 1;
     row->has_err = isfinite(ea);
     row->err = ea;
@@ -268,7 +269,8 @@ int cli_converge(int argc, char **argv)
   }
   cli_progress_setup(o.verbose);
   const char *notmine = o.csv ? "--csv" : o.plot ? "--plot" : o.adapt > 0 ? "--adapt"
-                        : o.cont ? "--continue" : o.max_elements ? "--max-elements" : NULL;
+                        : o.tol > 0 ? "--tol" : o.cont ? "--continue"
+                        : o.max_elements ? "--max-elements" : NULL;
   if (notmine) {
     rc = bad("%s is an option of solve, not of converge", notmine);
     goto done;
@@ -287,7 +289,8 @@ int cli_converge(int argc, char **argv)
   if (c.ndeg == 0)
     c.deg[c.ndeg++] = s->degree;
   cli_apply_solver_options(&o, s);
-  s->adapt = 0; /* converge studies fixed meshes: a scene's adapt does not apply */
+  s->adapt = 0; /* converge studies fixed meshes: a scene's adapt or tol does not apply */
+  s->tol = 0;
   /* The finest mesh, and the reference mesh of an estimate (p^2 times the nodes), must
    * keep every node count an int. */
   if ((long long)s->elements << (c.levels - 1) > INT_MAX / 81) {

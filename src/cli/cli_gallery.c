@@ -36,7 +36,7 @@ static int run_one(const cli_gallery_scene *g)
   int any_exact = 0;
   for (int i = 0; i < s->n; i++)
     any_exact |= s->exact[i] >= 0;
-  if (!any_exact && !r.has_err_action && cli_report_estimate(&r, s, p) < 0) {
+  if (!any_exact && !r.has_err_action && cli_report_estimate(&r, sv, p) < 0) {
     printf("%-*s  out of memory\n", TITLE_W, s->title);
     cli_report_free(&r);
     goto done;

@@ -25,6 +25,8 @@ static void usage(FILE *f)
         "  --set name=value     override a parameter (repeatable)\n"
         "  --adapt TOL          refine until the estimated max nodal error < TOL\n"
         "  --max-elements N     cap of adaptive refinement (default 2000000)\n"
+        "  --tol T              choose mesh and degrees until the estimated max nodal\n"
+        "                       error <= T (elements/degree, if given, are the start)\n"
         "  --continue name=from:to   continuation in a parameter\n"
         "  --all                every stationary path that can be found (deflation)\n"
         "  --max K              at most K paths with --all (default 8)\n"
@@ -42,7 +44,13 @@ static void usage(FILE *f)
  * ignore a request. */
 static int unsupported(const cli_opts *o, const scene *s)
 {
-  if (o->cont && (o->adapt > 0 || s->adapt > 0)) {
+  if ((o->tol > 0 && s->adapt > 0) || (o->adapt > 0 && s->tol > 0)) {
+    fprintf(stderr, "%s:%d: [mesh] %s cannot be combined with %s\n", s->file,
+            s->tol > 0 ? s->tol_line : s->adapt_line, s->tol > 0 ? "tol" : "adapt",
+            s->tol > 0 ? "--adapt" : "--tol");
+    return EXIT_BADINPUT;
+  }
+  if (o->cont && (o->adapt > 0 || s->adapt > 0 || o->tol > 0 || s->tol > 0)) {
     fprintf(stderr, "calcvar solve: --continue and adaptive refinement cannot be combined "
             "(continuation keeps one mesh)\n");
     return EXIT_BADINPUT;
@@ -107,6 +115,14 @@ int cli_solve(int argc, char **argv)
   cli_apply_solver_options(&o, s);
   if ((rc = unsupported(&o, s)) != 0)
     goto done;
+  double tol = o.tol > 0 ? o.tol : s->tol;
+  if (tol > 0) { /* automatic accuracy: the scene's or the flags' mesh is only the start */
+    s->tol = tol;
+    if (!o.elements && !s->elements_line && s->grading <= 0)
+      s->elements = SCENE_TOL_START_ELEMENTS;
+    if (!o.degree && !s->degree_line)
+      s->degree = SCENE_TOL_START_DEGREE;
+  }
   cv_status why;
   if ((!o.cont && !(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err))) ||
       !(sv = cv_solver_new(&why)) || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK) {
@@ -162,7 +178,7 @@ int cli_solve(int argc, char **argv)
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if (cli_report_build(&r, s, p, sv, st, adapt > 0) < 0) {
+  if (cli_report_build(&r, s, p, sv, st, tol > 0 ? 2 : adapt > 0) < 0) {
     fprintf(stderr, "calcvar solve: out of memory while reporting\n");
     rc = EXIT_UNSOLVED;
     goto done;

@@ -165,6 +165,17 @@ static PLINT legend_corner(const cli_plot_panel *p, double x0, double x1, double
   return corners[best];
 }
 
+/* The decimals a linear axis over [lo, hi] needs when its values share leading digits
+ * (an offset far larger than the range), else -1: PLplot's own choice is right then. */
+static int axis_decimals(double lo, double hi)
+{
+  double range = fabs(hi - lo), mid = fmax(fabs(lo), fabs(hi));
+  if (!(range > 0) || mid < 100 * range)
+    return -1;
+  int d = (int)ceil(-log10(range / 5));
+  return d < 0 ? -1 : d > 12 ? 12 : d;
+}
+
 static void draw_panel(const cli_plot_panel *p)
 {
   double x0, x1, y0, y1;
@@ -191,7 +202,13 @@ static void draw_panel(const cli_plot_panel *p)
   plcol0(2);
   plbox("g", 0, 0, "g", 0, 0);
   plcol0(1);
-  plbox(xo, 0, 0, yo, 0, 0);
+  /* Labels with enough decimals to tell the ticks apart: PLplot's automatic precision
+   * prints 1.000 at every tick of a range of 1e-4 around 1 (a ray that hardly bends). */
+  plprec(axis_decimals(x0, x1) >= 0, axis_decimals(x0, x1));
+  plbox(xo, 0, 0, "", 0, 0);
+  plprec(axis_decimals(y0, y1) >= 0, axis_decimals(y0, y1));
+  plbox("", 0, 0, yo, 0, 0);
+  plprec(0, 0);
   pllab(p->xlabel, p->ylabel, p->title);
   for (int l = 0; l < p->nlines; l++)
     draw_line(p, &p->lines[l]);

@@ -107,8 +107,8 @@ int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv)
     P->ydown = s->plot_down[pv];
   }
   char xl[256];
-  snprintf(xl, sizeof xl, "%s   (%d elements of degree %d, %s)", s->variable, r->elements,
-           r->degree, r->status);
+  snprintf(xl, sizeof xl, "%s   (%d elements of degree %s%d, %s)", s->variable, r->elements,
+           r->has_degrees ? "up to " : "", r->degree, r->status);
   if (path >= 0 && !components)
     pan[path].xlabel = xl; /* the only panel but errors: it carries the mesh line */
   if (components) {

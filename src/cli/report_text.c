@@ -12,7 +12,13 @@ void cli_report_text(FILE *f, const cli_report *r)
   if (r->has_time)
     fprintf(f, ", %.3g s", r->time_s);
   fputc('\n', f);
-  if (r->nodes > 0)
+  int dmin = r->degree;
+  for (int e = 0; r->degrees && e < r->elements; e++)
+    dmin = r->degrees[e] < dmin ? r->degrees[e] : dmin;
+  if (r->nodes > 0 && dmin < r->degree)
+    fprintf(f, "  mesh        %d elements of degrees %d to %d, %d nodes\n", r->elements, dmin,
+            r->degree, r->nodes);
+  else if (r->nodes > 0)
     fprintf(f, "  mesh        %d elements of degree %d, %d nodes\n", r->elements, r->degree,
             r->nodes);
   if (r->has_action)
@@ -34,7 +40,8 @@ void cli_report_text(FILE *f, const cli_report *r)
     fprintf(f, "  error       %.3g in the action (against [exact] action = %.17g)\n",
             r->err_action, s->exact_action);
   if (r->has_err_est)
-    fprintf(f, "  estimate    %.3g max nodal error (reference solve on a finer mesh)\n", r->err_est);
+    fprintf(f, "  estimate    %.3g max nodal error (from a solve with higher degrees)\n",
+            r->err_est);
   if (r->has_energy)
     fprintf(f, "  energy      H from %.15g to %.15g (drift %.3g)\n", r->emin, r->emax,
             r->emax - r->emin);

@@ -1,219 +1,236 @@
-/* src/core/cv_adapt.c — adaptive h-refinement driven by a two-mesh error estimate, theory
- * (AD-1).
+/* src/core/cv_adapt.c — automatic accuracy in rounds: solve, estimate (HP-2), decide (HP-4,
+ * HP-5), until the estimate is at most the tolerance or a stop rule says why not (HP-6).
+ * --tol chooses degrees and elements (hp); --adapt the elements at a fixed degree (AD-1).
  * SPDX-License-Identifier: MIT */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
 #include "cv_internal.h"
 
 #define MAX_ROUNDS 80
+/* Rounds without halving the best estimate before the loop counts as stalled (HP-6): few
+ * near the round-off floor, many before it (bisecting towards a thin layer leaves the
+ * estimate flat for as many rounds as the layer is halvings thin). */
+#define STALL_ROUNDS_FLOOR 3
+#define STALL_ROUNDS 40
 
-/* Point solver s at the mesh with boundaries xe[0..E] (a user mesh on [0, 1]). */
-static cv_status use_mesh(cv_solver *s, const double *xe, int E, double *t) {
-  double a = xe[0], L = xe[E] - xe[0];
-  for (int i = 0; i <= E; i++) t[i] = (xe[i] - a) / L;
-  t[0] = 0.0;
-  t[E] = 1.0;
-  return cv_solver_set_mesh(s, E, t);
+cv_status cv_solver_set_tol(cv_solver *s, double tol, int max_nodes) {
+  if (!s || !(tol >= 0) || !isfinite(tol) || max_nodes < 2) return CVAR_EINVAL;
+  s->adapt_tol = tol;
+  s->adapt_max = max_nodes;
+  s->hp = 1;
+  return CVAR_OK;
 }
 
-/* Start s (about to be solved on its mesh) from the solution held by `from`. */
-static cv_status warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from) {
-  cv_disc d;
-  char msg[160];
-  cv_status st = cv_disc_init(&d, p, s, msg, sizeof msg);
+cv_status cv_solver_set_adapt(cv_solver *s, double tol, int max_elements) {
+  if (!s || !(tol >= 0) || !isfinite(tol) || max_elements < 1) return CVAR_EINVAL;
+  s->adapt_tol = tol;
+  s->adapt_max = max_elements;
+  s->hp = 0;
+  return CVAR_OK;
+}
+
+/* The starting mesh of the rounds on [0, 1] with its degrees, from the caller's settings. */
+static cv_status start_mesh(cv_solver *s, const cv_problem *p, int *E, double **t,
+                            int **deg) {
+  double *xe = NULL;
+  cv_status st = cv_mesh_build(&s->mesh, p->a, p->b, E, &xe, s->msg, sizeof s->msg);
   if (st) return st;
-  int n = p->n, N = d.nodes;
-  double *x = cv_malloc((size_t)N * sizeof *x), *ys = cv_malloc((size_t)N * n * sizeof *ys);
-  double *y = cv_malloc((size_t)N * n * sizeof *y);
-  if (!x || !ys || !y) st = CVAR_ENOMEM;
-  if (!st) {
-    cv_disc_fill_nodes(&d, x);
-    st = cv_solver_eval(from, N, x, ys, NULL);
+  *t = cv_malloc((size_t)(*E + 1) * sizeof **t);
+  *deg = cv_malloc((size_t)*E * sizeof **deg);
+  if (!*t || !*deg) {
+    cv_free(xe);
+    return CVAR_ENOMEM;
   }
-  if (!st) {
-    for (int j = 0; j < N; j++)
-      for (int i = 0; i < n; i++) y[(size_t)j * n + i] = ys[(size_t)i * N + j];
-    st = cv_solver_set_start(s, N * n, y);
-  }
-  cv_free(x);
-  cv_free(ys);
-  cv_free(y);
-  cv_disc_free(&d);
-  return st;
+  for (int i = 0; i <= *E; i++) (*t)[i] = (xe[i] - p->a) / (p->b - p->a);
+  (*t)[0] = 0.0;
+  (*t)[*E] = 1.0;
+  if (s->mesh.degrees) cv_mesh_degrees(&s->mesh, p->a, p->b, *E, xe, *deg);
+  else
+    for (int e = 0; e < *E; e++) (*deg)[e] = s->degree;
+  cv_free(xe);
+  return CVAR_OK;
 }
 
-/* (AD-1) Solve on the current mesh and on a reference mesh whose element boundaries are
- * all its nodes (degree 1: every element halved). Element boundaries converge as O(h^2p),
- * so at the nodes the reference is far more accurate than the solution judged, and the
- * error of element e is estimated as max over its nodes of |y_h - y_ref| (degree 1: times
- * 4/3, Richardson for order 2). Elements above tol/4 are bisected. */
+/* Largest nodal value of the solution (at least 1): the scale of its round-off floor. */
+static double value_scale(const cv_solver *s) {
+  double m = 1.0;
+  for (long k = 0; k < s->disc.ndof; k++) m = fmax(m, fabs(s->y[k]));
+  return m;
+}
+
+/* HP-6: why the rounds must stop before reaching tol, as a sentence in s->msg, or 0 to go
+ * on. best: smallest estimate so far; floor_: the estimate's round-off part (HP-2);
+ * stalled: rounds since the best last halved. */
+static int stop_rule(cv_solver *s, double est, double best, double floor_, int stalled,
+                     int next_size) {
+  double tol = s->adapt_tol;
+  const char *what = s->hp ? "nodes" : "elements";
+  if ((best <= floor_ && tol < floor_) || (stalled >= STALL_ROUNDS_FLOOR && best <= 10.0 * floor_)) {
+    cv_set_msg(s->msg, sizeof s->msg,
+               "the error estimate reached %.2g > %.2g and can go no lower: that is the "
+               "round-off floor of double precision for this solution (about %.1g, from "
+               "values of size %.2g and the slope times the spacing of doubles at the "
+               "nodes); ask for a larger tolerance",
+               est, tol, floor_, value_scale(s));
+    return 1;
+  }
+  if (stalled >= STALL_ROUNDS) {
+    cv_set_msg(s->msg, sizeof s->msg,
+               "the error estimate stopped decreasing at %.2g > %.2g (%d rounds without "
+               "halving it, %d elements, %d nodes)",
+               best, tol, stalled, s->disc.E, s->disc.nodes);
+    return 1;
+  }
+  if (next_size > s->adapt_max) {
+    cv_set_msg(s->msg, sizeof s->msg,
+               "the next refinement would exceed the cap of %d %s after %d rounds; the "
+               "estimated max nodal error reached is %.2g > %.2g; %s",
+               s->adapt_max, what, s->rounds, est, tol,
+               s->hp ? "ask for a larger tolerance (or raise the cap: the max_nodes argument "
+                       "of cv_solver_set_tol)"
+                     : "use a higher degree or a looser tolerance (or raise the cap: "
+                       "--max-elements, or the max_elements argument of cv_solver_set_adapt)");
+    return 1;
+  }
+  if (s->rounds >= MAX_ROUNDS) {
+    cv_set_msg(s->msg, sizeof s->msg,
+               "no estimate below %.2g after %d refinement rounds (estimate %.2g)", tol,
+               MAX_ROUNDS, est);
+    return 1;
+  }
+  return 0;
+}
+
+/* Nodes (hp) or elements (--adapt) after refining d's elements with eta >= thresh. */
+static int next_size(const cv_disc *d, const double *eta, double thresh, int hp) {
+  long size = hp ? d->nodes : d->E;
+  for (long e = 0; e < d->E; e++)
+    if (eta[e] >= thresh) size += hp ? cv_disc_edeg(d, e) + 1 : 1;
+  return size > 2000000000L ? 2000000000 : (int)size;
+}
+
+/* Rounds (HP-1): solve on the current mesh warm-started from the last enriched solution,
+ * estimate, refine. Ends with s holding the last round's solution and s->err_est. */
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   cv_status st;
   cv_solver *f = cv_solver_new(&st);
-  double *xe = NULL, *t = NULL, *xn = NULL, *yf = NULL, *eta = NULL;
+  double *t = NULL, *eta = NULL, *sigma = NULL, *where = NULL;
+  int *deg = NULL, E = 0, stalled = 0, warm = 0, misses = 0;
+  long iters = 0, iters_ref = 0; /* Newton iterations of all rounds; of the enriched solves */
+  double tol = s->adapt_tol, best = INFINITY;
   cv_meshspec spec0 = s->mesh;
-  int E = 0, n = p->n;
-  /* Newton iterations summed over the rounds (working meshes; the reference solves apart):
-   * what the report gives, not the last round's count alone. */
-  int it_work = 0, it_ref = 0;
-  double tol = s->adapt_tol;
+  int degree0 = s->degree;
   if (!f) return CVAR_ENOMEM;
-  f->degree = s->degree;
-  f->nq = s->nq;
-  f->rtol = s->rtol;
-  f->atol = s->atol;
-  f->maxit = s->maxit;
-  f->method = s->method;
-  /* the starting mesh, as the other setters describe it */
-  st = cv_mesh_build(&s->mesh, p->a, p->b, &E, &xe, s->msg, sizeof s->msg);
-  if (st) goto cleanup;
-  s->mesh.t = NULL; /* spec0 keeps the caller's user mesh; restored at the end */
-  s->mesh.nbreak = 0; /* breakpoints are already boundaries of xe, and stay so */
-  for (s->rounds = 1; s->rounds <= MAX_ROUNDS; s->rounds++) {
-    cv_free(t);
-    /* room for the reference mesh too: E p elements (degree 1: 2E) >= E */
-    t = cv_malloc((size_t)((s->degree == 1 ? 2 : s->degree) * E + 1) * sizeof *t);
-    if (!t) {
-      st = CVAR_ENOMEM;
-      goto cleanup;
-    }
-    st = use_mesh(s, xe, E, t);
-    if (!st && s->rounds > 1) st = warm_start(s, p, f);
+  st = start_mesh(s, p, &E, &t, &deg);
+  if (st) {
+    if (st == CVAR_ENOMEM) cv_set_msg(s->msg, sizeof s->msg, "out of memory");
+    goto cleanup;
+  }
+  s->mesh.t = NULL; /* spec0 keeps the caller's mesh; restored at the end */
+  s->mesh.degrees = NULL;
+  s->mesh.nbreak = 0; /* breakpoints are already boundaries, and stay so */
+  for (s->rounds = 1;; s->rounds++) {
+    st = cv_solver_set_mesh_hp(s, E, t, deg);
+    if (!st && warm) st = cv_warm_start(s, p, warm == 1 ? f : s);
     if (st) goto cleanup;
     st = cv_solve_mesh(s, p);
-    it_work += s->iterations;
     cv_solver_set_start(s, 0, NULL);
+    iters += s->iterations;
     if (st) {
-      char why[320];
+      char why[400];
       memcpy(why, s->msg, sizeof why);
       why[sizeof why - 1] = '\0';
-      cv_set_msg(s->msg, sizeof s->msg, "adaptive refinement, round %d (%d elements): %s",
-                 s->rounds, E, why);
+      cv_set_msg(s->msg, sizeof s->msg, "%s, round %d (%d elements, %d nodes): %s",
+                 s->hp ? "automatic accuracy" : "adaptive refinement", s->rounds, E,
+                 s->disc.nodes, why);
       goto cleanup;
     }
-    /* the reference mesh: every node an element boundary (degree 1: halved) */
-    int pd = s->disc.p, Nc = s->disc.nodes, Ef = pd == 1 ? 2 * E : Nc - 1;
-    double *xf = cv_malloc((size_t)(Ef + 1) * sizeof *xf), *xc = cv_malloc((size_t)Nc * sizeof *xc);
-    if (!xf || !xc) {
-      cv_free(xf);
-      cv_free(xc);
-      st = CVAR_ENOMEM;
-      goto cleanup;
-    }
-    cv_disc_fill_nodes(&s->disc, xc);
-    for (int j = 0, k = 0; j < Nc; j++) {
-      xf[k++] = xc[j];
-      if (pd == 1 && j + 1 < Nc) xf[k++] = 0.5 * (xc[j] + xc[j + 1]);
-    }
-    cv_free(xc);
-    st = use_mesh(f, xf, Ef, t);
-    cv_free(xf);
-    if (!st) st = warm_start(f, p, s);
-    if (!st) st = cv_solve_mesh(f, p);
-    it_ref += f->iterations;
-    cv_solver_set_start(f, 0, NULL);
-    if (st) {
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "adaptive refinement, round %d: the solve on the reference mesh (%d "
-                 "elements) failed: %s",
-                 s->rounds, Ef, f->msg);
-      s->status = st;
-      goto cleanup;
-    }
-    /* indicators */
-    int N = s->disc.nodes, pdeg = s->disc.p;
-    cv_free(xn);
-    cv_free(yf);
     cv_free(eta);
-    xn = cv_malloc((size_t)N * sizeof *xn);
-    yf = cv_malloc((size_t)N * n * sizeof *yf);
-    eta = cv_calloc((size_t)E, sizeof *eta);
-    if (!xn || !yf || !eta) {
+    cv_free(sigma);
+    cv_free(where);
+    eta = cv_malloc((size_t)E * sizeof *eta);
+    sigma = cv_malloc((size_t)E * sizeof *sigma);
+    where = cv_malloc((size_t)E * sizeof *where);
+    if (!eta || !sigma || !where) {
       st = CVAR_ENOMEM;
       goto cleanup;
     }
-    cv_disc_fill_nodes(&s->disc, xn);
-    st = cv_solver_eval(f, N, xn, yf, NULL);
-    if (st) goto cleanup;
-    /* degree >= 2: the reference's error at these points is O((h/p)^2p), negligible;
-     * degree 1: Richardson for order 2 against the halved mesh */
-    double factor = pdeg == 1 ? 4.0 / 3.0 : 1.0, est = 0.0;
-    for (int e = 0; e < E; e++)
-      for (int l = 0; l <= pdeg; l++) {
-        long j = (long)e * pdeg + l;
-        for (int i = 0; i < n; i++) {
-          double d = factor * fabs(s->y[j * n + i] - yf[(size_t)i * N + j]);
-          if (!(d <= eta[e])) eta[e] = d; /* NaN propagates */
-        }
+    double est, floor_ = 0.0;
+    int done = 0;
+    char why[400];
+    st = cv_estimate_enriched(s, p, f, &est, NULL, &floor_, eta, sigma, where, why, sizeof why);
+    iters_ref += f->iterations;
+    if (st == CVAR_ENOMEM) goto cleanup;
+    if (st) {
+      /* HP-3: no bound from this mesh; halve every element and start the next round from
+       * this solution. Three such rounds in a row end the search. */
+      s->err_est = NAN;
+      if (++misses >= 3) {
+        cv_set_msg(s->msg, sizeof s->msg, "%s, round %d: %s",
+                   s->hp ? "automatic accuracy" : "adaptive refinement", s->rounds, why);
+        st = CVAR_EMAXITER;
+        goto cleanup;
       }
-    for (int e = 0; e < E; e++)
-      if (!(eta[e] <= est)) est = eta[e];
-    s->err_est = est;
-    if (!isfinite(est)) {
-      st = CVAR_ENONFINITE;
-      cv_set_msg(s->msg, sizeof s->msg, "adaptive refinement: the error estimate is not finite");
-      goto cleanup;
+      for (int e = 0; e < E; e++) eta[e] = 1.0, sigma[e] = 0.0, where[e] = 0.0;
+      est = INFINITY;
+      warm = 2;
+    } else {
+      misses = 0;
+      warm = 1;
+      s->err_est = est;
+      if (est <= tol) {
+        cv_set_msg(s->msg, sizeof s->msg,
+                   "converged on %d elements (%d nodes) after %d round%s, %ld Newton "
+                   "iterations in all (and %ld on the reference meshes); estimated max nodal "
+                   "error %.2g <= %.2g",
+                   E, s->disc.nodes, s->rounds, s->rounds == 1 ? "" : "s", iters, iters_ref,
+                   est, tol);
+        st = CVAR_OK;
+        done = 1; /* leaves after the progress report below */
+      }
+      if (est <= 0.5 * best) stalled = 0;
+      else stalled++;
+      if (est < best) best = est;
     }
     if (s->progress) {
       cv_progress info = {CVAR_PROGRESS_ROUND, s->iterations, s->gnorm, NAN, NAN, s->action,
-                          s->rounds, E, est};
+                          s->rounds, E, s->err_est};
       if (s->progress(&info, s->progress_user) != 0) {
         st = CVAR_ECANCELLED;
         cv_set_msg(s->msg, sizeof s->msg, "cancelled by the progress callback after adaptive "
-                   "round %d (%d elements, estimated max nodal error %.2g)", s->rounds, E, est);
+                   "round %d (%d elements, estimated max nodal error %.2g)", s->rounds, E,
+                   s->err_est);
         goto cleanup;
       }
     }
-    if (est <= tol) {
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "converged on an adapted mesh of %d elements after %d round%s, %d Newton "
-                 "iterations in all (and %d on the reference meshes); estimated max nodal "
-                 "error %.2g <= %.2g",
-                 E, s->rounds, s->rounds == 1 ? "" : "s", it_work, it_ref, est, tol);
-      st = CVAR_OK;
-      goto cleanup;
-    }
-    int marked = 0;
-    for (int e = 0; e < E; e++) marked += eta[e] > 0.25 * tol;
-    if (E + marked > s->adapt_max) {
+    if (done) goto cleanup; /* converged (above), reported to the callback */
+    double emax = 0.0;
+    for (int e = 0; e < E; e++) emax = fmax(emax, eta[e]);
+    /* mark: hp, the elements within a factor 4 of the largest surplus; --adapt, those above
+     * tol / 4 (AD-1), and always the largest */
+    double thresh = s->hp ? 0.25 * emax : fmin(0.25 * tol, emax);
+    if (stop_rule(s, est, best, floor_, stalled, next_size(&s->disc, eta, thresh, s->hp))) {
       st = CVAR_EMAXITER;
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "adaptive refinement reached the cap of %d elements after %d rounds with an "
-                 "estimated max nodal error of %.2g > %.2g; use a higher degree or a looser "
-                 "tolerance (or raise the cap: --max-elements, or the max_elements argument "
-                 "of cv_solver_set_adapt)",
-                 s->adapt_max, s->rounds, est, tol);
       goto cleanup;
     }
-    double *xn2 = cv_malloc((size_t)(E + marked + 1) * sizeof *xn2);
-    if (!xn2) {
-      st = CVAR_ENOMEM;
-      goto cleanup;
-    }
-    int k = 0;
-    for (int e = 0; e < E; e++) {
-      xn2[k++] = xe[e];
-      if (eta[e] > 0.25 * tol) xn2[k++] = 0.5 * (xe[e] + xe[e + 1]);
-    }
-    xn2[k] = xe[E];
-    cv_free(xe);
-    xe = xn2;
-    E = k;
+    cv_free(t);
+    cv_free(deg);
+    st = cv_hp_refine(&s->disc, eta, sigma, where, thresh, tol, s->hp, &E, &t, &deg);
+    if (st) goto cleanup;
   }
-  st = CVAR_EMAXITER;
-  cv_set_msg(s->msg, sizeof s->msg,
-             "adaptive refinement did not reach %.2g in %d rounds (estimated error %.2g)", tol,
-             MAX_ROUNDS, s->err_est);
 cleanup:
-  if (it_work > 0) s->iterations = it_work; /* the total over the rounds */
+  s->iterations = (int)(iters > 2000000000L ? 2000000000L : iters); /* all rounds */
   cv_free(s->mesh.t);
+  cv_free(s->mesh.degrees);
   s->mesh = spec0; /* the caller's mesh settings, for the next solve */
-  cv_free(xe);
+  s->degree = degree0;
   cv_free(t);
-  cv_free(xn);
-  cv_free(yf);
+  cv_free(deg);
   cv_free(eta);
+  cv_free(sigma);
+  cv_free(where);
   cv_solver_free(f);
   return st;
 }

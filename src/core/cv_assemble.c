@@ -47,11 +47,11 @@ static inline __attribute__((always_inline)) void
 fill_batch(const int N, const int P1, cv_assembler *as, const double *Y, const cv_rule *r,
            int e0, int ne) {
   const cv_disc *d = as->disc;
-  int p = P1 - 1, q = r->q, m = ne * q;
+  int q = r->q, m = ne * q;
   for (int el = 0; el < ne; el++) {
     int e = e0 + el;
     double x0 = d->xe[e], h = d->xe[e + 1] - x0, rh = 2.0 / h;
-    const double *Ye = Y + (size_t)e * p * N;
+    const double *Ye = Y + (size_t)cv_disc_enode(d, e) * N;
     for (int k = 0; k < q; k++) {
       int idx = el * q + k;
       const double *Bk = r->B + k * P1, *Dk = r->D + k * P1;
@@ -71,10 +71,11 @@ fill_batch(const int N, const int P1, cv_assembler *as, const double *Y, const c
   }
 }
 
-static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int e0, int ne) {
+static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int e0, int ne,
+                        int p) {
   const cv_disc *d = as->disc;
   if (d->n == 1) {
-    switch (d->p) {
+    switch (p) {
     case 1: fill_batch(1, 2, as, Y, r, e0, ne); return;
     case 2: fill_batch(1, 3, as, Y, r, e0, ne); return;
     case 3: fill_batch(1, 4, as, Y, r, e0, ne); return;
@@ -82,7 +83,7 @@ static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int
     default: break;
     }
   }
-  fill_batch(d->n, d->p + 1, as, Y, r, e0, ne);
+  fill_batch(d->n, p + 1, as, Y, r, e0, ne);
 }
 
 /* v[0 .. len-1] = NaN by block copies (a plain loop stays scalar at -O2: 12 stores per
@@ -127,7 +128,7 @@ batch_scalar(const int P1, const int Q, const cv_disc *d, const cv_rule *r, int 
              const cv_partials *o, double *restrict g, const int *restrict colptr,
              double *restrict Ax, double hscale, double *bad) {
   enum { MAXB = CV_MAX_QUAD * (CV_MAX_DEGREE + 1) };
-  const int q = Q ? Q : r->q, p = P1 - 1;
+  const int q = Q ? Q : r->q;
   double B[MAXB], D[MAXB], om[CV_MAX_QUAD];
   for (int k = 0; k < q * P1; k++) B[k] = r->B[k], D[k] = r->D[k];
   for (int k = 0; k < q; k++) om[k] = r->omega[k];
@@ -143,7 +144,7 @@ batch_scalar(const int P1, const int Q, const cv_disc *d, const cv_rule *r, int 
       int base = cv_disc_elem_first(d, e), st = d->stride;
       for (int l = 0; l < P1; l++) fl[l] = base + l * st;
     } else {
-      for (int l = 0; l < P1; l++) fl[l] = cv_disc_fidx(d, (long)e * p + l);
+      for (int l = 0; l < P1; l++) fl[l] = cv_disc_fidx(d, cv_disc_enode(d, e) + l);
     }
     double gacc[CV_MAX_DEGREE + 1], Kacc[(CV_MAX_DEGREE + 1) * (CV_MAX_DEGREE + 1)];
 #pragma GCC unroll 9
@@ -195,12 +196,12 @@ batch_scalar(const int P1, const int Q, const cv_disc *d, const cv_rule *r, int 
   return S;
 }
 
-static double batch_scalar_dispatch(const cv_disc *d, const cv_rule *r, int e0, int ne,
+static double batch_scalar_dispatch(const cv_disc *d, const cv_rule *r, int e0, int ne, int p,
                                     const cv_partials *o, double *g, const int *colptr,
                                     double *Ax, double hscale, double *bad) {
   /* constant points only up to degree 4: beyond, the fully unrolled kernel spills (p = 8
    * measured 1.5x slower than with the loop over points kept) */
-  int P1 = d->p + 1, same = r->q == P1 && P1 <= 5;
+  int P1 = p + 1, same = r->q == P1 && P1 <= 5;
   switch (P1) {
 #define CASE(c)                                                                            \
   case c:                                                                                  \
@@ -221,32 +222,40 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
                       double *S, double *g, const int *colptr, double *Ax, double hscale,
                       int overwrite) {
   const cv_disc *d = as->disc;
-  int n = d->n, p = d->p, P1 = p + 1, nl = P1 * n;
+  int n = d->n;
   unsigned need = CVAR_NEED_F | (g ? CVAR_NEED_GRAD : 0u) | (Ax ? CVAR_NEED_HESS : 0u);
-  double Ssum = 0.0, bad = 0.0, *K = as->K, *gl = as->K + nl * nl;
+  double Ssum = 0.0, bad = 0.0, *K = as->K;
   int *flp = as->fl;
   cv_status st;
   for (int e0 = 0, ne; e0 < d->E; e0 += ne) {
-    /* A batch: up to CV_BATCH points of elements sharing one rule; with per-element
-     * singular-end rules (Q-2) one element at a time. */
+    /* A batch: up to CV_BATCH points of elements sharing one rule (and degree, HP-1);
+     * with per-element singular-end rules (Q-2) one element at a time. */
     cv_rule rule = cv_disc_rule(d, e0), *r = &rule;
+    int p = cv_disc_edeg(d, e0), P1 = p + 1, nl = P1 * n;
     int q = r->q, nb = d->srule ? 1 : CV_BATCH / q;
     ne = d->E - e0 < nb ? d->E - e0 : nb;
+    if (d->pe)
+      for (int k = 1; k < ne; k++)
+        if (d->pe[e0 + k] != p) {
+          ne = k;
+          break;
+        }
     int m = ne * q;
-    fill_points(as, Y, r, e0, ne);
+    double *gl = as->K + nl * nl;
+    fill_points(as, Y, r, e0, ne, p);
     st = call_integrand(as, Fn, user, m, need);
     if (st) return st;
     if (overwrite) {
       /* Clear the columns of this batch's nodes not shared with the previous batch, just
        * before they are summed into: in cache, instead of a pass over all of g and Ax. */
-      long J0 = (long)e0 * p + (e0 > 0), J1 = (long)(e0 + ne) * p;
+      long J0 = cv_disc_enode(d, e0) + (e0 > 0), J1 = cv_disc_enode(d, e0 + ne);
       int cA = cv_disc_node_first(d, J0);
       int cB = J1 == d->nodes - 1 ? d->nu0 : cv_disc_node_first(d, J1 + 1);
       if (g) memset(g + cA, 0, (size_t)(cB - cA) * sizeof *g);
       if (Ax) memset(Ax + colptr[cA], 0, (size_t)(colptr[cB] - colptr[cA]) * sizeof *Ax);
     }
     if (n == 1) {
-      Ssum += batch_scalar_dispatch(d, r, e0, ne, &as->out, g, colptr, Ax, hscale, &bad);
+      Ssum += batch_scalar_dispatch(d, r, e0, ne, p, &as->out, g, colptr, Ax, hscale, &bad);
       continue; /* scattered by the kernel */
     }
     double *F = as->out.F;
@@ -262,7 +271,7 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
         for (int l = 0; l < P1; l++)
           for (int i = 0; i < n; i++) flp[l * n + i] = base + l * st + i;
       } else {
-        for (int a = 0; a < nl; a++) flp[a] = cv_disc_fidx(d, (long)e * p * n + a);
+        for (int a = 0; a < nl; a++) flp[a] = cv_disc_fidx(d, cv_disc_enode(d, e) * n + a);
       }
       if (Ax) memset(K, 0, (size_t)nl * nl * sizeof *K);
       if (g) memset(gl, 0, (size_t)nl * sizeof *gl);

@@ -13,24 +13,66 @@ void cv_disc_free(cv_disc *d) {
   cv_free(d->mass);
   cv_free(d->imass);
   cv_free(d->srule);
+  cv_free(d->pe);
+  cv_free(d->en);
+  cv_free(d->refs);
   memset(d, 0, sizeof *d);
 }
 
 void cv_disc_fill_nodes(const cv_disc *d, double *x) {
   for (long e = 0; e < d->E; e++) {
     double h = d->xe[e + 1] - d->xe[e];
-    x[e * d->p] = d->xe[e];
-    for (int l = 1; l < d->p; l++) x[e * d->p + l] = d->xe[e] + 0.5 * (d->ref.xi[l] + 1.0) * h;
+    long j0 = cv_disc_enode(d, e);
+    int pe = cv_disc_edeg(d, e);
+    const double *xi = cv_disc_eref(d, e)->xi;
+    x[j0] = d->xe[e];
+    for (int l = 1; l < pe; l++) x[j0 + l] = d->xe[e] + 0.5 * (xi[l] + 1.0) * h;
   }
   x[d->nodes - 1] = d->xe[d->E];
 }
 
+long cv_disc_node_elem(const cv_disc *d, long j) {
+  if (j >= d->nodes - 1) return d->E - 1;
+  if (!d->en) return j / d->p;
+  long lo = 0, hi = d->E; /* en[lo] <= j < en[hi] */
+  while (hi - lo > 1) {
+    long mid = (lo + hi) / 2;
+    if (d->en[mid] <= j) lo = mid;
+    else hi = mid;
+  }
+  return lo;
+}
+
 double cv_disc_node_x(const cv_disc *d, long j) {
   if (j >= d->nodes - 1) return d->xe[d->E];
-  long e = j / d->p;
-  int l = (int)(j - e * d->p);
+  long e = cv_disc_node_elem(d, j);
+  int l = (int)(j - cv_disc_enode(d, e));
   double h = d->xe[e + 1] - d->xe[e];
-  return l == 0 ? d->xe[e] : d->xe[e] + 0.5 * (d->ref.xi[l] + 1.0) * h;
+  return l == 0 ? d->xe[e] : d->xe[e] + 0.5 * (cv_disc_eref(d, e)->xi[l] + 1.0) * h;
+}
+
+/* Variable degrees (HP-1): per-element degrees from the mesh spec, first nodes, and one
+ * reference element per degree. Sets d->p to the largest degree and d->nodes. */
+static cv_status disc_init_hp(cv_disc *d, const cv_meshspec *m, int nq) {
+  d->pe = cv_malloc((size_t)d->E * sizeof *d->pe);
+  d->en = cv_malloc((size_t)(d->E + 1) * sizeof *d->en);
+  d->refs = cv_malloc((CV_MAX_DEGREE + 1) * sizeof *d->refs);
+  if (!d->pe || !d->en || !d->refs) return CVAR_ENOMEM;
+  cv_mesh_degrees(m, d->a, d->b, d->E, d->xe, d->pe);
+  int used[CV_MAX_DEGREE + 1] = {0};
+  long j = 0;
+  d->p = 1;
+  for (long e = 0; e < d->E; e++) {
+    d->en[e] = j;
+    j += d->pe[e];
+    used[d->pe[e]] = 1;
+    if (d->pe[e] > d->p) d->p = d->pe[e];
+  }
+  d->en[d->E] = j;
+  d->nodes = j > 2000000000L ? 2000000000 : (int)j + 1;
+  for (int k = 1; k <= CV_MAX_DEGREE; k++)
+    if (used[k]) cv_refelem_init(&d->refs[k], k, nq ? nq : k + 1);
+  return CVAR_OK;
 }
 
 /* Unknowns are node-major (theory E-2); fixed end values are removed, so free indices are
@@ -47,6 +89,13 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
   d->a = p->a;
   d->b = p->b;
   d->nodes = d->E * d->p + 1;
+  if (s->mesh.degrees) {
+    st = disc_init_hp(d, &s->mesh, s->nq);
+    if (st) {
+      cv_disc_free(d);
+      return st;
+    }
+  }
   if ((double)d->nodes * n > 2.0e9) {
     cv_set_msg(msg, len, "%d elements of degree %d with %d unknowns exceed 2e9 unknowns",
                d->E, d->p, n);
@@ -88,9 +137,10 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
    * node's multipliers share it, integral multipliers get the interval length. */
   for (int e = 0; e < d->E; e++) {
     double h = d->xe[e + 1] - d->xe[e];
-    for (int l = 0; l <= d->p; l++) {
-      long node = (long)e * d->p + l;
-      double m = 0.5 * h * d->ref.wl[l];
+    const double *wl = cv_disc_eref(d, e)->wl;
+    for (int l = 0, pe = cv_disc_edeg(d, e); l <= pe; l++) {
+      long node = cv_disc_enode(d, e) + l;
+      double m = 0.5 * h * wl[l];
       if (node > 0 && node < d->nodes - 1) { /* interior: the node's block, y then lambda */
         double *blk = d->mass + cv_disc_node_first(d, node);
         for (int t = 0; t < d->stride; t++) blk[t] += m;
@@ -116,18 +166,26 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
   return CVAR_OK;
 }
 
+/* Per-element stride of the singular-end rules: room for the largest degree. */
+static size_t srule_stride(const cv_disc *d) {
+  return (size_t)d->ref.qs * (2 + 2 * (d->p + 1));
+}
+
 cv_rule cv_disc_rule(const cv_disc *d, long e) {
-  const cv_refelem *r = &d->ref;
+  const cv_refelem *r = cv_disc_eref(d, e);
   if (d->srule) {
-    int qs = r->qs, P1 = d->p + 1;
-    const double *base = d->srule + (size_t)e * qs * (2 + 2 * P1);
+    int qs = r->qs, P1 = r->p + 1;
+    const double *base = d->srule + (size_t)e * srule_stride(d);
     return (cv_rule){qs, base, base + qs, base + 2 * qs, base + 2 * qs + qs * P1};
   }
   return (cv_rule){r->q, r->tau, r->omega, r->B, r->D};
 }
 
 long cv_disc_num_qpoints(const cv_disc *d) {
-  return (long)d->E * (d->srule ? d->ref.qs : d->ref.q);
+  if (!d->pe) return (long)d->E * (d->srule ? d->ref.qs : d->ref.q);
+  long total = 0;
+  for (long e = 0; e < d->E; e++) total += d->srule ? d->refs[d->pe[e]].qs : d->refs[d->pe[e]].q;
+  return total;
 }
 
 /* Rules for an integrand singular at an end c (theory Q-2): on every element, Gauss in
@@ -137,17 +195,18 @@ long cv_disc_num_qpoints(const cv_disc *d) {
  * Gauss rule on the second element still let the discrete brachistochrone exploit it).
  * With both ends singular each element uses the nearer one. */
 cv_status cv_disc_build_singular_rules(cv_disc *d) {
-  const cv_refelem *r = &d->ref;
-  int qs = r->qs, P1 = d->p + 1;
-  size_t per = (size_t)qs * (2 + 2 * P1);
+  size_t per = srule_stride(d);
   double t[CV_MAX_QUAD], w[CV_MAX_QUAD];
+  int qlast = 0;
   cv_free(d->srule);
   d->srule = NULL;
   if (!d->sing_a && !d->sing_b) return CVAR_OK;
   d->srule = cv_malloc((size_t)d->E * per * sizeof *d->srule);
   if (!d->srule) return CVAR_ENOMEM;
-  cv_gauss_legendre(qs, t, w);
   for (long e = 0; e < d->E; e++) {
+    const cv_refelem *r = cv_disc_eref(d, e);
+    int qs = r->qs, P1 = r->p + 1;
+    if (qs != qlast) cv_gauss_legendre(qs, t, w), qlast = qs;
     double x0 = d->xe[e], x1 = d->xe[e + 1], h = x1 - x0, J = 0.5 * h;
     int at_a = d->sing_a && (!d->sing_b || x0 + x1 <= d->a + d->b);
     double c = at_a ? d->a : d->b;
@@ -158,7 +217,7 @@ cv_status cv_disc_build_singular_rules(cv_disc *d) {
       double x = at_a ? c + u * u : c - u * u;
       tau[k] = 2.0 * (x - x0) / h - 1.0;
       om[k] = wu * 2.0 * u / J; /* weight in x, divided by the element's J = h/2 */
-      cv_lagrange(d->p, r->xi, tau[k], B + k * P1, D + k * P1);
+      cv_lagrange(r->p, r->xi, tau[k], B + k * P1, D + k * P1);
     }
   }
   return CVAR_OK;
@@ -173,7 +232,9 @@ long cv_disc_pattern(const cv_disc *d, int *colptr, int *gof) {
   if (colptr) colptr[0] = 0;
   long since = 0; /* nodes since the last element boundary, without % */
   for (long J = 0, e = 0; J < d->nodes; J++) {
-    if (J > 1 && ++since == p) e++, since = 0; /* e = first element containing node J */
+    /* e = first element containing node J */
+    if (d->en) e += J > 1 && J - 1 == d->en[e + 1];
+    else if (J > 1 && ++since == p) e++, since = 0;
     long r0 = cv_disc_elem_first(d, e);
     /* the node's unknowns in increasing order: y components, then multipliers */
     for (int t = 0; t < n + nc; t++) {

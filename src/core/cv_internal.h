@@ -13,6 +13,8 @@
 #define CV_MAX_DEGREE 8
 #define CV_MAX_QUAD 32
 #define CV_PI 3.14159265358979323846
+/* The round-off floor of an error estimate, in units of eps times the values' size (HP-2). */
+#define CV_ROUNDOFF_ULPS 256.0
 
 
 typedef struct {
@@ -83,17 +85,22 @@ typedef struct {
   double *t;   /* user mesh on [0,1], elements+1 */
   int nbreak;
   double *breaks;
+  int *degrees; /* user mesh only: degree of each of its elements (hp), or NULL */
 } cv_meshspec;
 /* Element boundaries on [a, b] from a spec; *xe is allocated (E+1 entries). */
 cv_status cv_mesh_build(const cv_meshspec *m, double a, double b, int *E, double **xe,
                         char *msg, size_t len);
+/* Degrees of the E elements xe[0..E] built from m (m->degrees set): an element takes the
+ * degree of the user element containing its midpoint (breakpoints may have split some). */
+void cv_mesh_degrees(const cv_meshspec *m, double a, double b, int E, const double *xe,
+                     int *pe);
 
 /* ---- discretisation of one solve (cv_disc.c) ---- */
 /* Unknowns of the discrete problem, node-major (theory E-2, C-3): at each node its free
  * components of y, then (with pointwise constraints, at nodes having a free component) its
  * nc multipliers; after the last node the ni integral multipliers. */
 typedef struct {
-  int n, p, E, nodes, ndof, nfree;
+  int n, p, E, nodes, ndof, nfree; /* p: the (largest) element degree */
   int nc, ni, stride, off0;   /* stride = n + nc; off0 = unknowns at node 0 */
   int nfree0, nfree1;         /* free y components at node 0 / at the last node */
   double a, b;
@@ -105,7 +112,20 @@ typedef struct {
   double *imass;       /* 1 / mass */
   int sing_a, sing_b;  /* integrand singular at that end: rules Q-2 on every element */
   double *srule;       /* per-element rules (tau, omega, B, D) when singular, else NULL */
+  /* Variable degree (hp, theory HP-1): NULL when every element has degree p. */
+  int *pe;             /* degree of each element */
+  long *en;            /* first node of each element, E+1 entries (en[E] = nodes - 1) */
+  cv_refelem *refs;    /* reference element of each degree, refs[k] for k = 1..p */
 } cv_disc;
+
+/* First node, degree and reference element of element e (constant or hp). */
+static inline long cv_disc_enode(const cv_disc *d, long e) { return d->en ? d->en[e] : e * d->p; }
+static inline int cv_disc_edeg(const cv_disc *d, long e) { return d->pe ? d->pe[e] : d->p; }
+static inline const cv_refelem *cv_disc_eref(const cv_disc *d, long e) {
+  return d->pe ? &d->refs[d->pe[e]] : &d->ref;
+}
+/* The element containing node j (the left one at a shared boundary node). */
+long cv_disc_node_elem(const cv_disc *d, long j);
 
 /* Build the per-element singular-end rules after sing_a/sing_b are set. */
 cv_status cv_disc_build_singular_rules(cv_disc *d);
@@ -131,7 +151,7 @@ static inline int cv_disc_node_first(const cv_disc *d, long j) {
 }
 /* first unknown of element e (its first node's first unknown) */
 static inline int cv_disc_elem_first(const cv_disc *d, long e) {
-  return e == 0 ? 0 : (int)(d->off0 + (e * d->p - 1) * d->stride);
+  return e == 0 ? 0 : (int)(d->off0 + (cv_disc_enode(d, e) - 1) * d->stride);
 }
 
 /* Sparsity pattern of the Hessian / KKT matrix (E-2, C-3): colptr (nfree + 1; may be NULL
@@ -245,6 +265,7 @@ struct cv_solver {
   double t_assemble, t_factor; /* seconds in assembly / LDL^T (bench/; from 512 unknowns) */
   double adapt_tol, err_est;   /* adaptive refinement (cv_adapt.c) */
   int adapt_max, rounds;
+  int hp;                      /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
   int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
   char note[320];              /* what the solver decided on its own, prefixed to msg */
   cv_progress_fn progress;     /* cv_solver_set_progress; NULL: none */
@@ -275,6 +296,22 @@ int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double 
 /* The paths found by cv_solve_all (cv_deflation.c); NULL is a no-op. */
 void cv_pathset_free(struct cv_pathset *ps);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
+/* ---- error estimate and hp decisions (cv_estimate.c, cv_hp.c) ---- */
+/* Start s (mesh set) from `from` interpolated at its nodes. */
+cv_status cv_warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from);
+/* HP-2, HP-3: the estimate of s's max nodal error from a warm-started solve into f on the
+ * enriched mesh (est_vertex: at the element boundaries; floor_out: its round-off part; both
+ * may be NULL); with eta, sigma, where (E each, all or none) the indicators of HP-4. */
+cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solver *f,
+                               double *est, double *est_vertex, double *floor_out,
+                               double *eta, double *sigma, double *where,
+                               char *msg, size_t len);
+/* HP-4, HP-5: the next mesh (on [0, 1], *t with *Enew + 1 entries, *deg with *Enew) from
+ * d with the elements eta[e] >= thresh refined (hp = 0: bisected at their degree); target:
+ * the tolerance, for the degree a smooth element is raised to. */
+cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
+                       const double *where, double thresh, double target, int hp, int *Enew,
+                       double **t, int **deg);
 double cv_now(void);
 
 cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y);

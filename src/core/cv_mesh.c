@@ -107,3 +107,13 @@ cleanup:
   *xout = xe;
   return CVAR_OK;
 }
+
+void cv_mesh_degrees(const cv_meshspec *m, double a, double b, int E, const double *xe,
+                     int *pe) {
+  int U = m->elements, u = 0;
+  for (int e = 0; e < E; e++) {
+    double mid = (0.5 * (xe[e] + xe[e + 1]) - a) / (b - a);
+    while (u < U - 1 && m->t[u + 1] <= mid) u++;
+    pe[e] = m->degrees[u];
+  }
+}

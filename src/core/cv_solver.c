@@ -38,6 +38,7 @@ void cv_solver_free(cv_solver *s) {
   if (!s) return;
   cv_solver_drop_factor(s);
   cv_free(s->mesh.t);
+  cv_free(s->mesh.degrees);
   cv_free(s->mesh.breaks);
   cv_free(s->start);
   cv_free(s->y);
@@ -49,7 +50,9 @@ void cv_solver_free(cv_solver *s) {
 
 static void mesh_reset(cv_solver *s, int kind, int elements) {
   cv_free(s->mesh.t);
+  cv_free(s->mesh.degrees);
   s->mesh.t = NULL;
+  s->mesh.degrees = NULL;
   s->mesh.kind = kind;
   s->mesh.elements = elements;
 }
@@ -63,6 +66,8 @@ cv_status cv_solver_set_elements(cv_solver *s, int elements) {
 cv_status cv_solver_set_degree(cv_solver *s, int degree) {
   if (!s || degree < 1 || degree > CV_MAX_DEGREE) return CVAR_EINVAL;
   s->degree = degree;
+  cv_free(s->mesh.degrees); /* every element: the hp degrees are dropped */
+  s->mesh.degrees = NULL;
   return CVAR_OK;
 }
 
@@ -91,6 +96,27 @@ cv_status cv_solver_set_mesh(cv_solver *s, int elements, const double *t) {
   memcpy(c, t, (size_t)(elements + 1) * sizeof *c);
   mesh_reset(s, CV_MESH_USER, elements);
   s->mesh.t = c;
+  return CVAR_OK;
+}
+
+cv_status cv_solver_set_mesh_hp(cv_solver *s, int elements, const double *t,
+                                const int *degrees) {
+  if (!s || elements < 1 || !degrees) return CVAR_EINVAL;
+  int pmax = 1;
+  for (int e = 0; e < elements; e++) {
+    if (degrees[e] < 1 || degrees[e] > CV_MAX_DEGREE) return CVAR_EINVAL;
+    if (degrees[e] > pmax) pmax = degrees[e];
+  }
+  int *c = cv_malloc((size_t)elements * sizeof *c);
+  if (!c) return CVAR_ENOMEM;
+  cv_status st = cv_solver_set_mesh(s, elements, t);
+  if (st) {
+    cv_free(c);
+    return st;
+  }
+  memcpy(c, degrees, (size_t)elements * sizeof *c);
+  s->mesh.degrees = c;
+  s->degree = pmax;
   return CVAR_OK;
 }
 
@@ -179,6 +205,12 @@ const char *cv_solver_last_error(const cv_solver *s) {
 int cv_solver_get_num_nodes(const cv_solver *s) { return s && s->have ? s->disc.nodes : 0; }
 int cv_solver_get_num_elements(const cv_solver *s) { return s && s->have ? s->disc.E : 0; }
 int cv_solver_get_degree(const cv_solver *s) { return s && s->have ? s->disc.p : 0; }
+int cv_solver_get_degrees(const cv_solver *s, int *degrees) {
+  if (!s || !s->have) return 0;
+  if (degrees)
+    for (long e = 0; e < s->disc.E; e++) degrees[e] = cv_disc_edeg(&s->disc, e);
+  return s->disc.E;
+}
 int cv_solver_get_num_free(const cv_solver *s) {
   if (!s || !s->have) return 0;
   const cv_disc *d = &s->disc;
@@ -215,9 +247,9 @@ int cv_solver_get_num_qpoints(const cv_solver *s) {
 static void eval_local(const cv_solver *s, long e, const double *phi,
                        const double *dphi, double *yv, double *dv) {
   const cv_disc *d = &s->disc;
-  int n = d->n, P1 = d->p + 1;
+  int n = d->n, P1 = cv_disc_edeg(d, e) + 1;
   double rh = 2.0 / (d->xe[e + 1] - d->xe[e]);
-  const double *Ye = s->y + (size_t)e * d->p * n;
+  const double *Ye = s->y + (size_t)cv_disc_enode(d, e) * n;
   for (int i = 0; i < n; i++) {
     double a = 0.0, b = 0.0;
     for (int l = 0; l < P1; l++) {
@@ -234,7 +266,7 @@ cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double
   if (!s) return CVAR_EINVAL;
   if (!s->have) return CVAR_ESTATE;
   const cv_disc *d = &s->disc;
-  int n = d->n, P1 = d->p + 1;
+  int n = d->n;
   long nq = cv_disc_num_qpoints(d), idx = 0;
   double yv[64], dv[64];
   double *yb = yv, *db = dv, *big = NULL;
@@ -247,6 +279,7 @@ cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double
   for (long e = 0; e < d->E; e++) {
     double h = d->xe[e + 1] - d->xe[e];
     cv_rule R = cv_disc_rule(d, e), *r = &R;
+    int P1 = cv_disc_edeg(d, e) + 1;
     for (int k = 0; k < r->q; k++, idx++) {
       if (x) x[idx] = d->xe[e] + 0.5 * (r->tau[k] + 1.0) * h;
       if (w) w[idx] = 0.5 * h * r->omega[k];
@@ -283,7 +316,7 @@ cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y, 
       else hi = mid;
     }
     double h = d->xe[lo + 1] - d->xe[lo], t = 2.0 * (x[k] - d->xe[lo]) / h - 1.0;
-    cv_lagrange(d->p, d->ref.xi, t, phi, dphi);
+    cv_lagrange(cv_disc_edeg(d, lo), cv_disc_eref(d, lo)->xi, t, phi, dphi);
     eval_local(s, lo, phi, dphi, buf, buf + n);
     for (int i = 0; i < n; i++) {
       y[i * m + k] = buf[i];
@@ -328,13 +361,6 @@ cv_status cv_solver_get_multiplier(const cv_solver *s, int k, double *mu) {
   if (!s->have) return CVAR_ESTATE;
   if (k < 0 || k >= s->disc.ni) return CVAR_EINVAL;
   *mu = s->mult[(size_t)s->disc.nodes * s->disc.nc + k];
-  return CVAR_OK;
-}
-
-cv_status cv_solver_set_adapt(cv_solver *s, double tol, int max_elements) {
-  if (!s || !(tol >= 0) || !isfinite(tol) || max_elements < 1) return CVAR_EINVAL;
-  s->adapt_tol = tol;
-  s->adapt_max = max_elements;
   return CVAR_OK;
 }
 

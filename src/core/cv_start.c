@@ -59,9 +59,10 @@ cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, d
     double rl = 1.0 / (d->b - d->a);
     for (long e = 0; e < d->E; e++) {
       double x0 = d->xe[e], h = d->xe[e + 1] - x0;
-      for (int l = 0; l < d->p; l++) {
-        double x = l ? x0 + 0.5 * (d->ref.xi[l] + 1.0) * h : x0;
-        straight_line(p, (x - d->a) * rl, Y + (e * d->p + l) * n);
+      const double *xi = cv_disc_eref(d, e)->xi;
+      for (int l = 0, pe = cv_disc_edeg(d, e); l < pe; l++) {
+        double x = l ? x0 + 0.5 * (xi[l] + 1.0) * h : x0;
+        straight_line(p, (x - d->a) * rl, Y + (cv_disc_enode(d, e) + l) * n);
       }
     }
     straight_line(p, 1.0, Y + (d->nodes - 1) * n);
@@ -100,10 +101,11 @@ static void detect_singular_ends(const cv_problem *p, cv_disc *d, const double *
     long node = end ? d->nodes - 1 : 0;
     long e = end ? d->E - 1 : 0;
     double h = d->xe[e + 1] - d->xe[e], phi[CV_MAX_DEGREE + 1], dphi[CV_MAX_DEGREE + 1];
-    cv_lagrange(d->p, d->ref.xi, end ? 1.0 : -1.0, phi, dphi);
+    int pe = cv_disc_edeg(d, e);
+    cv_lagrange(pe, cv_disc_eref(d, e)->xi, end ? 1.0 : -1.0, phi, dphi);
     for (int i = 0; i < n; i++) {
       double dv = 0.0;
-      for (int l = 0; l <= d->p; l++) dv += Y[(e * d->p + l) * n + i] * dphi[l];
+      for (int l = 0; l <= pe; l++) dv += Y[(cv_disc_enode(d, e) + l) * n + i] * dphi[l];
       buf[i] = Y[node * n + i];
       buf[n + i] = dv * 2.0 / h;
     }
@@ -153,10 +155,10 @@ cv_status cv_start_setup(cv_solver *s, const cv_problem *p) {
  * basis tables). buf: q (2 n + 2) doubles. Returns 0 when F fails or is not finite. */
 static int element_integral(const cv_problem *p, const cv_disc *d, const double *Y, long e,
                             const cv_rule *r, double *buf, double *S) {
-  int n = p->n, P1 = d->p + 1, q = r->q;
+  int n = p->n, P1 = cv_disc_edeg(d, e) + 1, q = r->q;
   double x0 = d->xe[e], h = d->xe[e + 1] - x0, *x = buf, *y = x + q, *dy = y + (size_t)n * q;
   double *F = dy + (size_t)n * q;
-  const double *Ye = Y + (size_t)e * d->p * n;
+  const double *Ye = Y + (size_t)cv_disc_enode(d, e) * n;
   for (int k = 0; k < q; k++) {
     x[k] = x0 + 0.5 * (r->tau[k] + 1.0) * h;
     for (int i = 0; i < n; i++) {
@@ -182,13 +184,14 @@ static int element_integral(const cv_problem *p, const cv_disc *d, const double 
  * element's integral under its own rule. */
 static double rule_gap(const cv_problem *p, const cv_disc *d, const double *Y, long e, int end,
                        double *buf, double *own) {
-  int qs = d->ref.qs, P1 = d->p + 1;
+  const cv_refelem *re = cv_disc_eref(d, e); /* the element's own degree (HP-1) */
+  int qs = re->qs, P1 = re->p + 1;
   double S0, S1;
   cv_rule r0 = cv_disc_rule(d, e), r1;
   double tau[CV_MAX_QUAD], om[CV_MAX_QUAD];
   double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
   if (e == (end ? d->E - 1 : 0)) {
-    r1 = cv_end_rule(d->p, qs, end); /* the element touching the end: fixed tables */
+    r1 = cv_end_rule(re->p, qs, end); /* the element touching the end: fixed tables */
   } else {
     double t[CV_MAX_QUAD], w[CV_MAX_QUAD];
     cv_gauss_legendre(qs, t, w);
@@ -198,7 +201,7 @@ static double rule_gap(const cv_problem *p, const cv_disc *d, const double *Y, l
       double u = u0 + (u1 - u0) * 0.5 * (t[k] + 1.0), x = end ? c - u * u : c + u * u;
       tau[k] = 2.0 * (x - x0) / h - 1.0;
       om[k] = 0.5 * fabs(u1 - u0) * w[k] * 2.0 * u / J;
-      cv_lagrange(d->p, d->ref.xi, tau[k], B + k * P1, D + k * P1);
+      cv_lagrange(re->p, re->xi, tau[k], B + k * P1, D + k * P1);
     }
     r1 = (cv_rule){qs, tau, om, B, D};
   }

@@ -121,14 +121,16 @@ static ex_id parse_cond(parser *p) {
   return built(p, ex_binary(p->d, op, a, b));
 }
 
-static ex_id parse_call(parser *p, const ex_function *f, size_t at) {
-  ex_id args[3];
+/* The arguments of a call, from its '(' at p->pos: up to 3 sums (the first a condition
+ * when cond_first), separated by ',' and closed by ')'. Returns their number, -1 on a
+ * failure (message set), or -2 when a fourth would begin (args holds three, p->pos is
+ * after the third's ','). */
+static int parse_args(parser *p, const char *name, int cond_first, ex_id *args) {
   int n = 0;
   p->pos++; /* '(' */
   for (;;) {
-    if (n == 3) return fail(p, at, "'%s' takes %d argument%s", f->name, f->nargs,
-                            f->nargs == 1 ? "" : "s");
-    args[n] = (f->op == EX_IF && n == 0) ? parse_cond(p) : parse_sum(p);
+    if (n == 3) return -2;
+    args[n] = (cond_first && n == 0) ? parse_cond(p) : parse_sum(p);
     if (args[n] < 0) return -1;
     n++;
     skip_ws(p);
@@ -138,12 +140,22 @@ static ex_id parse_call(parser *p, const ex_function *f, size_t at) {
     }
     if (p->s[p->pos] == ')') {
       p->pos++;
-      break;
+      return n;
     }
     char buf[16];
-    return fail(p, p->pos, "expected ',' or ')' in the arguments of '%s' but found %s",
-                f->name, found(p, buf, sizeof buf));
+    fail(p, p->pos, "expected ',' or ')' in the arguments of '%s' but found %s", name,
+         found(p, buf, sizeof buf));
+    return -1;
   }
+}
+
+static ex_id parse_call(parser *p, const ex_function *f, size_t at) {
+  ex_id args[3];
+  int n = parse_args(p, f->name, f->op == EX_IF, args);
+  if (n == -2)
+    return fail(p, at, "'%s' takes %d argument%s", f->name, f->nargs,
+                f->nargs == 1 ? "" : "s");
+  if (n < 0) return -1;
   if (n != f->nargs)
     return fail(p, at, "'%s' takes %d argument%s, not %d", f->name, f->nargs,
                 f->nargs == 1 ? "" : "s", n);
@@ -177,26 +189,9 @@ static ex_id parse_table_call(parser *p, int index, const char *name, size_t at)
       return fail(p, at, "'%s' is a table: write %s(...)", name, name);
   }
   ex_id args[3];
-  int n = 0;
-  p->pos++; /* '(' */
-  for (;;) {
-    if (n == 3) break;
-    args[n] = parse_sum(p);
-    if (args[n] < 0) return -1;
-    n++;
-    skip_ws(p);
-    if (p->s[p->pos] == ',') {
-      p->pos++;
-      continue;
-    }
-    if (p->s[p->pos] == ')') {
-      p->pos++;
-      break;
-    }
-    char buf[16];
-    return fail(p, p->pos, "expected ',' or ')' in the arguments of '%s' but found %s", name,
-                found(p, buf, sizeof buf));
-  }
+  int n = parse_args(p, name, 0, args);
+  if (n == -2) n = 3; /* a fourth argument begins: refused below */
+  if (n < 0) return -1;
   if (n != dim || (n == 3 && p->s[p->pos - 1] != ')'))
     return fail(p, at, "table '%s' has %d coordinate%s, so it takes %d argument%s%s", name,
                 dim, dim == 1 ? "" : "s", dim, dim == 1 ? "" : "s",

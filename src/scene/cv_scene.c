@@ -213,8 +213,9 @@ cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *s, cv_sta
     goto done;
   }
   r = cv_calloc(1, sizeof *r);
+  int rounds = isfinite(cv_solver_get_error_estimate(s)); /* --adapt or --tol: 1, 2 */
   if (!r || cli_report_build(&cr, sc->s, p, s, cv_solver_get_status(s),
-                             isfinite(cv_solver_get_error_estimate(s))) < 0 ||
+                             rounds && sc->s->tol > 0 ? 2 : rounds) < 0 ||
       !(r->json = cli_report_json_text(&cr))) {
     cv_report_free(r);
     r = NULL;

@@ -76,6 +76,12 @@ typedef struct scene {
   double *breakpoints; /* sorted, inside (a, b) */
   double adapt;        /* 0: off */
   int adapt_line;
+  double tol;          /* [mesh] tol: automatic accuracy (hp), 0: off */
+  int tol_line;
+  int elements_line, degree_line; /* 0 when not given (--tol then picks its start) */
+#define SCENE_TOL_MAX_NODES 1000000 /* cap of --tol / [mesh] tol on the nodes */
+#define SCENE_TOL_START_ELEMENTS 4  /* --tol's starting mesh when the scene gives none */
+#define SCENE_TOL_START_DEGREE 4
   double grading;      /* 0: uniform; else the exponent k >= 1 (an addition, docs/scenes.md) */
   int graded_end;      /* CVAR_GRADE_A, CVAR_GRADE_B or CVAR_GRADE_BOTH */
 

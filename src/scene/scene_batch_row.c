@@ -355,6 +355,16 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals,
   r->status = st;
   r->iterations = cv_solver_get_num_iterations(w->sv);
   int morse = -1, nfree = 0, degenerate = 0;
+  double xs, alpha;
+  if (st == CVAR_OK && scene_interior_singularity(w->inst, w->sv, &xs, &alpha) == 1) {
+    /* as `solve` does: a finite discrete action of an infinite one (theory (SG-1)) */
+    r->status = CVAR_ENONFINITE;
+    snprintf(r->message, sizeof r->message, "the integrand is singular at %s = %.6g inside "
+             "the interval: along the path |F| grows like |%s - %.6g|^(-%.2f), so the "
+             "action is infinite and the discrete answer (which changes with the mesh) is "
+             "no stationary path", w->inst->variable, xs, w->inst->variable, xs, alpha);
+    goto done;
+  }
   if (st == CVAR_OK) {
     r->has_result = 1;
     r->action = cv_solver_get_action(w->sv);

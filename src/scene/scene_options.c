@@ -77,14 +77,14 @@ static int load_breakpoints(sc_loader *L, const sc_entry *e)
 
 int sc_load_mesh(sc_loader *L)
 {
-  static const char *const keys[] = {"elements", "degree", "breakpoints", "adapt",
+  static const char *const keys[] = {"elements", "degree", "breakpoints", "adapt", "tol",
                                      "grading", "grading_at", NULL};
   scene *s = L->s;
   s->elements = 100;
   s->degree = 1;
   s->graded_end = CVAR_GRADE_A;
   if (sc_check_keys(L, SEC_MESH, keys,
-                 "elements, degree, breakpoints, adapt, grading, grading_at") < 0)
+                 "elements, degree, breakpoints, adapt, tol, grading, grading_at") < 0)
     return -1;
   for (int i = 0; i < L->raw.ne[SEC_MESH]; i++) {
     const sc_entry *e = &L->raw.e[SEC_MESH][i];
@@ -93,9 +93,11 @@ int sc_load_mesh(sc_loader *L)
       /* INT_MAX / 9: nodes = elements * degree + 1 must stay an int at degree 8. */
       if (parse_count(L, e, 1, INT_MAX / 9, &s->elements) < 0)
         return -1;
+      s->elements_line = e->line;
     } else if (strcmp(k, "degree") == 0) {
       if (parse_count(L, e, 1, 8, &s->degree) < 0)
         return -1;
+      s->degree_line = e->line;
     } else if (strcmp(k, "breakpoints") == 0) {
       if (load_breakpoints(L, e) < 0)
         return -1;
@@ -108,6 +110,15 @@ int sc_load_mesh(sc_loader *L)
         return -1;
       }
       s->adapt_line = e->line;
+    } else if (strcmp(k, "tol") == 0) {
+      if (sc_parse_const(L, e, 0, e->value, "tol", &s->tol) < 0)
+        return -1;
+      if (!(s->tol > 0)) {
+        sc_err(L->err, L->errlen, L->file, e->line,
+               "tol is the target max nodal error and must be > 0, got %g", s->tol);
+        return -1;
+      }
+      s->tol_line = e->line;
     } else if (strcmp(k, "grading") == 0) {
       if (sc_parse_const(L, e, 0, e->value, "grading", &s->grading) < 0)
         return -1;
@@ -130,6 +141,12 @@ int sc_load_mesh(sc_loader *L)
         return -1;
       }
     }
+  }
+  if (s->tol > 0 && s->adapt > 0) {
+    sc_err(L->err, L->errlen, L->file, s->tol_line > s->adapt_line ? s->tol_line : s->adapt_line,
+           "tol and adapt cannot both be given (tol chooses the mesh and the degrees, adapt "
+           "the mesh at one degree)");
+    return -1;
   }
   return 0;
 }

@@ -20,7 +20,7 @@ static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *m
   int np = s->params_as_inputs ? s->nparams : 0;
   ex_integrand *g = ex_integrand_new_params(s->dag, s->n, np, e, max_need, msg, len);
   if (g && np) {
-    double *v = malloc((size_t)np * sizeof *v);
+    double *v = cv_malloc((size_t)np * sizeof *v);
     if (!v) {
       ex_integrand_free(g);
       return NULL;
@@ -28,7 +28,7 @@ static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *m
     for (int i = 0; i < np; i++)
       v[i] = s->params[i].value;
     ex_integrand_set_params(g, v);
-    free(v);
+    cv_free(v);
   }
   return g;
 }
@@ -143,6 +143,10 @@ cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_
   if (st == CVAR_OK && s->adapt > 0) {
     what = "adapt"; /* [mesh] adapt; the command caps the mesh at 2e6 elements */
     st = cv_solver_set_adapt(sv, s->adapt, 2000000);
+  }
+  if (st == CVAR_OK && s->tol > 0) {
+    what = "tol"; /* [mesh] tol or --tol: automatic accuracy, capped at 1e6 nodes */
+    st = cv_solver_set_tol(sv, s->tol, SCENE_TOL_MAX_NODES);
   }
   if (st == CVAR_OK) {
     what = "method";

@@ -43,6 +43,7 @@ void cli_report_free(cli_report *r)
   cv_free(r->lam);
   cv_free(r->has_mu);
   cv_free(r->mu);
+  cv_free(r->degrees);
   memset(r, 0, sizeof *r);
 }
 
@@ -230,6 +231,12 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
   r->elements = cv_solver_get_num_elements(sv);
   r->degree = cv_solver_get_degree(sv);
   r->nodes = cv_solver_get_num_nodes(sv);
+  if (r->elements > 0) {
+    r->degrees = cv_malloc((size_t)r->elements * sizeof *r->degrees);
+    if (!r->degrees)
+      return -1;
+    cv_solver_get_degrees(sv, r->degrees);
+  }
   r->iterations = cv_solver_get_num_iterations(sv);
   r->action = cv_solver_get_action(sv);
   r->has_action = isfinite(r->action);
@@ -306,11 +313,12 @@ int cli_report_build(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv
   for (int i = 0; i < s->n; i++)
     any_exact |= s->exact[i] >= 0;
   if (adaptive) {
-    /* the adaptive solve's own two-mesh estimate (theory AD-1) */
+    /* the rounds' own estimate (theory HP-2); with --tol always, and the degrees */
     double est = cv_solver_get_error_estimate(sv);
-    r->has_err_est = !any_exact && isfinite(est);
+    r->has_err_est = (adaptive == 2 || !any_exact) && isfinite(est);
     r->err_est = est;
+    r->has_degrees = adaptive == 2;
     return 0;
   }
-  return any_exact ? 0 : cli_report_estimate(r, s, p);
+  return any_exact ? 0 : cli_report_estimate(r, sv, p);
 }

@@ -28,6 +28,8 @@ typedef struct {
   const char *status;
   char message[640];
   int elements, degree, nodes, n;
+  int *degrees; /* degree of each element (written with --tol), or NULL */
+  int has_degrees;
   int has_action, has_gradient_norm, has_time;
   double action, gradient_norm, time_s;
   int iterations;
@@ -51,17 +53,19 @@ typedef struct {
 const char *cli_status_string(cv_status st);
 int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv,
                        cv_method m, cv_status st);
-/* estimate.c: the max nodal error of a solve without [exact], from a reference solve on
- * a mesh whose element boundaries include every node (docs/cli.md). cli_estimate_error
- * gives the max over all nodes and over the element boundaries (NaN when the reference
- * solve fails); both return 0, or -1 on allocation failure. */
-int cli_report_estimate(cli_report *r, const scene *s, const cv_problem *p);
-int cli_estimate_error(const scene *s, const cv_problem *p, int nodes, int degree,
-                       const double *x, const double *y, double *e_all, double *e_vertex);
+/* scene_estimate.c: the max nodal error of the solver's last solve, from the core's
+ * estimator (theory HP-2, HP-3; docs/cli.md). cli_estimate_error gives the max over all
+ * nodes and over the element boundaries (NaN, and the reason in why, when there is no
+ * bound); cli_report_estimate puts it into r (or the reason into its message). Both return
+ * 0, or -1 on allocation failure. */
+int cli_report_estimate(cli_report *r, const cv_solver *sv, const cv_problem *p);
+int cli_estimate_error(const cv_solver *sv, const cv_problem *p, double *e_all,
+                       double *e_vertex, char *why, size_t len);
 void cli_report_free(cli_report *r);
 
-/* Collect and, without [exact], estimate the error: the adaptive solve's own estimate when
- * `adaptive`, else cli_report_estimate. Returns 0, or -1 on allocation failure. */
+/* Collect and, without [exact], estimate the error: the rounds' own estimate when
+ * `adaptive` (1: --adapt; 2: --tol, then always, with the degrees), else
+ * cli_report_estimate. Returns 0, or -1 on allocation failure. */
 int cli_report_build(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv, cv_status st,
                      int adaptive);
 

@@ -46,6 +46,12 @@ json_t *cli_report_json_object(const cli_report *r)
     json_object_set_new(o, "elements", json_integer(r->elements));
     json_object_set_new(o, "degree", json_integer(r->degree));
     json_object_set_new(o, "nodes", json_integer(r->nodes));
+    if (r->has_degrees && r->degrees) { /* --tol: the degree of each element, in order */
+      json_t *d = json_array();
+      for (int e = 0; e < r->elements; e++)
+        json_array_append_new(d, json_integer(r->degrees[e]));
+      json_object_set_new(o, "degrees", d);
+    }
   }
   a = json_array();
   for (int i = 0; i < s->n; i++)

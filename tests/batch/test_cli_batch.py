@@ -152,6 +152,18 @@ if len(crow) == 3:
     check("R=1.2 iterations, time and message given", bad["iterations"] != "" and
           bad["time_s"] != "" and len(bad["message"]) > 10, "filled", bad)
 
+# ---- a row whose integrand is singular inside the interval: as `solve` says (SG-1) -------
+stab = write("sing.csv", "c\n-1\n0.5\n2\n")
+rc, out, err = batch("singular.scene", stab)
+srow = rows_of(out)
+check("singular batch exit 1", rc == 1, 1, (rc, err))
+check("singular rows: converged, diverged, converged",
+      [r["status"] for r in srow] == ["converged", "diverged", "converged"],
+      ["converged", "diverged", "converged"], [r["status"] for r in srow])
+if len(srow) == 3:
+    check("singular row says where", "singular at x = 0.5" in srow[1]["message"] and
+          srow[1]["action"] == "", "singular at x = 0.5, no action", srow[1])
+
 # ---- bad input: exit 2, FILE:LINE of the table, no output file ----------------------
 def bad_case(name, text, line):
     path = write(name, text)

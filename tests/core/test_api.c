@@ -1,6 +1,7 @@
 /* tests/core/test_api.c — bad input and failure paths: statuses and messages, never a crash
  * or a claimed success; derivative checker; version; allocation failures.
  * SPDX-License-Identifier: MIT */
+#include <float.h>
 #include <string.h>
 
 #include "refproblems.h"
@@ -134,6 +135,36 @@ int main(void) {
     for (int k = 0; k < CVAR_NUM_STATUS; k++)
       CHECK(strlen(cv_strerror((cv_status)k)) > 3, "empty message for status %d", k);
     CHECK(strcmp(cv_strerror((cv_status)999), "unknown status") == 0, "unknown status text");
+  }
+
+  /* Energy and momenta at more points than one callback batch (256): for the catenary
+   * F = y sqrt(1 + y'^2), p = y y'/sqrt(1 + y'^2) and H = y' p - F = -y/sqrt(1 + y'^2),
+   * compared with those closed forms: p to 8 eps relative, H to 4 eps (1 + y'^2) relative
+   * (y'p and F are each (1 + y'^2) times larger than H and cancel); a failing callback is
+   * reported. */
+  {
+    enum { M = 600 };
+    static double xs[M], ys[M], ds[M], H[M], P[M];
+    for (int k = 0; k < M; k++) {
+      xs[k] = -1 + 2.0 * k / (M - 1);
+      ys[k] = 1.5 + 0.25 * sin(3 * xs[k]);
+      ds[k] = -2 + 4.0 * k / (M - 1);
+    }
+    cv_problem_set_integrand(p, catenary_F, NULL);
+    st = cv_problem_eval_energy(p, M, xs, ys, ds, H, P);
+    double worst = 0;
+    for (int k = 0; k < M; k++) {
+      double r = sqrt(1 + ds[k] * ds[k]);
+      double eh = fabs(H[k] + ys[k] / r) / (ys[k] / r) / (4 * (1 + ds[k] * ds[k]));
+      double ep = fabs(P[k] - ys[k] * ds[k] / r) / fmax(1e-300, fabs(ys[k] * ds[k] / r)) / 8;
+      worst = fmax(worst, fmax(eh, ep));
+    }
+    CHECK(st == CVAR_OK && worst <= DBL_EPSILON, "energy/momenta at %d points: %s, worst "
+          "error %.3g eps of its tolerance", M, cv_status_name(st), worst / DBL_EPSILON);
+    CHECK(cv_problem_eval_energy(p, M, xs, NULL, ds, H, P) == CVAR_EINVAL, "NULL y accepted");
+    cv_problem_set_integrand(p, abort_F, NULL);
+    st = cv_problem_eval_energy(p, M, xs, ys, ds, H, NULL);
+    CHECK(st == CVAR_ECALLBACK, "failing callback gave %s", cv_status_name(st));
   }
 
   /* Allocation failures: fail the k-th allocation of a whole solve, for every k, and expect

@@ -30,6 +30,19 @@ static int poincare_F(int m, const double *x, const double *y, const double *dy,
   return 0;
 }
 
+/* y'^2/2 - pi^2 y^2/2 on [0, 1]: the conjugate point of 0 is the end 1, so with y(1) = 1
+ * there is no stationary path (the Jacobi field sin(pi x) vanishes at both ends). */
+static int resonant_F(int m, const double *x, const double *y, const double *dy,
+                      unsigned need, cv_partials *o, void *user) {
+  (void)x, (void)need, (void)user;
+  for (int k = 0; k < m; k++) {
+    o->F[k] = 0.5 * dy[k] * dy[k] - 0.5 * PI * PI * y[k] * y[k];
+    if (o->Fy) { o->Fy[k] = -PI * PI * y[k]; o->Fp[k] = dy[k]; }
+    if (o->Fyy) { o->Fyy[k] = -PI * PI; o->Fyp[k] = 0; o->Fpp[k] = 1; }
+  }
+  return 0;
+}
+
 static double circle(double x) { return sqrt(1 + EPS_END * EPS_END - x * x); }
 
 int main(void) {
@@ -56,6 +69,24 @@ int main(void) {
           "expected", deg[i], cv_solver_get_morse_index(s));
     CHECK(rel <= 1e-10, "Poincare p=%d: length error %.3g", deg[i], rel);
     CHECK(err <= 1e-6, "Poincare p=%d: nodal error %.3g", deg[i], err);
+    cv_solver_free(s);
+  }
+  cv_problem_free(p);
+  /* The graded retry must not turn a problem without a solution into a "converged" one:
+   * on the graded mesh it found a discrete path of amplitude 8e6 (degree 3), which the
+   * check on twice the elements rejects. (Degrees 1 and 2 report such a discrete path on
+   * the uniform mesh already, before any retry: not this test's subject.) */
+  p = cv_problem_new(1, 0, 1, NULL);
+  cv_problem_set_integrand(p, resonant_F, NULL);
+  cv_problem_set_dirichlet(p, 0, 0, 1);
+  for (int deg = 3; deg <= 8; deg += 5) {
+    cv_solver *s = cv_solver_new(NULL);
+    cv_solver_set_elements(s, 20);
+    cv_solver_set_degree(s, deg);
+    cv_status st = cv_solve(s, p);
+    printf("no solution, p=%d: %s\n  %s\n", deg, cv_strerror(st), cv_solver_last_error(s));
+    CHECK(st != CVAR_OK, "no solution, p=%d: reported converged (action %g)", deg,
+          cv_solver_get_action(s));
     cv_solver_free(s);
   }
   cv_problem_free(p);

@@ -1,0 +1,164 @@
+/* bench/bench_tol.c — automatic accuracy (--tol, theory HP-1..HP-6) on the reference
+ * problems: time of one whole --tol solve (fresh solver: configure, all rounds, free; the
+ * fastest of repeats filling 50 ms), nodes, rounds, the estimate and the true error, and, in
+ * the same run, the time of one solve on the best hand-picked mesh of docs/performance.md
+ * for that accuracy (the baseline), with the ratio; then the brachistochrone's action error
+ * against sqrt(nodes) as the tolerance falls (HP-5: exp(-b sqrt(N))).
+ * Usage: bench_tol [scene_dir (default: the tests' copy of the reference problems)]
+ * SPDX-License-Identifier: MIT */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "calcvar.h"
+#include "scene/scene.h"
+
+#ifndef CV_SCENE_DIR
+#define CV_SCENE_DIR "tests/scene/data"
+#endif
+
+typedef struct {
+  const char *scene, *set; /* set: one name=value override or NULL */
+  double tol;
+  int elements, degree; /* the hand-picked baseline mesh (0: none) */
+} bench_case;
+
+static const bench_case cases[] = {
+    {"brachistochrone.scene", NULL, 1e-10, 0, 0},
+    {"boundary_layer.scene", "eps=1e-8", 1e-9, 0, 0},
+    {"boundary_layer.scene", "eps=1e-8", 2e-8, 0, 0},
+    {"catenary.scene", NULL, 1e-12, 2, 8},
+    {"fisheye_ray.scene", NULL, 1e-12, 3, 8},
+    {"harmonic_saddle.scene", NULL, 1e-12, 5, 8},
+    {"boundary_layer.scene", NULL, 1e-12, 98, 8},
+    {"sphere_geodesic.scene", NULL, 1e-12, 5, 8},
+};
+
+typedef struct {
+  cv_status st;
+  double t, est, err, errA;
+  int nodes, rounds;
+} bench_result;
+
+/* One timed solve of scene s (tol > 0: --tol from the CLI's start; else the given mesh),
+ * the fastest of repeats filling 50 ms; errors against [exact] from the last one. */
+static int run(scene *s, const cv_problem *p, double tol, int elements, int degree,
+               bench_result *r) {
+  double best = INFINITY, total = 0.0;
+  char err[SC_ERRLEN];
+  for (int rep = 0; rep < 200 && (rep < 3 || total < 0.05); rep++) {
+    cv_solver *sv = cv_solver_new(NULL);
+    s->tol = tol;
+    s->elements = tol > 0 ? SCENE_TOL_START_ELEMENTS : elements;
+    s->degree = tol > 0 ? SCENE_TOL_START_DEGREE : degree;
+    if (!sv || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK) {
+      fprintf(stderr, "%s\n", err);
+      cv_solver_free(sv);
+      return -1;
+    }
+    r->st = cv_solve(sv, p);
+    double t = cv_solver_get_time(sv);
+    total += t;
+    best = fmin(best, t);
+    r->nodes = cv_solver_get_num_nodes(sv);
+    r->rounds = cv_solver_get_adapt_rounds(sv);
+    r->est = cv_solver_get_error_estimate(sv);
+    r->err = NAN;
+    r->errA = s->has_exact_action
+                  ? fabs(cv_solver_get_action(sv) - s->exact_action) / fmax(1, fabs(s->exact_action))
+                  : NAN;
+    int N = r->nodes, n = s->n, any = 0;
+    for (int i = 0; i < n; i++) any |= s->exact[i] >= 0;
+    double *x = malloc((size_t)N * sizeof *x), *y = malloc((size_t)N * n * sizeof *y);
+    double *ex = malloc((size_t)N * n * sizeof *ex);
+    if (any && x && y && ex && cv_solver_get_nodes(sv, x) == CVAR_OK &&
+        cv_solver_get_values(sv, y) == CVAR_OK && scene_eval_exact(s, N, x, ex) == 0) {
+      double m = 0;
+      for (int i = 0; i < n; i++)
+        if (s->exact[i] >= 0)
+          for (int j = 0; j < N; j++) m = fmax(m, fabs(y[(size_t)j * n + i] - ex[(size_t)i * N + j]));
+      r->err = m;
+    }
+    free(x);
+    free(y);
+    free(ex);
+    cv_solver_free(sv);
+  }
+  r->t = best;
+  return 0;
+}
+
+int main(int argc, char **argv) {
+  const char *dir = argc > 1 ? argv[1] : CV_SCENE_DIR;
+  printf("--tol on the reference problems (timings on a shared machine: noisy; the baseline\n"
+         "is measured in the same run)\n");
+  printf("%-22s %-9s %7s %-9s %6s %6s %9s %9s %9s %9s | %-10s %9s %9s %6s\n", "problem",
+         "set", "tol", "status", "nodes", "rounds", "estimate", "true_max", "true_act",
+         "time_s", "hand mesh", "time_s", "true_max", "ratio");
+  for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+    const bench_case *bc = &cases[c];
+    char path[1024], err[SC_ERRLEN], nm[64] = "", val[64] = "";
+    snprintf(path, sizeof path, "%s/%s", dir, bc->scene);
+    sc_set set = {nm, val};
+    if (bc->set) {
+      const char *eq = strchr(bc->set, '=');
+      snprintf(nm, sizeof nm, "%.*s", (int)(eq - bc->set), bc->set);
+      snprintf(val, sizeof val, "%s", eq + 1);
+    }
+    scene *s = scene_load_file(path, bc->set ? 1 : 0, &set, err, sizeof err);
+    cv_problem *p = s ? scene_problem_new(s, scene_method_need(s->method), err, sizeof err) : NULL;
+    if (!p) {
+      fprintf(stderr, "%s\n", err);
+      scene_free(s);
+      return 1;
+    }
+    bench_result a, b = {0};
+    b.t = b.err = NAN;
+    if (run(s, p, bc->tol, 0, 0, &a) < 0 ||
+        (bc->elements && run(s, p, 0, bc->elements, bc->degree, &b) < 0)) {
+      cv_problem_free(p);
+      scene_free(s);
+      return 1;
+    }
+    char hand[16] = "-";
+    if (bc->elements) snprintf(hand, sizeof hand, "%dx p%d", bc->elements, bc->degree);
+    printf("%-22s %-9s %7.0e %-9s %6d %6d %9.2e %9.2e %9.2e %9.2e | %-10s %9.2e %9.2e %6.1f\n",
+           bc->scene, bc->set ? bc->set : "-", bc->tol,
+           a.st == CVAR_OK ? "converged" : cv_status_name(a.st) + 5, a.nodes, a.rounds, a.est,
+           a.err, a.errA, a.t, hand, b.t, b.err, bc->elements ? a.t / b.t : NAN);
+    cv_problem_free(p);
+    scene_free(s);
+  }
+  /* Exponential convergence in sqrt(unknowns) (HP-5): the brachistochrone's action error
+   * against the nodes as T falls; b from the least-squares line ln(err) = c - b sqrt(N). */
+  char path[1024], err[SC_ERRLEN];
+  snprintf(path, sizeof path, "%s/brachistochrone.scene", dir);
+  scene *s = scene_load_file(path, 0, NULL, err, sizeof err);
+  cv_problem *p = s ? scene_problem_new(s, scene_method_need(s->method), err, sizeof err) : NULL;
+  if (!p) {
+    fprintf(stderr, "%s\n", err);
+    scene_free(s);
+    return 1;
+  }
+  printf("\nbrachistochrone: action error against sqrt(nodes) under --tol\n%8s %6s %10s %10s\n",
+         "tol", "nodes", "sqrt(N)", "act_err");
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  int m = 0;
+  for (double T = 1e-3; T >= 0.99e-12; T /= 10) {
+    bench_result a;
+    if (run(s, p, T, 0, 0, &a) < 0) break;
+    double r = sqrt((double)a.nodes), e = fmax(a.errA, 1e-16);
+    printf("%8.0e %6d %10.2f %10.2e\n", T, a.nodes, r, a.errA);
+    if (a.errA > 1e-14) { /* above round-off */
+      sx += r, sy += log(e), sxx += r * r, sxy += r * log(e);
+      m++;
+    }
+  }
+  if (m >= 3)
+    printf("fit ln(err) = c - b sqrt(N): b = %.3f (%d points above round-off)\n",
+           -(m * sxy - sx * sy) / (m * sxx - sx * sx), m);
+  cv_problem_free(p);
+  scene_free(s);
+  return 0;
+}

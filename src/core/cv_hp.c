@@ -1,0 +1,94 @@
+/* src/core/cv_hp.c — the hp decisions of one refinement round (theory HP-4, HP-5): for each
+ * marked element, raise its degree (smooth) or split it (not smooth, or degree 8),
+ * geometrically towards a singular end.
+ * SPDX-License-Identifier: MIT */
+#include <math.h>
+
+#include "cv_internal.h"
+
+/* Legendre coefficients decaying at least like e^(-sigma k) with sigma >= this count as
+ * smooth: each extra degree then gains a factor e or more (HP-4). */
+#define SMOOTH_RATE 1.0
+/* Geometric split ratio towards a singular end or a layer (HP-5). */
+#define GEOM_RATIO 0.15
+
+static int clamp_deg(int p) { return p > CV_MAX_DEGREE ? CV_MAX_DEGREE : p < 1 ? 1 : p; }
+
+/* A split point u of [x0, x1] on the reference interval, or -1 when round-off would
+ * leave one of the two parts empty (an element near an end of ~1e-16 relative size). */
+static double split_at(double x0, double x1, double u, double a, double L) {
+  double t0 = (x0 - a) / L, t1 = (x1 - a) / L, tu = (u - a) / L;
+  return tu > t0 && tu < t1 && a + L * tu > a + L * t0 && a + L * tu < a + L * t1 ? tu : -1.0;
+}
+
+/* HP-4: the degree at which a smooth element's surplus eta, falling like e^(-sigma k),
+ * would be below a tenth of the target: p + ceil(ln(eta / (target / 10)) / sigma), at
+ * least p + 1, at most 8. */
+static int predicted_degree(int p, double eta, double sigma, double target) {
+  double k = log(eta / (0.1 * target)) / sigma;
+  if (!(k >= 1)) return clamp_deg(p + 1);
+  return k > CV_MAX_DEGREE ? CV_MAX_DEGREE : clamp_deg(p + (int)ceil(k));
+}
+
+cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
+                       const double *where, double thresh, double target, int hp, int *Enew,
+                       double **t, int **deg) {
+  int E = d->E, F = 0;
+  for (int e = 0; e < E; e++) F += eta[e] >= thresh ? 2 : 1;
+  *t = cv_malloc((size_t)(F + 1) * sizeof **t);
+  *deg = cv_malloc((size_t)F * sizeof **deg);
+  if (!*t || !*deg) {
+    cv_free(*t);
+    cv_free(*deg);
+    *t = NULL;
+    *deg = NULL;
+    return CVAR_ENOMEM;
+  }
+  double a = d->xe[0], L = d->xe[E] - a;
+  int k = 0;
+  for (int e = 0; e < E; e++) {
+    int pe = cv_disc_edeg(d, e);
+    double x0 = d->xe[e], x1 = d->xe[e + 1];
+    (*t)[k] = (x0 - a) / L;
+    double tm = split_at(x0, x1, 0.5 * (x0 + x1), a, L);
+    double tl = split_at(x0, x1, x0 + GEOM_RATIO * (x1 - x0), a, L);
+    double tr = split_at(x0, x1, x1 - GEOM_RATIO * (x1 - x0), a, L);
+    if (!(eta[e] >= thresh) || tm < 0 || tl < 0 || tr < 0) { /* unmarked, or too small */
+      (*deg)[k++] = eta[e] >= thresh ? clamp_deg(pe + 1) : pe;
+      continue;
+    }
+    if (!hp) { /* fixed degree (--adapt): bisect */
+      (*deg)[k++] = pe;
+      (*t)[k] = tm;
+      (*deg)[k++] = pe;
+      continue;
+    }
+    int sing_left = (e == 0 && d->sing_a) || (!(e == E - 1 && d->sing_b) && where[e] < -0.5 &&
+                                              sigma[e] < SMOOTH_RATE);
+    int sing_right = (e == E - 1 && d->sing_b) || (!(e == 0 && d->sing_a) && where[e] > 0.5 &&
+                                                   sigma[e] < SMOOTH_RATE);
+    if (sing_left && !sing_right) { /* small element at x0 keeps p, the rest p + 1 (HP-5) */
+      (*deg)[k++] = pe;
+      (*t)[k] = tl;
+      (*deg)[k++] = clamp_deg(pe + 1);
+      continue;
+    }
+    if (sing_right && !sing_left) {
+      (*deg)[k++] = clamp_deg(pe + 1);
+      (*t)[k] = tr;
+      (*deg)[k++] = pe;
+      continue;
+    }
+    if (sigma[e] >= SMOOTH_RATE && pe < CV_MAX_DEGREE) { /* smooth: raise p (HP-4) */
+      (*deg)[k++] = predicted_degree(pe, eta[e], sigma[e], target);
+      continue;
+    }
+    (*deg)[k++] = pe; /* not smooth, or degree 8 already: halve */
+    (*t)[k] = tm;
+    (*deg)[k++] = pe;
+  }
+  (*t)[0] = 0.0;
+  (*t)[k] = 1.0;
+  *Enew = k;
+  return CVAR_OK;
+}
