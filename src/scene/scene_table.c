@@ -5,8 +5,10 @@
  * then the value), then one row per grid point, in any order, forming a full rectilinear
  * grid. Every fault is reported at the CSV's own FILE:LINE. Numbers are read by a fast
  * exact path (Clinger: at most 19 significant digits whose integer fits in 2^53, a power of
- * ten up to 22; both exact doubles, so one rounding) with strtod for everything else, so a
- * 200^3 grid reads in well under a second (bench/bench_table). */
+ * ten up to 22; both exact doubles, so one rounding) with strtod for everything else.
+ * One pass over the mapped file, no array of parsed rows; a grid written in its own order
+ * is read straight into the table's array of values (docs/scenes.md "Reading speed";
+ * bench/bench_table). */
 #define _DEFAULT_SOURCE /* MAP_POPULATE */
 #include <errno.h>
 #include <float.h>
