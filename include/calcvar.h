@@ -559,6 +559,91 @@ CVAR_API const char *cv_report_json(const cv_report *r);
 CVAR_API void cv_report_free(cv_report *r);
 /**@}*/
 
+/** \name Mechanics of a scene: equations and small oscillations (docs/mechanics.md)
+ * What `calcvar equations` and `calcvar modes` compute, for a loaded scene, with the same
+ * JSON text as their `--json` (built by the same code). Each result is an opaque handle
+ * that owns everything its getters return; strings are UTF-8, NUL-terminated and live
+ * until the handle is freed. Both calls add nodes to the scene's expression store: do not
+ * call them on one scene from two threads at once. The handles do not refer to the scene
+ * once made (the scene may be freed first). */
+/**@{*/
+/** Momenta, Euler–Lagrange equations, Hamiltonian and conservation laws of a scene's
+ * integrand F (with its [constraints] and [integrals] multipliers (P-8)), as expressions. */
+typedef struct cv_equations cv_equations;
+/** Derive the equations of sc (theory (P-3)..(P-7)). NULL on failure, with *why (may be
+ * NULL; CVAR_EINVAL for a NULL scene, CVAR_ENOMEM) and a sentence in err (may be NULL). */
+CVAR_API cv_equations *cv_equations_new(cv_scene *sc, cv_status *why, char *err,
+                                        size_t errlen);
+/** Release; NULL is a no-op. */
+CVAR_API void cv_equations_free(cv_equations *e);
+/** The number of unknowns (as the scene's, in its order). */
+CVAR_API int cv_equations_get_num_unknowns(const cv_equations *e);
+/** The momentum p_i = dF/dy_i' of unknown i, printed in the scene grammar with the scene's
+ * names and its parameters as numbers (so it parses without the scene); NULL when i is out
+ * of range. */
+CVAR_API const char *cv_equations_get_momentum(const cv_equations *e, int i);
+/** The left side E_i of unknown i's Euler–Lagrange equation E_i = 0, expanded with y_i''
+ * (written "y''"; a multiplier field of constraint C is "lambda_C", an integral's
+ * multiplier "mu_NAME"), signed so that the coefficient of y_i'' is not a negative
+ * number; NULL when i is out of range. */
+CVAR_API const char *cv_equations_get_euler_lagrange(const cv_equations *e, int i);
+/** The Hamiltonian H = sum_i y_i' p_i - F. */
+CVAR_API const char *cv_equations_get_hamiltonian(const cv_equations *e);
+/** The integrand F itself, printed the same way. */
+CVAR_API const char *cv_equations_get_integrand(const cv_equations *e);
+/** 1 when F does not depend on y_i (p_i is conserved), else 0 (also out of range). */
+CVAR_API int cv_equations_is_cyclic(const cv_equations *e, int i);
+/** 1 when F does not depend on the variable (H is conserved), else 0. */
+CVAR_API int cv_equations_is_autonomous(const cv_equations *e);
+/** The JSON text of `calcvar equations --json` (without its final newline): keys momenta,
+ * euler_lagrange, hamiltonian, cyclic, autonomous (docs/cli.md); "" for NULL. */
+CVAR_API const char *cv_equations_json(const cv_equations *e);
+
+/** The kind of a small oscillation. */
+typedef enum {
+  CVAR_MODE_STABLE = 0, /**< omega2 > 0: oscillation with period 2 pi / sqrt(omega2) */
+  CVAR_MODE_UNSTABLE,   /**< omega2 < 0: growth rate sqrt(-omega2) */
+  CVAR_MODE_NEUTRAL     /**< omega2 = 0 to round-off: a free translation or rotation */
+} cv_mode_kind;
+/** The equilibrium of a Lagrangian L(y, y') and its normal modes K v = omega2 M v. */
+typedef struct cv_modes cv_modes;
+/** Find the equilibrium dL/dy = 0 (y' = 0; on the [constraints] G(y) = 0 with their
+ * multipliers) by Newton from the scene's guess at the start of the interval, and the
+ * modes there (theory (P-9), (P-10), (P-12), (P-13)). NULL on failure, with *why (may be
+ * NULL) and a sentence "FILE:LINE: what is wrong" in err (may be NULL): CVAR_EINVAL
+ * when modes do not apply (L or a constraint depends on the variable, integral
+ * constraints, as many constraints as unknowns); CVAR_ENONFINITE, CVAR_EMAXITER (no equilibrium from the
+ * guess), CVAR_ESINGULAR (M not positive definite, dependent constraints), CVAR_EDEPENDENCY
+ * (LAPACK), CVAR_ENOMEM. */
+CVAR_API cv_modes *cv_modes_new(cv_scene *sc, cv_status *why, char *err, size_t errlen);
+/** Release; NULL is a no-op. */
+CVAR_API void cv_modes_free(cv_modes *m);
+/** n, the number of unknowns. */
+CVAR_API int cv_modes_get_num_unknowns(const cv_modes *m);
+/** The number of modes: n minus the number of [constraints]. */
+CVAR_API int cv_modes_get_num_modes(const cv_modes *m);
+/** The number of [constraints] (multipliers). */
+CVAR_API int cv_modes_get_num_constraints(const cv_modes *m);
+/** The equilibrium y*[i], i < n, into the caller's array. */
+CVAR_API cv_status cv_modes_get_equilibrium(const cv_modes *m, double *y);
+/** omega2[k] of each mode k, increasing, into the caller's array of num_modes values. */
+CVAR_API cv_status cv_modes_get_omega2(const cv_modes *m, double *omega2);
+/** The kind of mode k (CVAR_MODE_NEUTRAL when k is out of range). */
+CVAR_API cv_mode_kind cv_modes_get_kind(const cv_modes *m, int k);
+/** The mode shapes, mode-major: shape[k*n + i] is unknown i of mode k (num_modes*n values),
+ * normalised to v^T M v = 1. */
+CVAR_API cv_status cv_modes_get_shapes(const cv_modes *m, double *shape);
+/** The multipliers lambda_c of L + lambda.G at the equilibrium (num_constraints values;
+ * lambda may be NULL when there are none). */
+CVAR_API cv_status cv_modes_get_multipliers(const cv_modes *m, double *lambda);
+/** M = d2L/dy'dy' and K = -d2(L + lambda.G)/dydy at the equilibrium, n*n row-major each
+ * (either may be NULL). */
+CVAR_API cv_status cv_modes_get_matrices(const cv_modes *m, double *mass, double *stiffness);
+/** The JSON text of `calcvar modes --json` (without its final newline): keys equilibrium,
+ * modes, and multipliers / gyroscopic when they apply (docs/cli.md); "" for NULL. */
+CVAR_API const char *cv_modes_json(const cv_modes *m);
+/**@}*/
+
 /** @name Many parameter sets on one compiled scene (the engine of `calcvar batch`)
  * A scene file is read and compiled once, its [parameters] as inputs of the compiled
  * expressions; each row (values of some parameters) is then solved as `calcvar solve

@@ -7,23 +7,22 @@ Three lines to a solved geodesic::
     print(sol.status, sol.x, sol["th"], sol(0.5))
 
 `solve` takes a scene (a path, or the text of a scene) and the options of the command
-`calcvar solve`; `Problem` builds a scene from Python values. The work is done by the C
+`calcvar solve`; `equations` and `modes` give its mechanics (as `calcvar equations` and
+`calcvar modes`); `Problem` builds a scene from Python values. The work is done by the C
 library libcalcvar through ctypes (docs/python.md).
 SPDX-License-Identifier: MIT
 """
 import ctypes
 import json
 import os
-import shutil
-import subprocess
-import tempfile
 
 import numpy as np
 
 from . import _lib
 from ._lib import lib
 
-__all__ = ["solve", "Solution", "Problem", "CalcvarError", "InputError", "version",
+__all__ = ["solve", "equations", "modes", "Solution", "Problem", "CalcvarError",
+           "InputError", "version",
            "dependency_versions",
            "METHODS"]
 
@@ -436,6 +435,43 @@ class Solution:
                    ", ".join(self.unknowns)))
 
 
+def _mechanics(new, to_json, free, scene, set):
+    h = _load(scene, set)
+    err = ctypes.create_string_buffer(_lib.ERRLEN)
+    why = ctypes.c_int(_lib.OK)
+    r = None
+    try:
+        r = new(h, ctypes.byref(why), err, _lib.ERRLEN)
+        if not r:
+            _fail(why.value, err.value.decode(errors="replace"))
+        return json.loads(to_json(r).decode())
+    finally:
+        if r:
+            free(r)
+        lib.cv_scene_free(h)
+
+
+def equations(scene, *, set=None):
+    """The mechanics of a scene's integrand F (a path or scene text, with `set` overriding
+    [parameters]) as a dict, the JSON of `calcvar equations --json` (docs/mechanics.md):
+    "momenta" and "euler_lagrange" ({unknown: expression}), "hamiltonian", "cyclic" (the
+    unknowns F does not contain) and "autonomous" (F does not contain the variable). The
+    expressions are text in the scene grammar with the parameters as numbers."""
+    return _mechanics(lib.cv_equations_new, lib.cv_equations_json, lib.cv_equations_free,
+                      scene, set)
+
+
+def modes(scene, *, set=None):
+    """The equilibrium of a scene's Lagrangian L(y, y') found from its guess at the start
+    of the interval, and the small oscillations there, as a dict: the JSON of `calcvar
+    modes --json` (docs/mechanics.md): "equilibrium" ({unknown: value}), "modes" (a list of
+    {"omega2", "kind", "shape"}, omega2 increasing), and "multipliers" / "gyroscopic" when
+    they apply. Raises InputError when modes do not apply (L depends on the variable,
+    integral constraints) and CalcvarError (status CVAR_EMAXITER, CVAR_ESINGULAR, ...) when
+    no equilibrium or no modes are found."""
+    return _mechanics(lib.cv_modes_new, lib.cv_modes_json, lib.cv_modes_free, scene, set)
+
+
 def _num(v):
     if isinstance(v, str):
         return v
@@ -515,41 +551,15 @@ class Problem:
         """calcvar.solve on this problem, with the same options."""
         return solve(self.text, **options)
 
-    def _mechanics(self, command):
-        exe = os.environ.get("CALCVAR_EXE") or shutil.which("calcvar")
-        if not exe:
-            try:
-                from . import _config
-                exe = _config.EXECUTABLE if os.path.exists(_config.EXECUTABLE) else None
-            except ImportError:
-                exe = None
-        if not exe:
-            raise CalcvarError("CVAR_ESTATE", "the calcvar command is not found (set "
-                               "CALCVAR_EXE): %s() runs `calcvar %s`" % (command, command))
-        with tempfile.TemporaryDirectory() as tmp:
-            path = os.path.join(tmp, "problem.scene")
-            with open(path, "w", encoding="utf-8") as f:
-                f.write(self.text)
-            r = subprocess.run([exe, command, path, "--json", "-", "--quiet"],
-                               capture_output=True, text=True, check=False)
-        if r.returncode == 2:
-            raise InputError("CVAR_EINVAL", r.stderr.strip().replace(path, "<problem>"))
-        try:
-            return json.loads(r.stdout)
-        except ValueError:
-            raise CalcvarError("CVAR_EDEPENDENCY", "calcvar %s: %s"
-                               % (command, r.stderr.strip() or "no JSON output")) from None
-
     def equations(self):
-        """Momenta, Euler-Lagrange equations and Hamiltonian as a dict: the JSON of
-        `calcvar equations --json` (this runs the command until the mechanics has a C
-        API)."""
-        return self._mechanics("equations")
+        """Momenta, Euler-Lagrange equations and Hamiltonian as a dict: calcvar.equations
+        on this problem."""
+        return equations(self.text)
 
     def modes(self):
-        """Equilibrium and small-oscillation modes as a dict: the JSON of `calcvar modes
-        --json` (this runs the command until the mechanics has a C API)."""
-        return self._mechanics("modes")
+        """Equilibrium and small-oscillation modes as a dict: calcvar.modes on this
+        problem."""
+        return modes(self.text)
 
     def __repr__(self):
         return "<calcvar.Problem>\n" + self.text

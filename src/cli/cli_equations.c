@@ -3,10 +3,10 @@
  * SPDX-License-Identifier: MIT
  *
  * The expressions come from scene_equations_new (src/scene/scene_mechanics.c, src/mech). They are
- * printed in the scene grammar (ex_print), with parameters as numbers, so the JSON strings
- * parse and evaluate without the scene (docs/mechanics.md).
+ * printed in the scene grammar, with parameters as numbers, by the library
+ * (scene_mechanics_json.c), which also builds the JSON, so `--json` and the public
+ * cv_equations_json give the same bytes (docs/mechanics.md).
  */
-#include <jansson.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,80 +23,13 @@ static void usage(FILE *f)
         "  --json FILE   the same as JSON ('-' for stdout)\n", f);
 }
 
-/* e printed in the scene grammar, malloc'ed; NULL on allocation failure. */
-static char *print_expr(const scene *s, const mech_equations *eq, ex_id e)
+/* The JSON of the library (scene_mechanics_json.c, also cv_equations_json) and a newline. */
+static int write_json(FILE *f, const scene *s, const mech_equations *eq,
+                      const scene_eq_texts *t)
 {
-  const char *const *names = (const char *const *)eq->names;
-  size_t len = ex_print(s->dag, e, names, NULL, 0) + 1;
-  char *buf = malloc(len);
-  if (buf)
-    ex_print(s->dag, e, names, buf, len);
-  return buf;
-}
-
-/* The printed texts: mom[i], el[i], then H, then F; one array, NULL entries on failure. */
-typedef struct {
-  char **mom, **el, *H, *F;
-} texts;
-
-static int texts_make(texts *t, const scene *s, const mech_equations *eq)
-{
-  int n = s->n;
-  memset(t, 0, sizeof *t);
-  t->mom = calloc((size_t)n, sizeof *t->mom);
-  t->el = calloc((size_t)n, sizeof *t->el);
-  if (!t->mom || !t->el)
-    return -1;
-  for (int i = 0; i < n; i++)
-    if (!(t->mom[i] = print_expr(s, eq, eq->momentum[i])) ||
-        !(t->el[i] = print_expr(s, eq, eq->el[i])))
-      return -1;
-  ex_id F = ex_collect(s->dag, s->F);
-  if (F < 0 || !(t->H = print_expr(s, eq, eq->hamiltonian)) || !(t->F = print_expr(s, eq, F)))
-    return -1;
-  return 0;
-}
-
-static void texts_free(texts *t, int n)
-{
-  for (int i = 0; i < n; i++) {
-    if (t->mom)
-      free(t->mom[i]);
-    if (t->el)
-      free(t->el[i]);
-  }
-  free(t->mom);
-  free(t->el);
-  free(t->H);
-  free(t->F);
-}
-
-static int write_json(FILE *f, const scene *s, const mech_equations *eq, const texts *t)
-{
-  json_t *o = json_object(), *mom = json_object(), *el = json_object(), *cyc = json_array();
-  int rc = -1;
-  if (!o || !mom || !el || !cyc) {
-    json_decref(mom);
-    json_decref(el);
-    json_decref(cyc);
-    goto done;
-  }
-  for (int i = 0; i < s->n; i++) {
-    json_object_set_new(mom, s->unknowns[i], json_string(t->mom[i]));
-    json_object_set_new(el, s->unknowns[i], json_string(t->el[i]));
-    if (eq->cyclic[i])
-      json_array_append_new(cyc, json_string(s->unknowns[i]));
-  }
-  json_object_set_new(o, "momenta", mom);
-  json_object_set_new(o, "euler_lagrange", el);
-  json_object_set_new(o, "hamiltonian", json_string(t->H));
-  json_object_set_new(o, "cyclic", cyc);
-  json_object_set_new(o, "autonomous", json_boolean(eq->autonomous));
-  rc = json_dumpf(o, f, JSON_INDENT(2) | JSON_PRESERVE_ORDER);
-  if (rc == 0 && fputc('\n', f) == EOF)
-    rc = -1;
-done:
-  json_decref(o);
+  char *text = scene_equations_json(s, eq, t);
+  int rc = text && fputs(text, f) != EOF && fputc('\n', f) != EOF ? 0 : -1;
+  free(text); /* from json_dumps: jansson's allocator */
   return rc;
 }
 
@@ -111,7 +44,8 @@ static const char *shortest(double v, char *buf, size_t len)
   return buf;
 }
 
-static void write_text(FILE *f, const scene *s, const mech_equations *eq, const texts *t)
+static void write_text(FILE *f, const scene *s, const mech_equations *eq,
+                       const scene_eq_texts *t)
 {
   int n = s->n, ncyc = 0;
   char num[32];
@@ -162,14 +96,15 @@ int cli_equations(int argc, char **argv)
   char err[SC_ERRLEN] = "";
   scene *s = NULL;
   mech_equations eq;
-  texts t;
+  scene_eq_texts t;
   cli_outfile jf = {0};
   memset(&eq, 0, sizeof eq);
   memset(&t, 0, sizeof t);
   int rc = cli_scene_command_start("equations", argc, argv, usage, &o, &s, &jf);
   if (rc >= 0)
     goto done;
-  if (scene_equations_new(s, &eq, err, sizeof err) != CVAR_OK || texts_make(&t, s, &eq) < 0) {
+  if (scene_equations_new(s, &eq, err, sizeof err) != CVAR_OK ||
+      scene_eq_texts_make(&t, s, &eq) < 0) {
     fprintf(stderr, "%s\n", err[0] ? err : "calcvar equations: out of memory");
     rc = EXIT_UNSOLVED;
     goto done;
@@ -186,7 +121,7 @@ int cli_equations(int argc, char **argv)
   rc = EXIT_SOLVED;
 done:
   cli_outfile_abandon(&jf);
-  texts_free(&t, s ? s->n : 0);
+  scene_eq_texts_free(&t);
   mech_equations_free(&eq);
   scene_free(s);
   cli_opts_free(&o);

@@ -2,12 +2,12 @@
  * its small oscillations, for a person or as JSON (SCENES.md).
  * SPDX-License-Identifier: MIT
  *
- * The numbers come from scene_modes_new (src/scene/scene_mechanics.c, src/mech). Exit status: 0 modes
+ * The numbers come from scene_modes_new (src/scene/scene_mechanics.c, src/mech), the JSON from
+ * the library (scene_mechanics_json.c, as cv_modes_json). Exit status: 0 modes
  * found; 1 no equilibrium from the guess, M not positive definite, or non-finite values
  * (nothing written); 2 bad input, including a scene whose integrand or a constraint
  * depends on the variable, or that has integral constraints (modes does not apply).
  */
-#include <jansson.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -33,78 +33,15 @@ static void usage(FILE *f)
 
 static const char *kind_name(mech_mode_kind k)
 {
-  return k == MECH_MODE_STABLE ? "stable" : k == MECH_MODE_UNSTABLE ? "unstable" : "neutral";
+  return scene_mode_kind_name(k);
 }
 
+/* The JSON of the library (scene_mechanics_json.c, also cv_modes_json) and a newline. */
 static int write_json(FILE *f, const scene *s, const mech_modes *md)
 {
-  int n = s->n;
-  json_t *o = json_object(), *eqm = json_object(), *modes = json_array();
-  int rc = -1;
-  if (!o || !eqm || !modes) {
-    json_decref(eqm);
-    json_decref(modes);
-    goto done;
-  }
-  for (int i = 0; i < n; i++)
-    json_object_set_new(eqm, s->unknowns[i], json_real(md->equilibrium[i]));
-  for (int k = 0; k < md->nmodes; k++) {
-    json_t *m = json_object(), *sh = json_object();
-    if (!m || !sh) {
-      json_decref(m);
-      json_decref(sh);
-      json_decref(eqm);
-      json_decref(modes);
-      goto done;
-    }
-    json_object_set_new(m, "omega2", json_real(md->omega2[k]));
-    json_object_set_new(m, "kind", json_string(kind_name(md->kind[k])));
-    for (int i = 0; i < n; i++)
-      json_object_set_new(sh, s->unknowns[i], json_real(md->shape[k * n + i]));
-    json_object_set_new(m, "shape", sh);
-    json_array_append_new(modes, m);
-  }
-  json_object_set_new(o, "equilibrium", eqm);
-  json_object_set_new(o, "modes", modes);
-  /* Addition to the contract: the multipliers of [constraints] at the equilibrium. */
-  if (md->nc > 0) {
-    json_t *mu = json_object();
-    if (!mu)
-      goto done;
-    for (int c = 0; c < md->nc; c++)
-      json_object_set_new(mu, s->cons[c].name, json_real(md->multipliers[c]));
-    json_object_set_new(o, "multipliers", mu);
-  }
-  /* Addition to the contract: with gyroscopic terms, the motions of M y'' + G y' + K y = 0
-   * (docs/mechanics.md); absent when G = 0. */
-  if (md->ngyro > 0) {
-    json_t *g = json_object(), *gm = json_array();
-    if (!g || !gm) {
-      json_decref(g);
-      json_decref(gm);
-      goto done;
-    }
-    json_object_set_new(g, "max_abs_G", json_real(md->gyroscopic));
-    for (int k = 0; k < md->ngyro; k++) {
-      json_t *m = json_object();
-      if (!m) {
-        json_decref(g);
-        json_decref(gm);
-        goto done;
-      }
-      json_object_set_new(m, "kind", json_string(kind_name(md->gyro_kind[k])));
-      json_object_set_new(m, "omega", json_real(md->gyro_omega[k]));
-      json_object_set_new(m, "growth", json_real(md->gyro_growth[k]));
-      json_array_append_new(gm, m);
-    }
-    json_object_set_new(g, "modes", gm);
-    json_object_set_new(o, "gyroscopic", g);
-  }
-  rc = json_dumpf(o, f, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
-  if (rc == 0 && fputc('\n', f) == EOF)
-    rc = -1;
-done:
-  json_decref(o);
+  char *text = scene_modes_json(s, md);
+  int rc = text && fputs(text, f) != EOF && fputc('\n', f) != EOF ? 0 : -1;
+  free(text); /* from json_dumps: jansson's allocator */
   return rc;
 }
 

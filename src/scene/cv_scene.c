@@ -12,10 +12,6 @@
 #include "scene/scene_internal.h"
 #include "scene/scene_report.h"
 
-struct cv_scene {
-  scene *s;
-};
-
 struct cv_report {
   char *json;
 };

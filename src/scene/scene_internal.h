@@ -124,4 +124,9 @@ int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const doub
  * them for the message. Returns 0, or -1 with FILE:LINE in L->err. */
 int sc_check_keys(sc_loader *L, int sec, const char *const *keys, const char *list);
 
+/* The opaque public handle of calcvar.h (cv_scene.c, cv_mechanics.c): a loaded scene. */
+struct cv_scene {
+  scene *s;
+};
+
 #endif /* CV_SCENE_INTERNAL_H */

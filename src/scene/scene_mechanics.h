@@ -23,4 +23,27 @@ cv_status scene_equations_new(const scene *s, mech_equations *eq, char *err, siz
  * FILE:LINE message in err (the line of the entry at fault, when there is one). */
 cv_status scene_modes_new(const scene *s, mech_modes *md, char *err, size_t errlen);
 
+/* ---- As text and JSON (scene_mechanics_json.c) --------------------------------------- */
+
+/** The equations printed in the scene grammar, parameters as numbers: mom[i] = p_i,
+ * el[i] = E_i, H, and F itself. */
+typedef struct {
+  int n;
+  char **mom, **el, *H, *F;
+} scene_eq_texts;
+
+/** Print eq's expressions (all of them, or -1 on allocation failure; free it either way). */
+int scene_eq_texts_make(scene_eq_texts *t, const scene *s, const mech_equations *eq);
+void scene_eq_texts_free(scene_eq_texts *t);
+
+/** The JSON of `calcvar equations --json` (docs/cli.md), without the final newline;
+ * malloc'ed by jansson (release with free), NULL when out of memory. */
+char *scene_equations_json(const scene *s, const mech_equations *eq, const scene_eq_texts *t);
+
+/** The JSON of `calcvar modes --json`, as scene_equations_json. */
+char *scene_modes_json(const scene *s, const mech_modes *md);
+
+/** "stable", "unstable" or "neutral". */
+const char *scene_mode_kind_name(mech_mode_kind k);
+
 #endif /* CV_SCENE_MECHANICS_H */

@@ -149,7 +149,7 @@ def test_problem_pointwise_constraint_and_free_end():
 def test_problem_equations():
     p = calcvar.Problem(integrand="m*q'^2/2 - k*q^2/2", interval=(0, 1),
                         boundary={"q": (0, 1)}, parameters={"m": 2, "k": 3})
-    eq = p.equations()
+    eq = p.equations()  # from the library since cv_equations_json
     assert set(eq) >= {"momenta", "euler_lagrange", "hamiltonian"}
     assert "q'" in eq["momenta"]["q"]
 
@@ -283,3 +283,97 @@ def test_solves_in_threads():
     for t in threads:
         t.join()
     assert sorted(out) == [2, 3, 4] and max(out.values()) < 1e-9
+
+
+# ---- mechanics from the library (cv_equations / cv_modes, no subprocess) ----------------
+
+def _evaluate(expr, values):
+    """An expression printed by calcvar (scene grammar) at the given values: y'' -> y_pp,
+    y' -> y_p, ^ -> **; math's functions."""
+    import re
+    py = re.sub(r"(\w+)''", r"\1_pp", expr)
+    py = re.sub(r"(\w+)'", r"\1_p", py).replace("^", "**")
+    env = {k: getattr(math, k) for k in ("sin", "cos", "tan", "exp", "log", "sqrt",
+                                          "sinh", "cosh", "tanh")}
+    env.update(values)
+    return eval(py, {"__builtins__": {}}, env)  # noqa: S307 — our own library's text
+
+
+@pytest.fixture
+def no_subprocess(monkeypatch):
+    def refuse(*_a, **_k):
+        raise AssertionError("a subprocess was started")
+    monkeypatch.setattr(subprocess, "run", refuse)
+    monkeypatch.setattr(subprocess, "Popen", refuse)
+
+
+def test_pendulum_euler_lagrange_exact(no_subprocess):
+    # L = m l^2 th'^2/2 + m g l cos th: p = m l^2 th', E = m l^2 th'' + m g l sin th,
+    # H = m l^2 th'^2/2 - m g l cos th (theory (P-3)..(P-5)); compared at random points to
+    # 1e-12 relative (the printed numbers are the shortest exact decimals).
+    m, l, g = 2.0, 1.5, 9.81
+    p = calcvar.Problem(integrand="m*l^2*th'^2/2 + m*g*l*cos(th)", interval=(0, 0.5),
+                        boundary={"th": (0, 1)}, variable="t",
+                        parameters={"m": m, "l": l, "g": g})
+    eq = p.equations()
+    assert eq["cyclic"] == [] and eq["autonomous"] is True
+    rng = np.random.default_rng(1)
+    for th, thp, thpp in rng.uniform(-2, 2, size=(20, 3)):
+        v = {"th": th, "th_p": thp, "th_pp": thpp}
+        exact_el = m * l * l * thpp + m * g * l * math.sin(th)
+        exact_p = m * l * l * thp
+        exact_h = m * l * l * thp**2 / 2 - m * g * l * math.cos(th)
+        for got, want in ((eq["euler_lagrange"]["th"], exact_el), (eq["momenta"]["th"], exact_p),
+                          (eq["hamiltonian"], exact_h)):
+            assert abs(_evaluate(got, v) - want) <= 1e-12 * (1 + abs(want)), got
+
+
+def test_free_particle_is_cyclic_and_scene_functions(no_subprocess):
+    # F = y'^2/2 + z'^2/2 - x*z: y cyclic (p_y conserved), F depends on x: not autonomous
+    text = ("[scene]\ninterval = 0, 1\nunknowns = y, z\nintegrand = y'^2/2 + z'^2/2 - x*z\n"
+            "[boundary]\ny = 0, 1\nz = 0, 1\n")
+    eq = calcvar.equations(text)
+    assert eq["cyclic"] == ["y"] and eq["autonomous"] is False
+
+
+def test_double_pendulum_modes_exact(no_subprocess):
+    # equal masses and lengths: w^2 = (g/l)(2 -+ sqrt 2), shapes b = +-sqrt(2) a; relative
+    # tolerance 1e-10 (a 2x2 generalised eigenproblem, exact to round-off)
+    g, l = 9.81, 2.0
+    md = calcvar.modes(scene("double_pendulum.scene"), set={"l": l})
+    assert md["equilibrium"] == pytest.approx({"a": 0.0, "b": 0.0}, abs=1e-12)
+    w2 = [k["omega2"] for k in md["modes"]]
+    exact = [g / l * (2 - math.sqrt(2)), g / l * (2 + math.sqrt(2))]
+    assert w2 == pytest.approx(exact, rel=1e-10)
+    assert [k["kind"] for k in md["modes"]] == ["stable", "stable"]
+    for k, sign in zip(md["modes"], (1, -1)):
+        assert k["shape"]["b"] / k["shape"]["a"] == pytest.approx(sign * math.sqrt(2),
+                                                                  rel=1e-10)
+
+
+def test_mechanics_equals_the_command():
+    # the library and `calcvar equations|modes --json` share one builder: same document
+    # (with a constraint's multiplier and with gyroscopic terms too)
+    for cmd, fn in (("equations", calcvar.equations), ("modes", calcvar.modes)):
+        for name in ("double_pendulum.scene", "pendulum_angle.scene", "pendulum_cartesian.scene",
+                     os.path.abspath(os.path.join(SCENES, "..", "..", "physics", "data",
+                                                  "magnetic_trap.scene"))):
+            r = subprocess.run([EXE, cmd, scene(name), "--json", "-"], capture_output=True,
+                               text=True, check=True)
+            assert fn(scene(name)) == json.loads(r.stdout)
+
+
+def test_modes_errors(no_subprocess):
+    # the Lagrangian depends on the variable: modes do not apply -> ValueError, FILE:LINE
+    p = calcvar.Problem(integrand="y'^2/2 + x*y", interval=(0, 1), boundary={"y": (0, 1)})
+    with pytest.raises(ValueError) as e:
+        p.modes()
+    assert str(e.value).startswith("<string>:") and e.value.status == "CVAR_EINVAL"
+    # a force nothing balances: no equilibrium -> CalcvarError, not ValueError
+    q = calcvar.Problem(integrand="y'^2/2 + y", interval=(0, 1), boundary={"y": (0, 1)})
+    with pytest.raises(calcvar.CalcvarError) as e:
+        q.modes()
+    assert not isinstance(e.value, ValueError)
+    assert e.value.status == "CVAR_EMAXITER" and "no equilibrium" in str(e.value)
+    with pytest.raises(ValueError, match="nosuch.scene"):
+        calcvar.equations("nosuch.scene")

@@ -4,7 +4,8 @@
  * succeeds. Each failing step must report a failure (NULL with a message, a status, -1),
  * never crash. (The scene's guess is a callback that compiles its expression when called:
  * an allocation failing there reaches the solver as CVAR_ECALLBACK, the status of a callback
- * that reported an error.) ASan (the sanitised CI run) checks that nothing leaks on any of these paths.
+ * that reported an error.) The mechanics (cv_equations_new, cv_modes_new: the constrained
+ * equilibrium of the rod) must come back NULL with a status and a sentence. ASan (the sanitised CI run) checks that nothing leaks on any of these paths.
  * SPDX-License-Identifier: MIT
  */
 #include <stdio.h>
@@ -12,6 +13,7 @@
 
 #include "core/cv_memory.h"
 #include "scene/scene.h"
+#include "scene/scene_internal.h" /* struct cv_scene, to call cv_equations_new on s */
 
 static int failures, checks;
 
@@ -111,6 +113,32 @@ int main(void)
   }
   truth("problem, solve and energy succeed once allocations do", ok, "never succeeded");
   printf("problem/solve/energy: %d injection points\n", k);
+
+  /* The mechanics of the scene through the public handles. */
+  for (int which = 0; which < 2; which++) {
+    ok = 0;
+    for (k = 0; k < 100000 && !ok; k++) {
+      scene *s = load(err);
+      truth("load without injection", s != NULL, err);
+      if (!s)
+        break;
+      struct cv_scene sc = {s};
+      cv_status why = CVAR_OK;
+      err[0] = '\0';
+      cv_debug_fail_alloc_after(k);
+      void *h = which == 0 ? (void *)cv_equations_new(&sc, &why, err, sizeof err)
+                           : (void *)cv_modes_new(&sc, &why, err, sizeof err);
+      cv_debug_fail_alloc_after(-1);
+      snprintf(what, sizeof what, "%s, allocation %d fails", which ? "modes" : "equations", k);
+      if (h) ok = 1;
+      else truth(what, err[0] != '\0' && why == CVAR_ENOMEM, cv_status_name(why));
+      if (which == 0) cv_equations_free(h);
+      else cv_modes_free(h);
+      scene_free(s);
+    }
+    truth("mechanics succeeds once allocations do", ok, which ? "modes" : "equations");
+    printf("%s: %d injection points\n", which ? "modes" : "equations", k);
+  }
 
   printf("%d checks, %d failed\n", checks, failures);
   return failures ? 1 : 0;
