@@ -53,6 +53,24 @@ static int parse_num(const char *s, size_t len, double *out)
   if (i < len && s[i] == '.') {
     i++;
     while (i < len && s[i] >= '0' && s[i] <= '9') {
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+      /* eight digits at once when they keep m within 19 significant digits (m != 0: all
+       * eight count); the first byte is the most significant digit */
+      if (m && nd <= 11 && len - i >= 8) {
+        uint64_t w;
+        memcpy(&w, s + i, 8);
+        if ((w & 0xF0F0F0F0F0F0F0F0ull) == 0x3030303030303030ull &&
+            ((w + 0x0606060606060606ull) & 0xF0F0F0F0F0F0F0F0ull) == 0x3030303030303030ull) {
+          w -= 0x3030303030303030ull;
+          w = w * 10 + (w >> 8); /* pairs of digits in the even bytes */
+          w = ((w & 0x000000FF000000FFull) * (100 + (1000000ull << 32)) +
+               ((w >> 16) & 0x000000FF000000FFull) * (1 + (10000ull << 32))) >> 32;
+          m = m * 100000000u + (uint32_t)w;
+          nd += 8, frac += 8, digits += 8, i += 8;
+          continue;
+        }
+      }
+#endif
       if (nd < 19) {
         m = m * 10 + (uint64_t)(s[i] - '0');
         if (m) nd++;
