@@ -726,9 +726,10 @@ typedef struct {
  * Otherwise the status and getters describe the failed plain solve. A later cv_solve
  * forgets the paths. */
 CVAR_API cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max);
-/** Work limit of cv_solve_all: its Newton iterations after the first solve (deflated and
- * polishing) stop at factor (>= 1, default 8) times the iterations of that first solve
- * (counted as at least 8). */
+/** Work limit of cv_solve_all: no new start is begun once its Newton iterations (deflated
+ * and polishing) since the last new path was found, or since the search began, reach factor
+ * (>= 1, default 2) times the iterations of the first solve (counted as at least 8) and
+ * every path has had two perturbations; each path found renews it (theory DF-4). */
 CVAR_API cv_status cv_solver_set_search_work(cv_solver *s, double factor);
 /** Number of distinct converged paths of the last cv_solve_all (0 otherwise). */
 CVAR_API int cv_solver_get_num_solutions(const cv_solver *s);

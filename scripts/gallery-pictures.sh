@@ -12,7 +12,7 @@ for scene in examples/scenes/*.scene; do
   name=$(basename "$scene" .scene)
   extra=()
   # the mirage's page shows every ray (docs/mirage.md), not the one a plain solve finds
-  [ "$name" = mirage ] && extra=(--all --work 100)
+  [ "$name" = mirage ] && extra=(--all)
   "$dir/src/cli/calcvar" solve "$scene" --quiet "${extra[@]}" --plot "docs/gallery/$name.png"
   echo "docs/gallery/$name.png"
 done

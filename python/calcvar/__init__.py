@@ -182,7 +182,9 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
     scene: a path (str or os.PathLike) or the text of a scene (any str with a newline or
     starting with '[').  Options mirror the command: elements, degree (1..8), method
     ("newton", "lbfgs", ...), tolerance (Newton step), max_iterations, adapt (target max
-    nodal error), set={name: value} overriding [parameters].  progress: a function called
+    nodal error at a fixed degree), tol (target max nodal error: calcvar chooses the
+    mesh and the degree of each element, as `calcvar solve --tol`), set={name: value}
+    overriding [parameters].  progress: a function called
     with a dict after every Newton iteration and adaptive round (keys kind, iteration,
     residual, step, alpha, action, round, elements, estimate); returning True cancels.
     verbose=True prints those lines.
@@ -194,10 +196,6 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
     Bad input raises InputError (a ValueError) with the FILE:LINE sentence. A solve that
     does not converge is not an exception: look at Solution.status / .success.
     """
-    if tol is not None:
-        raise NotImplementedError("tol=: the accuracy target of `calcvar solve --tol` is not "
-                                  "in this build of the library yet; adapt=TOL refines the "
-                                  "mesh until the estimated max nodal error is below TOL")
     if all and (isinstance(max_paths, bool) or not isinstance(max_paths, int)
                 or max_paths < 1):
         raise InputError("CVAR_EINVAL", "max_paths=%r: a whole number >= 1 is needed"
@@ -207,7 +205,7 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
     problem = solver = None
     try:
         options = {"elements": elements, "degree": degree, "tolerance": tolerance,
-                   "max_iterations": max_iterations, "adapt": adapt}
+                   "max_iterations": max_iterations, "adapt": adapt, "tol": tol}
         if method is not None:
             code = ctypes.c_int()
             if not isinstance(method, str) or lib.cv_method_from_name(

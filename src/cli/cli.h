@@ -28,7 +28,7 @@ typedef struct {
   const char *json, *csv, *plot;
   int quiet, help, verbose;
   int all, max_paths; /* --all, --max K (0: default 8) */
-  double work;        /* --work F: the search's work limit (0: default 8) */
+  double work;        /* --work F: the search's work limit (0: the default, 2) */
 } cli_opts;
 
 /* args.c: parse argv (after the command word). Returns 0, or EXIT_BADINPUT after printing

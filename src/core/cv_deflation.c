@@ -10,6 +10,7 @@
  * scaled by 1 / (1 - r.delta0), r = grad M / M (DF-3): one LDL^T solve per iteration, the
  * same as plain Newton.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,8 +22,13 @@
 #define DEFL_MAXIT 25   /* deflated Newton iterations per start */
 #define WORK_FLOOR 8    /* the first solve counts as at least this many iterations */
 #define EIG_DIRS 3      /* lowest Hessian eigen-directions per path (DF-4) */
-#define EIG_STEPS 6     /* block inverse-iteration steps */
-#define MAX_BACKTRACK 20
+#define MIN_TRIES 2 /* perturbations every path gets before the work limit may stop (DF-4) */
+#define EIG_STEPS 4     /* block inverse-iteration steps */
+#define MAX_BACKTRACK 12 /* deflated line search: a step cut below 2^-12 is no progress */
+#define TAU_BIG 10.0     /* |1 / (1 - r.delta0)| above this: deflation dominates (DF-3) */
+#define STALL_DROP 0.9   /* ... and |G| fell by less than 10% over two such steps: abandon */
+#define CRAWL_ALPHA 0.0625 /* a step cut to this or less is a crawl ... */
+#define CRAWL_RUN 8        /* ... and this many in a row that did not halve |G|: abandon */
 #define ARMIJO 1e-4
 #define SAME_FLOOR 1e-6 /* paths closer than this times their size are one (DF-5) */
 
@@ -245,7 +251,10 @@ static cv_status defl_run(defl *w, const cv_solver *s, double *Y, int maxit, int
   memcpy(w->Mt, w->M, (w->nmult + 1) * sizeof *w->M);
   st = cv_kkt_eval(&w->kkt, Y, w->M, &S, w->g, Ax, w->dreg);
   if (st) return st;
-  double Mv = deflation(w, Y, w->r), phi = merit(w, w->g, Mv);
+  double Mv = deflation(w, Y, w->r), phi = merit(w, w->g, Mv), phi_big = phi;
+  int big = 0;                /* consecutive iterations with |tau| > TAU_BIG */
+  int crawl = 0;              /* consecutive steps cut to CRAWL_ALPHA or less */
+  double phi_crawl = phi;     /* the merit before the first of them */
   for (int it = 0; it < maxit; it++) {
     int neg;
     double dmin, dmax;
@@ -274,6 +283,15 @@ static cv_status defl_run(defl *w, const cv_solver *s, double *Y, int maxit, int
     double den = 1.0 - rd;
     if (!(fabs(den) > 1e-14)) return CVAR_ESINGULAR;
     double tau = 1.0 / den, alpha = 1.0, St, Mt = 0.0, phit = 0.0;
+    /* Abandon (DF-3) when the deflation term has dominated the step for two iterations
+     * running and the deflated residual |G| has not fallen by a tenth over them: the
+     * iterate circles a pole of M's gradient rather than approaching a root. */
+    if (fabs(tau) > TAU_BIG) {
+      if (big++ >= 1 && phi > STALL_DROP * STALL_DROP * phi_big) return CVAR_ESTALL;
+      if (big == 1) phi_big = phi;
+    } else {
+      big = 0;
+    }
     int ok = 0;
     for (int ls = 0; ls < MAX_BACKTRACK; ls++, alpha *= 0.5) {
       put(w, Y, w->M, alpha * tau, w->delta, w->Yt, w->Mt);
@@ -289,6 +307,13 @@ static cv_status defl_run(defl *w, const cv_solver *s, double *Y, int maxit, int
       }
     }
     if (!ok) return CVAR_ESTALL;
+    /* a crawl: CRAWL_RUN cut steps in a row that have not halved |G| (DF-3) */
+    if (alpha > CRAWL_ALPHA) {
+      crawl = 0;
+    } else {
+      if (crawl++ == 0) phi_crawl = phi;
+      if (crawl >= CRAWL_RUN && phit > 0.25 * phi_crawl) return CVAR_ESTALL;
+    }
     memcpy(Y, w->Yt, (size_t)d->ndof * sizeof *Y);
     memcpy(w->M, w->Mt, (w->nmult + 1) * sizeof *w->M);
     st = cv_kkt_eval(&w->kkt, Y, w->M, &St, w->g, Ax, w->dreg); /* and its Hessian */
@@ -415,7 +440,8 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
   memset(&w, 0, sizeof w);
   cv_disc ds;
   memset(&ds, 0, sizeof ds);
-  double *Y = NULL, *xs = NULL, *ev = NULL, *E = NULL, *V = NULL;
+  double *Y = NULL, *xs = NULL, *ev = NULL, *E = NULL, **V = NULL;
+  int *nmodes = NULL, *cursor = NULL;
   cv_meshspec spec0 = s->mesh;
   double *t = NULL, adapt_tol = s->adapt_tol, *start0 = s->start;
   int start_len0 = s->start_len, cont0 = s->continuation;
@@ -434,9 +460,11 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
   /* 1. The plain solve from the guess (retries, continuation, adaptation as usual). */
   first = st = cv_solve(s, p);
   info->starts = 1;
-  /* Bounded work (DF-4): Newton iterations of the search, deflated and polishing, at most
-   * search_work times those of the first solve (counted as at least WORK_FLOOR). */
-  int work = 0, budget = (int)fmin(1e9, s->search_work * fmax(WORK_FLOOR, s->iterations));
+  /* Bounded work (DF-4): the search stops once its Newton iterations (deflated and
+   * polishing) since the last new path (or since it began) reach search_work times those
+   * of the first solve (counted as at least WORK_FLOOR): each path found renews it. */
+  int work = 0, found_at = 0;
+  int budget = (int)fmin(1e9, s->search_work * fmax(WORK_FLOOR, s->iterations));
   memcpy(msg0, s->msg, sizeof msg0);
   if (!s->have) goto finish; /* bad input: nothing to search around */
   /* 2. The search mesh: the mesh of that solve, frozen (DF-5); adaptation only polishes. */
@@ -471,27 +499,34 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
   xs = cv_malloc((size_t)ds.nodes * sizeof *xs);
   ev = cv_malloc(nd * sizeof *ev);
   E = cv_malloc(nd * sizeof *E);
-  V = cv_malloc((size_t)EIG_DIRS * (ds.nfree ? ds.nfree : 1) * sizeof *V);
-  if (!Y || !xs || !ev || !E || !V) goto nomem;
+  V = cv_calloc((size_t)max, sizeof *V);
+  nmodes = cv_malloc((size_t)max * sizeof *nmodes);
+  cursor = cv_calloc((size_t)max, sizeof *cursor);
+  if (!Y || !xs || !ev || !E || !V || !nmodes || !cursor) goto nomem;
+  for (int k = 0; k < max; k++) nmodes[k] = -1;
   s->start = NULL; /* restored below; the polishing solves set their own */
   s->start_len = 0;
   s->continuation = 0;
   if (first == CVAR_OK && keep_path(s, ps, &w, xs, ev, E, ests) < 0) goto nomem;
   if (first != CVAR_OK) info->failed++;
 
-  /* 3. Starts (DF-4): the guess and the straight line, deflated; then around every path
-   * found, in order, perturbations along its EIG_DIRS softest Hessian directions. */
-  static const double amp[] = {0.5, -0.5, 1.5, -1.5};
-  int namp = (int)(sizeof amp / sizeof amp[0]);
-  int around = 0; /* the path whose perturbations are being tried */
-  int nmodes = -1, mode = 0, ai = 0, phase = 0;
+  /* 3. Starts (DF-4): the guess and the straight line, deflated; then perturbations along
+   * the EIG_DIRS softest Hessian directions of the paths found, by promise: the next start
+   * is the least-tried path's next perturbation (a new path's first ones come at once),
+   * ties to the lower Morse index; on each path all +-1/2 ones before the +-3/2 ones. */
+  static const double amp[] = {0.5, 1.5};
+  int namp = 2 * (int)(sizeof amp / sizeof amp[0]);
+  int phase = 0;
   for (;;) {
     if (ps->n >= max) {
       cv_set_msg(info->stop, sizeof info->stop, "found the %d path%s asked for", max,
                  max == 1 ? "" : "s");
       break;
     }
-    if (work >= budget) {
+    int least = INT_MAX; /* the fewest perturbations tried on a path not yet exhausted */
+    for (int j = 0; j < w.nknown; j++)
+      if ((nmodes[j] < 0 || cursor[j] < namp * nmodes[j]) && cursor[j] < least) least = cursor[j];
+    if (work - found_at >= budget && least >= MIN_TRIES) {
       cv_set_msg(info->stop, sizeof info->stop,
                  "the work limit was reached (%d Newton iterations)", work);
       break;
@@ -515,35 +550,39 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
                    "perturb");
         break;
       }
-      if (around >= w.nknown) {
+      int k = -1; /* the path to perturb next */
+      for (int j = 0; j < w.nknown; j++) {
+        if (nmodes[j] >= 0 && cursor[j] >= namp * nmodes[j]) continue; /* exhausted */
+        if (k < 0 || cursor[j] < cursor[k] ||
+            (cursor[j] == cursor[k] && ps->v[j].morse < ps->v[k].morse))
+          k = j;
+      }
+      if (k < 0) {
         cv_set_msg(info->stop, sizeof info->stop,
                    "every start was tried (the guess, the straight line and %d perturbations "
                    "of each path found)", EIG_DIRS * namp);
         break;
       }
-      if (nmodes < 0) {
-        nmodes = low_modes(&w, w.known[around], V);
-        mode = ai = 0;
-      }
-      if (mode >= nmodes) {
-        around++;
-        nmodes = -1;
+      if (nmodes[k] < 0) {
+        V[k] = cv_malloc((size_t)EIG_DIRS * ds.nfree * sizeof **V);
+        if (!V[k]) goto nomem;
+        nmodes[k] = low_modes(&w, w.known[k], V[k]);
         continue;
       }
-      const double *K = w.known[around], *vm = V + (size_t)mode * ds.nfree;
+      int c = cursor[k]++, grp = c / (2 * nmodes[k]), mode = c % (2 * nmodes[k]) / 2;
+      const double *K = w.known[k], *vm = V[k] + (size_t)mode * ds.nfree;
       double size = 1.0, vmax = 0.0;
       for (size_t i = 0; i < nd; i++) size = fmax(size, fabs(K[i]));
       for (int f = 0; f < ds.nfree; f++) vmax = fmax(vmax, fabs(vm[f]));
       memcpy(Y, K, nd * sizeof *Y);
-      double a = vmax > 0 ? amp[ai] * size / vmax : 0.0;
+      double a = vmax > 0 ? (c % 2 ? -amp[grp] : amp[grp]) * size / vmax : 0.0;
       for (int f = 0; f < ds.nfree; f++)
         if (w.gof[f] >= 0) Y[w.gof[f]] += a * vm[f];
-      if (++ai == namp) ai = 0, mode++;
     }
     info->starts++;
     int it = 0;
-    int left = budget - work;
-    st = w.nknown ? defl_run(&w, s, Y, left < DEFL_MAXIT ? left : DEFL_MAXIT, &it) : CVAR_OK;
+    /* a start that begins within the limit runs to its end (at most DEFL_MAXIT) */
+    st = w.nknown ? defl_run(&w, s, Y, DEFL_MAXIT, &it) : CVAR_OK;
     work += it;
     if (st) {
       info->failed++;
@@ -563,6 +602,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
     int added = keep_path(s, ps, &w, xs, ev, E, ests);
     if (added < 0) goto nomem;
     if (!added) info->duplicates++;
+    else found_at = work; /* a new path renews the allowance */
   }
   st = CVAR_OK;
   goto finish;
@@ -583,7 +623,10 @@ finish:
   cv_free(xs);
   cv_free(ev);
   cv_free(E);
+  for (int k = 0; V && k < max; k++) cv_free(V[k]);
   cv_free(V);
+  cv_free(nmodes);
+  cv_free(cursor);
   cv_free(ests);
   defl_free(&w);
   cv_disc_free(&ds);

@@ -18,7 +18,7 @@ cv_solver *cv_solver_new(cv_status *why) {
   s->rtol = s->atol = 1e-10;
   s->maxit = 50;
   s->continuation = 1;
-  s->search_work = 8.0;
+  s->search_work = 2.0;
   s->adapt_max = 1000000;
   s->err_est = NAN;
   s->status = CVAR_ESTATE;

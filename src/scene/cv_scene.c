@@ -160,11 +160,21 @@ cv_status cv_scene_set_option(cv_scene *sc, const char *name, double value, char
     s->tolerance = value;
   else if (strcmp(name, "adapt") == 0 && (ok = isfinite(value) && value >= 0))
     s->adapt = value;
+  else if (strcmp(name, "tol") == 0 && (ok = isfinite(value) && value >= 0))
+    s->tol = value;
   else if (ok && strcmp(name, "elements") && strcmp(name, "degree") &&
            strcmp(name, "max_iterations") && strcmp(name, "method") &&
-           strcmp(name, "tolerance") && strcmp(name, "adapt")) {
+           strcmp(name, "tolerance") && strcmp(name, "adapt") && strcmp(name, "tol")) {
     say(err, errlen, "unknown option '%s' (known: elements, degree, tolerance, "
-        "max_iterations, adapt, method)", name);
+        "max_iterations, adapt, tol, method)", name);
+    return CVAR_EINVAL;
+  }
+  if (ok && s->tol > 0 && s->adapt > 0) {
+    /* as `solve --tol` with `--adapt`: two accuracy rules at once */
+    say(err, errlen, "%s", "tol and adapt may not be given together (tol chooses the degrees "
+        "too; adapt refines at a fixed degree)");
+    if (strcmp(name, "tol") == 0) s->tol = 0;
+    else s->adapt = 0;
     return CVAR_EINVAL;
   }
   if (!ok) {

@@ -216,7 +216,7 @@ turns = [bisect(lambda u: reach(u) - L, ts[k], ts[k + 1], 60)
 mirage = os.path.join(os.path.dirname(data), "..", "examples", "scenes", "mirage.scene")
 with tempfile.TemporaryDirectory() as tmp:
     c = os.path.join(tmp, "m.csv")
-    r = run("solve", mirage, "--all", "--work", "100", "--json", "-", "--csv", c)
+    r = run("solve", mirage, "--all", "--json", "-", "--csv", c)  # default work limit
     if r.returncode == 0:
         out = json.loads(r.stdout)
         rows = list(csv.reader(open(c)))[1:]

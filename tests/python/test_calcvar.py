@@ -195,9 +195,19 @@ def test_versions():
     assert calcvar.dependency_versions().startswith("CHOLMOD ")
 
 
-def test_not_yet_built_options_refuse():
-    with pytest.raises(NotImplementedError, match="tol"):
-        calcvar.solve(CATENARY, tol=1e-8)
+def test_tol_chooses_the_mesh():
+    # as `calcvar solve --tol`: the estimate is at most T, the true error below 10 T and
+    # not far above the estimate; degrees per element add up to the nodes
+    for T in (1e-6, 1e-10):
+        sol = calcvar.solve(CATENARY, tol=T)
+        assert sol.status == "converged"
+        r = sol.report
+        assert r["error_estimate"] <= T
+        true = np.max(np.abs(sol["y"] - 2 * np.cosh(sol.x / 2)))
+        assert true <= 10 * T and r["error_estimate"] >= 0.1 * true
+        assert r["nodes"] == 1 + sum(r["degrees"]) and r["degree"] == max(r["degrees"])
+    with pytest.raises(ValueError, match="together"):
+        calcvar.solve(CATENARY, tol=1e-8, adapt=1e-8)
 
 
 BRATU = """[scene]
