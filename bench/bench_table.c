@@ -139,20 +139,20 @@ int main(int argc, char **argv) {
   printf("\n(3) reading a %d^3 CSV grid (x, y, z, value; 17 significant digits)\n", N);
   char tmp[] = "/tmp/bench_table_XXXXXX", *path = argc > 2 ? argv[2] : tmp;
   if (argc <= 2) {
-  int fd = mkstemp(path);
-  FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
-  if (!f) return 1;
-  t0 = now();
-  fprintf(f, "x,y,z,v\n");
-  for (int i = 0; i < N; i++)
-    for (int j = 0; j < N; j++)
-      for (int k = 0; k < N; k++) {
-        double u[3] = {(double)i / (N - 1), (double)j / (N - 1), (double)k / (N - 1)};
-        fprintf(f, "%.17g,%.17g,%.17g,%.17g\n", u[0], u[1], u[2], fisheye(u, 3));
-      }
-  fclose(f);
-  t1 = now();
-  printf("  (writing it: %.2f s)\n", t1 - t0);
+    int fd = mkstemp(path);
+    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (!f) return 1;
+    t0 = now();
+    fprintf(f, "x,y,z,v\n");
+    for (int i = 0; i < N; i++)
+      for (int j = 0; j < N; j++)
+        for (int k = 0; k < N; k++) {
+          double u[3] = {(double)i / (N - 1), (double)j / (N - 1), (double)k / (N - 1)};
+          fprintf(f, "%.17g,%.17g,%.17g,%.17g\n", u[0], u[1], u[2], fisheye(u, 3));
+        }
+    fclose(f);
+    t1 = now();
+    printf("  (writing it: %.2f s)\n", t1 - t0);
   }
   char err[SC_ERRLEN] = "";
   t0 = now();

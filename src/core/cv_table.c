@@ -28,10 +28,10 @@ typedef struct {
 struct cv_table {
   atomic_int refs;
   int dim;
-  size_t size;         /* number of grid values */
-  size_t stride[3];    /* index of (i0, i1, i2) = i0*stride[0] + i1*stride[1] + i2 */
+  size_t size;      /* number of grid values */
+  size_t stride[3]; /* index of (i0, i1, i2) = i0*stride[0] + i1*stride[1] + i2 */
   tb_axis ax[3];
-  double *G[8];        /* G[mask], each `size` doubles */
+  double *G[8]; /* G[mask], each `size` doubles */
 };
 
 static void axis_free(tb_axis *a) {
@@ -157,18 +157,18 @@ static cv_table *table_build(int dim, const int *n, const double *const *coords,
                              const double *values, double *owned, cv_status *why, char *msg,
                              size_t len);
 
-cv_table *cv_table_new(int dim, const int *n, const double *const *coords,
-                       const double *values, cv_status *why) {
+cv_table *cv_table_new(int dim, const int *n, const double *const *coords, const double *values,
+                       cv_status *why) {
   return cv_table_new_msg(dim, n, coords, values, why, NULL, 0);
 }
 
-cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords,
-                           const double *values, cv_status *why, char *msg, size_t len) {
+cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords, const double *values,
+                           cv_status *why, char *msg, size_t len) {
   return table_build(dim, n, coords, values, NULL, why, msg, len);
 }
 
-cv_table *cv_table_new_owned(int dim, const int *n, const double *const *coords,
-                             double *values, cv_status *why, char *msg, size_t len) {
+cv_table *cv_table_new_owned(int dim, const int *n, const double *const *coords, double *values,
+                             cv_status *why, char *msg, size_t len) {
   return table_build(dim, n, coords, NULL, values, why, msg, len);
 }
 
@@ -188,8 +188,8 @@ static cv_table *table_build(int dim, const int *n, const double *const *coords,
   size_t size = 1;
   for (int k = 0; k < dim; k++) {
     if (n[k] < 4) {
-      cv_set_msg(msg, len, "coordinate %d has %d value%s; a cubic spline needs at least 4",
-                 k + 1, n[k], n[k] == 1 ? "" : "s");
+      cv_set_msg(msg, len, "coordinate %d has %d value%s; a cubic spline needs at least 4", k + 1,
+                 n[k], n[k] == 1 ? "" : "s");
       goto fail;
     }
     if (!coords[k]) goto fail;
@@ -206,8 +206,7 @@ static cv_table *table_build(int dim, const int *n, const double *const *coords,
   t->size = size;
   for (int k = 0; k < dim; k++)
     if (axis_init(&t->ax[k], n[k], coords[k], msg, len, k) != 0) {
-      if (!t->ax[k].x || !t->ax[k].h || !t->ax[k].ih || !t->ax[k].c || !t->ax[k].r ||
-          !t->ax[k].lo)
+      if (!t->ax[k].x || !t->ax[k].h || !t->ax[k].ih || !t->ax[k].c || !t->ax[k].r || !t->ax[k].lo)
         goto nomem;
       goto fail;
     }
@@ -283,15 +282,19 @@ static int find_cell(const tb_axis *a, double u) {
     i = (int)s;
     if (i > n - 2) i = n - 2;
     /* round-off in s: step to the cell that really holds u */
-    if (i > 0 && u < x[i]) i--;
-    else if (i < n - 2 && u >= x[i + 1]) i++;
+    if (i > 0 && u < x[i])
+      i--;
+    else if (i < n - 2 && u >= x[i + 1])
+      i++;
     return i;
   }
   int lo = 0, hi = n - 1; /* x[lo] <= u <= x[hi] */
   while (hi - lo > 1) {
     int mid = lo + (hi - lo) / 2;
-    if (u < x[mid]) hi = mid;
-    else lo = mid;
+    if (u < x[mid])
+      hi = mid;
+    else
+      lo = mid;
   }
   return lo;
 }

@@ -31,15 +31,13 @@ enum { TB_MAXCOL = 4 };
 static int is_sp(char c) { return c == ' ' || c == '\t'; }
 
 /* Parse one number from s[0..len): the whole field must be the number. 0 or -1. */
-static int parse_num(const char *s, size_t len, double *out)
-{
+static int parse_num(const char *s, size_t len, double *out) {
   static const double p10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                  1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                  1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
   size_t i = 0;
   int neg = 0;
-  if (i < len && (s[i] == '-' || s[i] == '+'))
-    neg = s[i++] == '-';
+  if (i < len && (s[i] == '-' || s[i] == '+')) neg = s[i++] == '-';
   uint64_t m = 0;
   int nd = 0, frac = 0, digits = 0;
   while (i < len && s[i] >= '0' && s[i] <= '9') {
@@ -64,7 +62,8 @@ static int parse_num(const char *s, size_t len, double *out)
           w -= 0x3030303030303030ull;
           w = w * 10 + (w >> 8); /* pairs of digits in the even bytes */
           w = ((w & 0x000000FF000000FFull) * (100 + (1000000ull << 32)) +
-               ((w >> 16) & 0x000000FF000000FFull) * (1 + (10000ull << 32))) >> 32;
+               ((w >> 16) & 0x000000FF000000FFull) * (1 + (10000ull << 32))) >>
+              32;
           m = m * 100000000u + (uint32_t)w;
           nd += 8, frac += 8, digits += 8, i += 8;
           continue;
@@ -84,17 +83,13 @@ static int parse_num(const char *s, size_t len, double *out)
   if (digits && i < len && (s[i] == 'e' || s[i] == 'E')) {
     size_t j = i + 1;
     int eneg = 0;
-    if (j < len && (s[j] == '-' || s[j] == '+'))
-      eneg = s[j++] == '-';
-    if (j >= len || s[j] < '0' || s[j] > '9')
-      fast = 0;
+    if (j < len && (s[j] == '-' || s[j] == '+')) eneg = s[j++] == '-';
+    if (j >= len || s[j] < '0' || s[j] > '9') fast = 0;
     while (j < len && s[j] >= '0' && s[j] <= '9') {
-      if (e < 10000)
-        e = e * 10 + (s[j] - '0');
+      if (e < 10000) e = e * 10 + (s[j] - '0');
       j++;
     }
-    if (eneg)
-      e = -e;
+    if (eneg) e = -e;
     i = j;
   }
   if (fast && i == len && m < ((uint64_t)1 << 53)) {
@@ -114,10 +109,10 @@ static int parse_num(const char *s, size_t len, double *out)
   if (fast && i == len && m != 0) {
     int ex = e - frac;
     if (ex >= -27 && ex <= 27) {
-      static const long double p10l[28] = {
-          1e0L,  1e1L,  1e2L,  1e3L,  1e4L,  1e5L,  1e6L,  1e7L,  1e8L,  1e9L,
-          1e10L, 1e11L, 1e12L, 1e13L, 1e14L, 1e15L, 1e16L, 1e17L, 1e18L, 1e19L,
-          1e20L, 1e21L, 1e22L, 1e23L, 1e24L, 1e25L, 1e26L, 1e27L}; /* exact: 5^27 < 2^64 */
+      static const long double p10l[28] = {1e0L,  1e1L,  1e2L,  1e3L,  1e4L,  1e5L,  1e6L,  1e7L,
+                                           1e8L,  1e9L,  1e10L, 1e11L, 1e12L, 1e13L, 1e14L, 1e15L,
+                                           1e16L, 1e17L, 1e18L, 1e19L, 1e20L, 1e21L, 1e22L, 1e23L,
+                                           1e24L, 1e25L, 1e26L, 1e27L}; /* exact: 5^27 < 2^64 */
       long double L = ex < 0 ? (long double)m / p10l[-ex] : (long double)m * p10l[ex];
       uint64_t bits; /* x87 extended: the explicit 64-bit significand comes first */
       memcpy(&bits, &L, sizeof bits);
@@ -132,45 +127,38 @@ static int parse_num(const char *s, size_t len, double *out)
 #endif
   /* everything else (and every malformed field) through strtod on a copy */
   char buf[128];
-  if (len == 0 || len >= sizeof buf)
-    return -1;
+  if (len == 0 || len >= sizeof buf) return -1;
   memcpy(buf, s, len);
   buf[len] = '\0';
   char *end;
   errno = 0;
   double v = strtod(buf, &end);
-  if (end != buf + len)
-    return -1;
+  if (end != buf + len) return -1;
   *out = v;
   return 0;
 }
 
 /* Split one line [p, q) at commas into at most TB_MAXCOL + 1 trimmed fields. Returns the
  * count (TB_MAXCOL + 1 means "more"). */
-static int split(const char *p, const char *q, const char **fs, size_t *fl)
-{
+static int split(const char *p, const char *q, const char **fs, size_t *fl) {
   int n = 0;
   for (;;) {
     const char *c = memchr(p, ',', (size_t)(q - p));
     const char *end = c ? c : q;
     const char *a = p, *b = end;
-    while (a < b && is_sp(*a))
-      a++;
-    while (b > a && is_sp(b[-1]))
-      b--;
+    while (a < b && is_sp(*a)) a++;
+    while (b > a && is_sp(b[-1])) b--;
     if (n <= TB_MAXCOL) {
       fs[n] = a;
       fl[n] = (size_t)(b - a);
     }
     n++;
-    if (!c || n > TB_MAXCOL)
-      return n > TB_MAXCOL ? TB_MAXCOL + 1 : n;
+    if (!c || n > TB_MAXCOL) return n > TB_MAXCOL ? TB_MAXCOL + 1 : n;
     p = c + 1;
   }
 }
 
-static int cmp_double(const void *a, const void *b)
-{
+static int cmp_double(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
   return (x > y) - (x < y);
 }
@@ -181,11 +169,11 @@ static int cmp_double(const void *a, const void *b)
  * Texts that differ but read as one number ("0.5", "0.50", "-0", "0") share the grid index
  * later (rank), so the grid is that of the values, as before. */
 typedef struct {
-  const char **s;  /* by id: the text (in the file's buffer), its length, value, hash */
+  const char **s; /* by id: the text (in the file's buffer), its length, value, hash */
   size_t *len;
   double *v;
   uint64_t *hash;
-  uint32_t *slot;  /* open addressing: id + 1, 0 = empty */
+  uint32_t *slot; /* open addressing: id + 1, 0 = empty */
   size_t n, cap, nslot;
   const char *last; /* the previous row's text of this column and its id */
   size_t lastlen;
@@ -193,8 +181,7 @@ typedef struct {
   int unsorted; /* a new text's value was not above every earlier one */
 } tcol;
 
-static uint64_t text_hash(const char *s, size_t len)
-{
+static uint64_t text_hash(const char *s, size_t len) {
   uint64_t h = (uint64_t)len * 0x9E3779B97F4A7C15ull, w;
   for (; len >= 8; s += 8, len -= 8) {
     memcpy(&w, s, 8);
@@ -210,48 +197,38 @@ static uint64_t text_hash(const char *s, size_t len)
 }
 
 /* The id of the text s[0..len) with hash hh, or -1 when the column has not seen it. */
-static long tcol_find(const tcol *c, const char *s, size_t len, uint64_t hh)
-{
-  if (!c->nslot)
-    return -1;
+static long tcol_find(const tcol *c, const char *s, size_t len, uint64_t hh) {
+  if (!c->nslot) return -1;
   size_t mask = c->nslot - 1;
   for (size_t i = (size_t)hh & mask; c->slot[i]; i = (i + 1) & mask) {
     uint32_t id = c->slot[i] - 1;
-    if (c->hash[id] == hh && c->len[id] == len && memcmp(c->s[id], s, len) == 0)
-      return (long)id;
+    if (c->hash[id] == hh && c->len[id] == len && memcmp(c->s[id], s, len) == 0) return (long)id;
   }
   return -1;
 }
 
 /* Add a new text with its value; its id, or -1 when out of memory. */
-static long tcol_add(tcol *c, const char *s, size_t len, double v, uint64_t hh)
-{
+static long tcol_add(tcol *c, const char *s, size_t len, double v, uint64_t hh) {
   if (c->n == c->cap) {
     size_t ncap = c->cap ? c->cap * 2 : 64;
     const char **ns = cv_realloc(c->s, ncap * sizeof *ns);
-    if (ns)
-      c->s = ns;
+    if (ns) c->s = ns;
     size_t *nl = ns ? cv_realloc(c->len, ncap * sizeof *nl) : NULL;
-    if (nl)
-      c->len = nl;
+    if (nl) c->len = nl;
     double *nv = nl ? cv_realloc(c->v, ncap * sizeof *nv) : NULL;
-    if (nv)
-      c->v = nv;
+    if (nv) c->v = nv;
     uint64_t *nh = nv ? cv_realloc(c->hash, ncap * sizeof *nh) : NULL;
-    if (!nh)
-      return -1;
+    if (!nh) return -1;
     c->hash = nh;
     c->cap = ncap;
   }
   if ((c->n + 1) * 2 > c->nslot) {
     size_t ns = c->nslot ? c->nslot * 2 : 128, mask = ns - 1;
     uint32_t *sl = cv_calloc(ns, sizeof *sl);
-    if (!sl)
-      return -1;
+    if (!sl) return -1;
     for (size_t id = 0; id < c->n; id++) {
       size_t i = (size_t)c->hash[id] & mask;
-      while (sl[i])
-        i = (i + 1) & mask;
+      while (sl[i]) i = (i + 1) & mask;
       sl[i] = (uint32_t)id + 1;
     }
     cv_free(c->slot);
@@ -259,11 +236,9 @@ static long tcol_add(tcol *c, const char *s, size_t len, double v, uint64_t hh)
     c->nslot = ns;
   }
   size_t mask = c->nslot - 1, i = (size_t)hh & mask;
-  while (c->slot[i])
-    i = (i + 1) & mask;
+  while (c->slot[i]) i = (i + 1) & mask;
   c->slot[i] = (uint32_t)c->n + 1;
-  if (c->n && !(v > c->v[c->n - 1]))
-    c->unsorted = 1;
+  if (c->n && !(v > c->v[c->n - 1])) c->unsorted = 1;
   c->s[c->n] = s;
   c->len[c->n] = len;
   c->v[c->n] = v;
@@ -271,8 +246,7 @@ static long tcol_add(tcol *c, const char *s, size_t len, double v, uint64_t hh)
   return (long)c->n++;
 }
 
-static void tcol_free(tcol *c)
-{
+static void tcol_free(tcol *c) {
   cv_free(c->s);
   cv_free(c->len);
   cv_free(c->v);
@@ -284,26 +258,20 @@ static void tcol_free(tcol *c)
  * enumeration of the ids (the last coordinate fastest), the radices rad (0 = not known
  * yet: the digit has not wrapped around) being learnt on the way. Known radices are
  * always those of the last coordinates (a digit wraps only when all after it do). */
-static int order_next(int dim, const uint32_t *p, const uint32_t *t, uint32_t *rad)
-{
+static int order_next(int dim, const uint32_t *p, const uint32_t *t, uint32_t *rad) {
   int d = 0;
-  while (d < dim && t[d] == p[d])
-    d++;
-  if (d == dim || t[d] != p[d] + 1 || (rad[d] && t[d] >= rad[d]))
-    return 0;
+  while (d < dim && t[d] == p[d]) d++;
+  if (d == dim || t[d] != p[d] + 1 || (rad[d] && t[d] >= rad[d])) return 0;
   for (int e = d + 1; e < dim; e++)
-    if (t[e] != 0 || (rad[e] && p[e] + 1 != rad[e]))
-      return 0;
+    if (t[e] != 0 || (rad[e] && p[e] + 1 != rad[e])) return 0;
   for (int e = d + 1; e < dim; e++)
-    if (!rad[e])
-      rad[e] = p[e] + 1;
+    if (!rad[e]) rad[e] = p[e] + 1;
   return 1;
 }
 
 /* The ids of the rows 0 .. nrows-1 when they were the enumeration of order_next: row r
  * in mixed radix (an unknown radix takes what is left: the digits before it are 0). */
-static void decode_ids(int dim, const uint32_t *rad, size_t nrows, uint32_t *ids)
-{
+static void decode_ids(int dim, const uint32_t *rad, size_t nrows, uint32_t *ids) {
   for (size_t r = 0; r < nrows; r++) {
     size_t q = r;
     for (int e = dim - 1; e >= 0; e--) {
@@ -319,8 +287,7 @@ static void decode_ids(int dim, const uint32_t *rad, size_t nrows, uint32_t *ids
 }
 
 /* Index of x in the sorted distinct values c[0..n) (present by construction). */
-static int locate(const double *c, int n, double x)
-{
+static int locate(const double *c, int n, double x) {
   int lo = 0, hi = n - 1;
   while (lo < hi) {
     int mid = lo + (hi - lo) / 2;
@@ -334,18 +301,14 @@ static int locate(const double *c, int n, double x)
 
 /* The line of the data row number r (0-based; blank lines are no rows), the first row
  * being on or after `line` at p. Used only to report a repeated grid point. */
-static int row_line(const char *p, const char *end, int line, size_t r)
-{
+static int row_line(const char *p, const char *end, int line, size_t r) {
   for (;;) {
     const char *nl = memchr(p, '\n', (size_t)(end - p));
     const char *q = nl ? nl : end;
     const char *a = p;
-    while (a < q && (is_sp(*a) || *a == '\r'))
-      a++;
-    if (a < q && r-- == 0)
-      return line;
-    if (!nl)
-      return line;
+    while (a < q && (is_sp(*a) || *a == '\r')) a++;
+    if (a < q && r-- == 0) return line;
+    if (!nl) return line;
     p = nl + 1;
     line++;
   }
@@ -354,8 +317,7 @@ static int row_line(const char *p, const char *end, int line, size_t r)
 /* The file's bytes: mapped when it is a regular file (no copy; the page cache is read
  * in place), else read into a buffer grown by doubling. 0, or -1 with errno set (EIO for
  * a read error, ENOMEM). */
-static int table_bytes(int fd, char **text, size_t *len, int *mapped)
-{
+static int table_bytes(int fd, char **text, size_t *len, int *mapped) {
   struct stat sb;
   *mapped = 0;
   if (fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode) && sb.st_size > 0 &&
@@ -381,20 +343,17 @@ static int table_bytes(int fd, char **text, size_t *len, int *mapped)
       return -1;
     }
     ssize_t got = read(fd, buf + n, cap - n);
-    if (got < 0 && errno == EINTR)
-      continue;
+    if (got < 0 && errno == EINTR) continue;
     if (got < 0) {
       cv_free(buf);
       errno = EIO;
       return -1;
     }
-    if (got == 0)
-      break;
+    if (got == 0) break;
     n += (size_t)got;
     if (n == cap) {
       char *nb = cv_realloc(buf, cap *= 2);
-      if (!nb)
-        cv_free(buf);
+      if (!nb) cv_free(buf);
       buf = nb;
     }
   }
@@ -403,8 +362,7 @@ static int table_bytes(int fd, char **text, size_t *len, int *mapped)
   return 0;
 }
 
-cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t errlen)
-{
+cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t errlen) {
   cv_table *t = NULL;
   char *text = NULL;
   size_t len = 0;
@@ -414,8 +372,7 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
   unsigned char *seen = NULL;
   tcol tc[3];
   memset(tc, 0, sizeof tc);
-  for (int k = 0; k < 3; k++)
-    tc[k].lastlen = SIZE_MAX; /* matches no field */
+  for (int k = 0; k < 3; k++) tc[k].lastlen = SIZE_MAX; /* matches no field */
   size_t nrows = 0, caprows = 0;
 
   int fd = open(path, O_RDONLY | O_CLOEXEC);
@@ -438,8 +395,7 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
   int line = 1;
   const char *nl = len ? memchr(p, '\n', len) : NULL;
   const char *q = nl ? nl : end;
-  if (q > p && q[-1] == '\r')
-    q--;
+  if (q > p && q[-1] == '\r') q--;
   if (len && memchr(text, '\0', len)) {
     sc_err(err, errlen, shown, 0, "the table contains a NUL byte (not a text file)");
     goto done;
@@ -448,14 +404,14 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
   if (ncol < 2 || ncol > TB_MAXCOL) {
     sc_err(err, errlen, shown, 1,
            "the header must name 2 to 4 columns (1 to 3 coordinates, then the value), "
-           "found %s%d", ncol > TB_MAXCOL ? "more than " : "", ncol > TB_MAXCOL ? TB_MAXCOL : ncol);
+           "found %s%d",
+           ncol > TB_MAXCOL ? "more than " : "", ncol > TB_MAXCOL ? TB_MAXCOL : ncol);
     goto done;
   }
   for (int c = 0; c < ncol; c++) {
     double dummy;
     if (fl[c] == 0 || parse_num(fs[c], fl[c], &dummy) == 0) {
-      sc_err(err, errlen, shown, 1,
-             "the header must name every column (column %d is %s)", c + 1,
+      sc_err(err, errlen, shown, 1, "the header must name every column (column %d is %s)", c + 1,
              fl[c] ? "a number: is the header line missing?" : "empty");
       goto done;
     }
@@ -478,11 +434,9 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
     nl = memchr(p, '\n', (size_t)(end - p));
     q = nl ? nl : end;
     const char *r = q;
-    if (r > p && r[-1] == '\r')
-      r--;
+    if (r > p && r[-1] == '\r') r--;
     const char *a = p;
-    while (a < r && is_sp(*a))
-      a++;
+    while (a < r && is_sp(*a)) a++;
     if (a == r) { /* blank line */
       p = nl ? nl + 1 : end;
       continue;
@@ -490,30 +444,26 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
     int n = split(p, r, fs, fl);
     if (n != ncol) {
       sc_err(err, errlen, shown, line, "%s%d value%s in this row, the header has %d columns",
-             n > TB_MAXCOL ? "more than " : "", n > TB_MAXCOL ? TB_MAXCOL : n,
-             n == 1 ? "" : "s", ncol);
+             n > TB_MAXCOL ? "more than " : "", n > TB_MAXCOL ? TB_MAXCOL : n, n == 1 ? "" : "s",
+             ncol);
       goto done;
     }
     if (nrows == caprows) {
       /* a first guess from the file's size (about 40 bytes a row), then doubling */
       size_t ncap = caprows ? caprows * 2 : len / 32 + 1024;
-      if (ncap > UINT32_MAX)
-        ncap = UINT32_MAX;
+      if (ncap > UINT32_MAX) ncap = UINT32_MAX;
       if (nrows == ncap) {
-        sc_err(err, errlen, shown, line, "too many rows (at most %lu)",
-               (unsigned long)UINT32_MAX);
+        sc_err(err, errlen, shown, line, "too many rows (at most %lu)", (unsigned long)UINT32_MAX);
         goto done;
       }
       double *nv = cv_realloc(vals, ncap * sizeof *nv);
-      if (nv)
-        vals = nv;
+      if (nv) vals = nv;
       uint32_t *ni = nv && ids ? cv_realloc(ids, ncap * (size_t)dim * sizeof *ni) : NULL;
       if (!nv || (ids && !ni)) {
         sc_err(err, errlen, shown, line, "out of memory");
         goto done;
       }
-      if (ni)
-        ids = ni;
+      if (ni) ids = ni;
       caprows = ncap;
     }
     uint32_t rid[3];
@@ -542,8 +492,8 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
           goto done;
         }
         if (!isfinite(x)) {
-          sc_err(err, errlen, shown, line, "column '%s': %.*s is not a finite number",
-                 names[c], (int)(fl[c] < 40 ? fl[c] : 40), fs[c]);
+          sc_err(err, errlen, shown, line, "column '%s': %.*s is not a finite number", names[c],
+                 (int)(fl[c] < 40 ? fl[c] : 40), fs[c]);
           goto done;
         }
         id = tcol_add(T, fs[c], fl[c], x == 0 ? 0.0 : x, hh); /* -0 and 0: one coordinate */
@@ -603,12 +553,11 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
     qsort(coords[k], tc[k].n, sizeof *coords[k], cmp_double);
     size_t m = 0;
     for (size_t i = 0; i < tc[k].n; i++)
-      if (m == 0 || coords[k][i] != coords[k][m - 1])
-        coords[k][m++] = coords[k][i];
+      if (m == 0 || coords[k][i] != coords[k][m - 1]) coords[k][m++] = coords[k][i];
     if (m < 4) {
       sc_err(err, errlen, shown, 1,
-             "coordinate '%s' has %zu distinct value%s; a cubic spline needs at least 4",
-             names[k], m, m == 1 ? "" : "s");
+             "coordinate '%s' has %zu distinct value%s; a cubic spline needs at least 4", names[k],
+             m, m == 1 ? "" : "s");
       goto done;
     }
     rank[k] = cv_malloc(tc[k].n * sizeof *rank[k]);
@@ -622,20 +571,18 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
     size *= m;
   }
   stride[dim - 1] = 1;
-  for (int k = dim - 2; k >= 0; k--)
-    stride[k] = stride[k + 1] * (size_t)n[k + 1];
-#define TB_INDEX(r)                                                                         \
-  (dim == 1   ? (size_t)rank[0][ids[(r)]]                                                   \
-   : dim == 2 ? (size_t)rank[0][ids[2 * (r)]] * stride[0] + rank[1][ids[2 * (r) + 1]]        \
-              : (size_t)rank[0][ids[3 * (r)]] * stride[0] +                                 \
+  for (int k = dim - 2; k >= 0; k--) stride[k] = stride[k + 1] * (size_t)n[k + 1];
+#define TB_INDEX(r)                                                                                \
+  (dim == 1   ? (size_t)rank[0][ids[(r)]]                                                          \
+   : dim == 2 ? (size_t)rank[0][ids[2 * (r)]] * stride[0] + rank[1][ids[2 * (r) + 1]]              \
+              : (size_t)rank[0][ids[3 * (r)]] * stride[0] +                                        \
                     (size_t)rank[1][ids[3 * (r) + 1]] * stride[1] + rank[2][ids[3 * (r) + 2]])
   /* In the order of the grid: the ids are the enumeration of order_next, complete (as
    * many rows as points), and each coordinate's values came in increasing order (an
    * id is then the index in the sorted values). Otherwise the ids are needed. */
   int identity = inorder && nrows == size;
   for (int k = 0; k < dim; k++)
-    if (tc[k].unsorted || tc[k].n != (size_t)n[k])
-      identity = 0;
+    if (tc[k].unsorted || tc[k].n != (size_t)n[k]) identity = 0;
   if (inorder && !identity) {
     ids = cv_malloc(nrows * (size_t)dim * sizeof *ids);
     if (!ids) {
@@ -649,8 +596,7 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
     vals = NULL;
     if (caprows > size) { /* give back the unused tail */
       double *g = cv_realloc(grid, size * sizeof *g);
-      if (g)
-        grid = g;
+      if (g) grid = g;
     }
   } else {
     grid = cv_malloc(size * sizeof *grid);
@@ -663,8 +609,7 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
       size_t idx = TB_INDEX(r);
       if (seen[idx >> 3] & (1u << (idx & 7))) {
         size_t first = 0;
-        while (TB_INDEX(first) != idx)
-          first++;
+        while (TB_INDEX(first) != idx) first++;
         sc_err(err, errlen, shown, row_line(body, end, 2, r),
                "repeated grid point (also on line %d)", row_line(body, end, 2, first));
         goto done;
@@ -676,8 +621,7 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
 #undef TB_INDEX
   if (nrows != size) {
     size_t miss = 0;
-    while (seen[miss >> 3] & (1u << (miss & 7)))
-      miss++;
+    while (seen[miss >> 3] & (1u << (miss & 7))) miss++;
     size_t rest = miss;
     double u[3] = {0, 0, 0};
     for (int k = dim - 1; k >= 0; k--) {
@@ -687,11 +631,11 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
     char at[200];
     int o = 0;
     for (int k = 0; k < dim; k++)
-      o += snprintf(at + o, sizeof at - (size_t)o, "%s%s = %.17g", k ? ", " : "", names[k],
-                    u[k]);
+      o += snprintf(at + o, sizeof at - (size_t)o, "%s%s = %.17g", k ? ", " : "", names[k], u[k]);
     sc_err(err, errlen, shown, lastline,
            "the grid is not complete: %zu of %zu points are missing, e.g. %s (every "
-           "combination of the coordinate values must have a row)", size - nrows, size, at);
+           "combination of the coordinate values must have a row)",
+           size - nrows, size, at);
     goto done;
   }
   /* the table takes grid as its own array of values (freed by it on failure too) */
@@ -703,8 +647,7 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
   char msg[200];
   t = cv_table_new_owned(dim, n, (const double *const *)coords, grid, &why, msg, sizeof msg);
   grid = NULL;
-  if (!t)
-    sc_err(err, errlen, shown, 0, "%s", msg);
+  if (!t) sc_err(err, errlen, shown, 0, "%s", msg);
 done:
   if (mapped)
     munmap(text, len);
@@ -726,8 +669,7 @@ done:
  * for a scene without a file, e.g. standard input) or absolute. Loaded before every other
  * name, so parameters and definitions may not reuse a table's name and every expression
  * may call it. */
-int sc_load_tables(sc_loader *L)
-{
+int sc_load_tables(sc_loader *L) {
   scene *s = L->s;
   const char *file = s->file;
   const char *slash = strrchr(file, '/');
@@ -735,8 +677,7 @@ int sc_load_tables(sc_loader *L)
   size_t dirlen = from_file && slash ? (size_t)(slash - file) + 1 : 0;
   for (int i = 0; i < L->raw.ne[SEC_TABLES]; i++) {
     const sc_entry *e = &L->raw.e[SEC_TABLES][i];
-    if (sc_check_new_name(L, e->line, e->key, "a table") < 0)
-      return -1;
+    if (sc_check_new_name(L, e->line, e->key, "a table") < 0) return -1;
     if (!e->value[0]) {
       sc_err(L->err, L->errlen, L->file, e->line, "table '%s' needs a file name", e->key);
       return -1;

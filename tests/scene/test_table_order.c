@@ -49,8 +49,10 @@ static int check(const char *what, const char *path) {
         if (cv_table_eval(t, u, NULL, &got) != 0 || got != data(i, j, k)) bad++;
       }
   cv_table_free(t);
-  if (bad) fprintf(stderr, "FAIL %s: %d of %d grid points differ from the data\n", what, bad, NP);
-  else printf("ok %s\n", what);
+  if (bad)
+    fprintf(stderr, "FAIL %s: %d of %d grid points differ from the data\n", what, bad, NP);
+  else
+    printf("ok %s\n", what);
   return bad != 0;
 }
 
