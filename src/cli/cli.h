@@ -127,8 +127,9 @@ int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_converge_json(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_plot_converge(cli_outfile *o, const cli_conv_row *rows, int nrows);
 
-/* cli_all.c: `solve --all`: the deflated search, its reports; returns the exit status. */
-int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, double adapt,
+/* cli_all.c: `solve --all`: the deflated search, its reports; returns the exit status.
+ * adaptive as cli_report_build's: 0 a fixed mesh, 1 --adapt, 2 --tol. */
+int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, int adaptive,
                 cli_outfile *jf, cli_outfile *cf, cli_outfile *pf);
 
 /* Subcommands. */

@@ -188,7 +188,7 @@ done:
   return rc;
 }
 
-int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, double adapt,
+int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, int adaptive,
                 cli_outfile *jf, cli_outfile *cf, cli_outfile *pf)
 {
   int max = o->max_paths > 0 ? o->max_paths : 8, rc = EXIT_UNSOLVED;
@@ -215,7 +215,7 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, doubl
     goto oom;
   for (int k = 0; k < np; k++) {
     if (cv_solver_select_solution(sv, k) != CVAR_OK ||
-        cli_report_build(&r[k], s, p, sv, CVAR_OK, adapt > 0) < 0)
+        cli_report_build(&r[k], s, p, sv, CVAR_OK, adaptive) < 0)
       goto oom;
     keep[k] = 1;
   }

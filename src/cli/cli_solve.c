@@ -152,7 +152,7 @@ int cli_solve(int argc, char **argv)
   cli_progress_setup(o.verbose);
   cli_progress_attach(sv);
   if (o.all) {
-    rc = cli_all_run(&o, s, p, sv, adapt, &jf, &cf, &pf);
+    rc = cli_all_run(&o, s, p, sv, tol > 0 ? 2 : adapt > 0, &jf, &cf, &pf);
     cli_progress_end();
     goto done;
   }

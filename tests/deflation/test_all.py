@@ -113,6 +113,26 @@ if out:
         check("bratu path %d Morse index %d" % (k + 1, morse), s["morse_index"] == morse, s)
     check("bratu kinds", [s["stationary_kind"] for s in sols] == ["minimum", "saddle"], sols)
 
+# ---- Bratu with --tol: every path on its own hp mesh, true error <= 10 T, estimate honest
+for T in (1e-8, 1e-11):
+    out = with_nodes("bratu.scene", "--tol", repr(T))
+    check("bratu --tol %g: ran" % T, out is not None)
+    if not out:
+        continue
+    sols = out["solutions"]
+    check("bratu --tol %g: two paths" % T, len(sols) == 2, len(sols))
+    for k, (s, th) in enumerate(zip(sols, thetas)):
+        x, y = nodes(s)
+        exact = [-2 * math.log(math.cosh((xx - 0.5) * th / 2) / math.cosh(th / 4)) for xx in x]
+        err = max(abs(a - b) for a, b in zip(y, exact))
+        est = s.get("error_estimate", -1)
+        check("bratu --tol %g path %d: true error %.2g <= 10 T" % (T, k + 1, err), err <= 10 * T)
+        check("bratu --tol %g path %d: estimate %.2g <= T, >= 0.1 x true" % (T, k + 1, est),
+              0 <= est <= T and est >= 0.1 * err)
+        check("bratu --tol %g path %d: degrees and nodes" % (T, k + 1),
+              "degrees" in s and s["nodes"] == 1 + sum(s["degrees"])
+              and s["degree"] == max(s["degrees"]), s.get("degrees"))
+
 # ---- catenary between rings at x = -1, 1 of radius 2: shallow minimum, deep saddle
 out = with_nodes("catenary_two.scene")
 if out:
