@@ -32,4 +32,3 @@ void *cv_realloc(void *ptr, size_t n) {
 }
 
 void cv_free(void *ptr) { free(ptr); }
-
