@@ -224,6 +224,27 @@ int cli_scene_command_start(const char *cmd, int argc, char **argv, void (*usage
   return -1;
 }
 
+int cli_apply_accuracy(const cli_opts *o, scene *s)
+{
+  if ((o->tol > 0 && s->adapt > 0) || (o->adapt > 0 && s->tol > 0)) {
+    fprintf(stderr, "%s:%d: [mesh] %s cannot be combined with %s\n", s->file,
+            s->tol > 0 ? s->tol_line : s->adapt_line, s->tol > 0 ? "tol" : "adapt",
+            s->tol > 0 ? "--adapt" : "--tol");
+    return EXIT_BADINPUT;
+  }
+  if (o->adapt > 0)
+    s->adapt = o->adapt;
+  double tol = o->tol > 0 ? o->tol : s->tol;
+  if (tol > 0) { /* automatic accuracy: the scene's or the flags' mesh is only the start */
+    s->tol = tol;
+    if (!o->elements && !s->elements_line && s->grading <= 0)
+      s->elements = SCENE_TOL_START_ELEMENTS;
+    if (!o->degree && !s->degree_line)
+      s->degree = SCENE_TOL_START_DEGREE;
+  }
+  return 0;
+}
+
 void cli_apply_solver_options(const cli_opts *o, scene *s)
 {
   if (o->method >= 0)

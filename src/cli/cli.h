@@ -39,6 +39,10 @@ void cli_opts_free(cli_opts *o);
  * option was given, else 0. */
 int cli_only_scene_options(const char *cmd, const cli_opts *o);
 /* --method, --tolerance and --max-iterations, where given, override the scene's [solver]. */
+/* --tol and --adapt on a loaded scene: refuses (exit 2, with a message) a flag that
+ * contradicts the scene's [mesh] tol/adapt, sets the target, and for --tol the starting mesh
+ * when neither flags nor scene give one. Returns 0 or EXIT_BADINPUT. */
+int cli_apply_accuracy(const cli_opts *o, scene *s);
 void cli_apply_solver_options(const cli_opts *o, scene *s);
 
 /* progress.c: --verbose lines and the terminal status line (see there). */

@@ -33,10 +33,10 @@ static void usage(FILE *f)
         "  --threads N          rows solved at once (default: the cores available)\n"
         "  --warm               start each row from the previous row's solution\n"
         "  --elements N, --degree P, --method M, --tolerance T, --max-iterations K,\n"
-        "  --set name=value, --adapt TOL   as for calcvar solve, for every row\n"
+        "  --set name=value, --adapt TOL, --tol T   as for calcvar solve, for every row\n"
         "Output: the input columns, status, action, iterations, time_s, morse_index,\n"
-        "error_max_nodal (with [exact]) or error_estimate (with --adapt), one column per\n"
-        "[report] entry and integral multiplier (mu_NAME), message.\n"
+        "error_max_nodal (with [exact]), error_estimate (with --adapt, always with --tol),\n"
+        "one column per [report] entry and integral multiplier (mu_NAME), message.\n"
         "exit status: 0 every row converged, 1 some did not, 2 bad input\n", f);
 }
 
@@ -377,8 +377,10 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
   if (o->degree)
     s->degree = o->degree;
   cli_apply_solver_options(o, s);
-  if (o->adapt > 0)
-    s->adapt = o->adapt;
+  if (cli_apply_accuracy(o, s) != 0) {
+    scene_free(s);
+    goto done;
+  }
   if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) &&
       (s->ncons > 0 || s->nints > 0)) {
     fprintf(stderr, "calcvar batch: method %s cannot impose constraints; use mma, ccsaq, "
@@ -447,7 +449,8 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
   const scene *sc = scene_batch_scene(b);
   for (int i = 0; i < sc->n; i++)
     cols.err_nodal |= sc->exact[i] >= 0;
-  cols.err_est = !cols.err_nodal && sc->adapt > 0;
+  /* the estimate where it applies: --adapt without [exact], and --tol always (its target) */
+  cols.err_est = (!cols.err_nodal && sc->adapt > 0) || sc->tol > 0;
   if (f) {
     for (int c = 0; c < nc; c++)
       fprintf(f, "%s,", t.names[c]);

@@ -45,12 +45,6 @@ static void usage(FILE *f)
  * ignore a request. */
 static int unsupported(const cli_opts *o, const scene *s)
 {
-  if ((o->tol > 0 && s->adapt > 0) || (o->adapt > 0 && s->tol > 0)) {
-    fprintf(stderr, "%s:%d: [mesh] %s cannot be combined with %s\n", s->file,
-            s->tol > 0 ? s->tol_line : s->adapt_line, s->tol > 0 ? "tol" : "adapt",
-            s->tol > 0 ? "--adapt" : "--tol");
-    return EXIT_BADINPUT;
-  }
   if (o->cont && (o->adapt > 0 || s->adapt > 0 || o->tol > 0 || s->tol > 0)) {
     fprintf(stderr, "calcvar solve: --continue and adaptive refinement cannot be combined "
             "(continuation keeps one mesh)\n");
@@ -116,14 +110,9 @@ int cli_solve(int argc, char **argv)
   cli_apply_solver_options(&o, s);
   if ((rc = unsupported(&o, s)) != 0)
     goto done;
-  double tol = o.tol > 0 ? o.tol : s->tol;
-  if (tol > 0) { /* automatic accuracy: the scene's or the flags' mesh is only the start */
-    s->tol = tol;
-    if (!o.elements && !s->elements_line && s->grading <= 0)
-      s->elements = SCENE_TOL_START_ELEMENTS;
-    if (!o.degree && !s->degree_line)
-      s->degree = SCENE_TOL_START_DEGREE;
-  }
+  if ((rc = cli_apply_accuracy(&o, s)) != 0)
+    goto done;
+  double tol = s->tol;
   cv_status why;
   if ((!o.cont && !(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err))) ||
       !(sv = cv_solver_new(&why)) || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK) {

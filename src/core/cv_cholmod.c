@@ -18,7 +18,19 @@ struct cv_ldlt {
   pthread_t th;  /* the symbolic analysis, started by cv_ldlt_new on large systems */
   int running;   /* th has to be joined */
   int analysed;  /* cholmod_analyze has run (L->L set, or NULL on its failure) */
+  /* Small systems: the skyline LDL^T of this file instead (theory N-7); then c, A and L
+   * are unused and the matrix, its factor and the pivots live here. */
+  int sky;
+  int *colp;      /* column pointers of the envelope (A and U share them) */
+  double *ax, *u; /* A, and U = L^T with D(j) in place of U(j,j), column by column */
+  long minor;     /* first zero pivot, n if none */
+  long mono;      /* columns 0 .. mono - 1 have nondecreasing first rows */
 };
+
+/* Up to this many unknowns the skyline factor is used (tests may lower it to 0 to
+ * compare with CHOLMOD). Above it CHOLMOD: its analysis is paid once per mesh and its
+ * numeric factor is as fast (docs/performance.md). */
+int cv_ldlt_skyline_max = 512;
 
 /* Below this many unknowns the analysis takes under ~3 ms and a thread is not worth it. */
 #define ASYNC_ANALYSIS_MIN 50000
@@ -59,6 +71,34 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
   }
   cv_ldlt *L = cv_calloc(1, sizeof *L);
   if (!L) return CVAR_ENOMEM;
+  L->n = nfree;
+  if (nfree <= cv_ldlt_skyline_max) {
+    L->sky = 1;
+    L->colp = cv_malloc(((size_t)nfree + 1) * sizeof *L->colp);
+    if (!L->colp) {
+      cv_ldlt_free(L);
+      return CVAR_ENOMEM;
+    }
+    nnz = cv_disc_pattern(d, L->colp, gof);
+    L->ax = cv_calloc((size_t)(nnz ? nnz : 1), sizeof *L->ax);
+    L->u = cv_malloc((size_t)(nnz ? nnz : 1) * sizeof *L->u);
+    if (!L->ax || !L->u) {
+      cv_ldlt_free(L);
+      return CVAR_ENOMEM;
+    }
+    L->minor = nfree;
+    L->mono = nfree;
+    for (int c = 1, f0 = 0; c < nfree; c++) {
+      int f = c + 1 - (L->colp[c + 1] - L->colp[c]);
+      if (f < f0) {
+        L->mono = c;
+        break;
+      }
+      f0 = f;
+    }
+    *out = L;
+    return CVAR_OK;
+  }
   cholmod_start(&L->c);
   /* The Hessian is block-banded in node-major order, so the natural ordering has no
    * fill beyond the band; AMD would scramble it (DESIGN.md performance model). */
@@ -96,19 +136,78 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
 
 void cv_ldlt_free(cv_ldlt *L) {
   if (!L) return;
-  join_analysis(L);
-  cholmod_free_sparse(&L->A, &L->c);
-  cholmod_free_factor(&L->L, &L->c);
-  cholmod_finish(&L->c);
+  if (L->sky) {
+    cv_free(L->colp);
+    cv_free(L->ax);
+    cv_free(L->u);
+  } else {
+    join_analysis(L);
+    cholmod_free_sparse(&L->A, &L->c);
+    cholmod_free_factor(&L->L, &L->c);
+    cholmod_finish(&L->c);
+  }
   cv_free(L);
 }
 
-const int *cv_ldlt_colptr(const cv_ldlt *L) { return L->A->p; }
+const int *cv_ldlt_colptr(const cv_ldlt *L) { return L->sky ? L->colp : L->A->p; }
 
-double *cv_ldlt_values(cv_ldlt *L) { return L->A->x; }
+double *cv_ldlt_values(cv_ldlt *L) { return L->sky ? L->ax : L->A->x; }
 
-cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg,
-                         size_t len) {
+int cv_ldlt_matches(const cv_ldlt *L, const cv_disc *d, const int *gof) {
+  if (!L || !gof || L->n != d->nfree) return 0;
+  size_t n = (size_t)d->nfree;
+  int *cp = cv_malloc((2 * n + 1) * sizeof *cp), same = 0;
+  if (!cp) return 0;
+  cv_disc_pattern(d, cp, cp + n + 1);
+  same = !memcmp(cp, cv_ldlt_colptr(L), (n + 1) * sizeof *cp) &&
+         !memcmp(cp + n + 1, gof, n * sizeof *cp);
+  cv_free(cp);
+  return same;
+}
+
+/* Skyline (envelope) LDL^T, A = U^T D U with U unit upper triangular, in the envelope of
+ * A: natural ordering of a matrix whose columns are contiguous from their first row fills
+ * nothing outside it (theory N-7). Column j by the Crout (left-looking) rule:
+ *   g_i = a_ij - sum_{k = max(f_i, f_j)}^{i-1} u_ki g_k,   u_ij = g_i / d_i,
+ *   d_j = a_jj - sum_{i = f_j}^{j-1} u_ij g_i.
+ * A zero pivot is treated as CHOLMOD treats it (N-5): the first sets minor, from there on
+ * every pivot is 0 and no column with a zero pivot contributes, so inertia, pivot test and
+ * solves see the same factor as with CHOLMOD. */
+static void skyline_factor(cv_ldlt *L) {
+  const int *cp = L->colp;
+  const double *ax = L->ax;
+  double *u = L->u;
+  long n = L->n;
+  L->minor = n;
+  for (long j = 0; j < n; j++) {
+    int pj = cp[j], fj = (int)j + 1 - (cp[j + 1] - pj);
+    double *uj = u + pj - fj; /* uj[i] = entry of row i in column j */
+    const double *aj = ax + pj - fj;
+    double dj = aj[j];
+    for (int i = fj; i < j; i++) {
+      int pi = cp[i], fi = i + 1 - (cp[i + 1] - pi), k0 = fi > fj ? fi : fj;
+      const double *ui = u + pi - fi;
+      double g = aj[i];
+      for (int k = k0; k < i; k++) g -= ui[k] * uj[k]; /* uj[k] holds g_k until below */
+      uj[i] = g;
+    }
+    for (int i = fj; i < j; i++) { /* g_i -> u_ij; d_j -= u_ij g_i */
+      double di = u[cp[i + 1] - 1], g = uj[i];
+      if (di == 0.0) { /* a zero pivot's column contributes nothing (CHOLMOD: L(k,i) = 0) */
+        uj[i] = 0.0;
+        continue;
+      }
+      double uij = g / di;
+      uj[i] = uij;
+      dj -= uij * g;
+    }
+    if (j >= L->minor) dj = 0.0;
+    else if (dj == 0.0) L->minor = j;
+    uj[j] = dj;
+  }
+}
+
+static cv_status factor_cholmod(cv_ldlt *L, char *msg, size_t len) {
   join_analysis(L);
   if (!L->analysed) {
     L->L = cholmod_analyze(L->A, &L->c);
@@ -123,17 +222,30 @@ cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char 
     cv_set_msg(msg, len, "CHOLMOD factorisation failed (status %d)", L->c.status);
     return L->c.status == CHOLMOD_OUT_OF_MEMORY ? CVAR_ENOMEM : CVAR_EDEPENDENCY;
   }
-  /* Simplicial LDL^T: D(j) is the first entry of column j of L. The pivot is compared
-   * with the diagonal entry A(j,j) (the last entry of column j of the upper triangle):
-   * |D(j)| / |A(j,j)| is dimensionless and independent of the mesh width, so a small value
-   * marks a (nearly) degenerate direction, not merely a small element (theory N-5). */
-  const int *Lp = L->L->p, *Ap = L->A->p;
-  const double *Lx = L->L->x, *Ax = L->A->x;
+  return CVAR_OK;
+}
+
+cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg,
+                         size_t len) {
+  if (L->sky) {
+    skyline_factor(L);
+  } else {
+    cv_status st = factor_cholmod(L, msg, len);
+    if (st) return st;
+  }
   int nneg = 0;
   long bad = -1;
   double lo = INFINITY, hi = 0.0;
+  const int *cp = cv_ldlt_colptr(L);
+  const int *Lp = L->sky ? NULL : L->L->p;
+  const double *Ax = cv_ldlt_values(L), *Lx = L->sky ? L->u : L->L->x;
+  /* Simplicial LDL^T: D(j) is the first entry of column j of L (CHOLMOD), the last of
+   * column j of U (skyline). The pivot is compared with the diagonal entry A(j,j) (the last
+   * entry of column j of the upper triangle): |D(j)| / |A(j,j)| is dimensionless and
+   * independent of the mesh width, so a small value marks a (nearly) degenerate direction,
+   * not merely a small element (theory N-5). */
   for (long j = 0; j < L->n; j++) {
-    double dj = Lx[Lp[j]], ajj = fabs(Ax[Ap[j + 1] - 1]);
+    double dj = L->sky ? Lx[cp[j + 1] - 1] : Lx[Lp[j]], ajj = fabs(Ax[cp[j + 1] - 1]);
     if (dj < 0) nneg++;
     if (!isfinite(dj) || !isfinite(ajj)) bad = bad < 0 ? j : bad;
     double a = fabs(dj), rel = ajj > 0 ? a / ajj : (a > 0 ? 1.0 : 0.0);
@@ -150,11 +262,11 @@ cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char 
                "integrand's second derivatives overflow", bad);
     return CVAR_ENONFINITE;
   }
-  /* CHOLMOD stops LDL^T at an exactly zero or NaN pivot and reports it as "not positive
+  /* CHOLMOD stops LDL^T at an exactly zero pivot and reports it as "not positive
    * definite" with L->minor < n; a TRUE return alone does not mean success (STYLE.md 4). */
-  if (L->c.status == CHOLMOD_NOT_POSDEF || L->L->minor < (size_t)L->n) {
-    cv_set_msg(msg, len, "zero pivot in the LDL^T factorisation at unknown %ld",
-               (long)L->L->minor);
+  long minor = L->sky ? L->minor : (long)L->L->minor;
+  if (minor < L->n || (!L->sky && L->c.status == CHOLMOD_NOT_POSDEF)) {
+    cv_set_msg(msg, len, "zero pivot in the LDL^T factorisation at unknown %ld", minor);
     return CVAR_ESINGULAR;
   }
   return CVAR_OK;
@@ -200,19 +312,68 @@ static inline __attribute__((always_inline)) void backward_Lt(const cv_ldlt *L, 
   }
 }
 
+/* The skyline factor's solves: row j of L is column j of U, so L^{-1} is a dot product per
+ * row and U^{-1} an update per column. */
+static void sky_forward(const cv_ldlt *L, double *x) { /* x <- U^{-T} x */
+  const int *cp = L->colp;
+  for (long j = 0; j < L->n; j++) {
+    int fj = (int)j + 1 - (cp[j + 1] - cp[j]);
+    const double *uj = L->u + cp[j] - fj;
+    double s = x[j];
+    for (int i = fj; i < j; i++) s -= uj[i] * x[i];
+    x[j] = s;
+  }
+}
+
+/* x <- U^{-1} D^{-1} x (diag 1) or U^{-1} x, as a dot product over row j of U in
+ * increasing column order: the order of CHOLMOD's backward_Lt above, so that both give the
+ * same round-off (a Newton step next to a singular leading block amplifies it, and the
+ * deflation's search follows). Row j of U lies in the columns r > j whose first row
+ * f_r <= j: a range j + 1 .. e over the columns with nondecreasing f_r (the node blocks,
+ * e falling with j), then every later column (an integral multiplier's, f_r = 0). */
+static void sky_backward(const cv_ldlt *L, int diag, double *x) {
+  const int *cp = L->colp;
+  const double *u = L->u;
+  long n = L->n, mono = L->mono, e = mono - 1;
+  for (long j = n - 1; j >= 0; j--) {
+    double xj = diag ? x[j] / u[cp[j + 1] - 1] : x[j];
+    if (j < mono) {
+      while (e > j && e + 1 - (cp[e + 1] - cp[e]) > j) e--;
+      for (long r = j + 1; r <= e; r++) xj -= u[cp[r + 1] - 1 - (r - j)] * x[r];
+    }
+    for (long r = j + 1 > mono ? j + 1 : mono; r < n; r++)
+      if (r + 1 - (cp[r + 1] - cp[r]) <= j) xj -= u[cp[r + 1] - 1 - (r - j)] * x[r];
+    x[j] = xj;
+  }
+}
+
 cv_status cv_ldlt_solve(cv_ldlt *L, double *x) {
+  if (L->sky) {
+    sky_forward(L, x);
+    sky_backward(L, 1, x);
+    return CVAR_OK;
+  }
   forward_L(L, x);
   backward_Lt(L, 1, x);
   return CVAR_OK;
 }
 
 cv_status cv_ldlt_solve_L(cv_ldlt *L, int transpose, double *x) {
+  if (L->sky) {
+    if (transpose) sky_backward(L, 0, x);
+    else sky_forward(L, x);
+    return CVAR_OK;
+  }
   if (transpose) backward_Lt(L, 0, x);
   else forward_L(L, x);
   return CVAR_OK;
 }
 
 void cv_ldlt_diag(const cv_ldlt *L, double *D) {
+  if (L->sky) {
+    for (long j = 0; j < L->n; j++) D[j] = L->u[L->colp[j + 1] - 1];
+    return;
+  }
   const int *Lp = L->L->p;
   const double *Lx = L->L->x;
   for (long j = 0; j < L->n; j++) D[j] = Lx[Lp[j]];

@@ -59,6 +59,9 @@ static cv_status ws_init(newton_ws *w, cv_solver *s, const cv_disc *d, size_t nm
   memset(w, 0, sizeof *w);
   w->d = d;
   w->borrowed = d == &s->disc;
+  /* the solver keeps its factor from solve to solve (cv_solve_mesh); it is used while the
+   * mesh's pattern is the same (batch rows, repeated solves) */
+  if (w->borrowed && s->ldlt && !cv_ldlt_matches(s->ldlt, d, s->gof)) cv_solver_drop_factor(s);
   if (w->borrowed && s->ldlt) {
     w->gof = s->gof;
     w->L = s->ldlt;

@@ -20,8 +20,7 @@ static void results_reset(cv_solver *s) {
   cv_free(s->y);
   cv_free(s->mult);
   s->y = s->mult = NULL;
-  cv_solver_drop_factor(s);
-  cv_disc_free(&s->disc);
+  cv_disc_free(&s->disc); /* the factor stays: cv_newton_run checks it against the mesh */
   s->have = 0;
   s->iterations = 0;
   s->morse = -1;

@@ -126,8 +126,7 @@ cv_status cv_start_setup(cv_solver *s, const cv_problem *p) {
   cv_free(s->y);
   cv_free(s->mult);
   s->y = s->mult = NULL;
-  cv_solver_drop_factor(s);
-  cv_disc_free(&s->disc);
+  cv_disc_free(&s->disc); /* the factor stays: cv_newton_run checks it against the mesh */
   s->have = 0;
   st = cv_disc_init(&s->disc, p, s, s->msg, sizeof s->msg);
   if (st) {

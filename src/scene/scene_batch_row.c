@@ -334,7 +334,7 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals,
     snprintf(r->message, sizeof r->message, "%s", err);
     goto done;
   }
-  int warm = b->warm && w->inst->adapt <= 0 && w->prev_row == row - 1 && w->prev_len > 0;
+  int warm = b->warm && w->inst->adapt <= 0 && w->inst->tol <= 0 && w->prev_row == row - 1 && w->prev_len > 0;
   cv_solver_set_start(w->sv, 0, NULL);
   if (warm && warm_start(w) < 0)
     warm = 0;
@@ -376,7 +376,7 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals,
     }
     if (b->any_exact)
       r->error_max_nodal = nodal_error(w);
-    if (w->inst->adapt > 0)
+    if (w->inst->adapt > 0 || w->inst->tol > 0)
       r->error_estimate = cv_solver_get_error_estimate(w->sv);
     if (outputs) {
       if (b->rep && eval_reports(b, w, outputs) < 0)

@@ -152,6 +152,28 @@ if len(crow) == 3:
     check("R=1.2 iterations, time and message given", bad["iterations"] != "" and
           bad["time_s"] != "" and len(bad["message"]) > 10, "filled", bad)
 
+# ---- --tol applies to every row: its estimate in the table, honest against the exact -----
+ttab = write("cat_tol.csv", "R\n2\n3\n5\n")
+rc, out, err = batch("catenoid.scene", ttab, "--tol", "1e-10", "--threads", "2")
+check("catenoid --tol exit 0", rc == 0, 0, (rc, err))
+trow = rows_of(out)
+check("catenoid --tol header has error_estimate",
+      out.splitlines()[0].split(",")[6] == "error_estimate" if out else False,
+      "status,action,iterations,time_s,morse_index,error_estimate", out[:120])
+for row in trow:
+    R = float(row["R"])
+    c = catenoid_c(R)
+    act = c * (1 + c / 2 * math.sinh(2 / c))
+    est = float(row.get("error_estimate") or "nan")
+    check("catenoid --tol R=%g converged, estimate <= 1e-10" % R,
+          row["status"] == "converged" and est <= 1e-10, "converged, <= 1e-10",
+          (row["status"], est))
+    # a max nodal error below 1e-9 leaves the action (stationary) far closer than that
+    a = float(row["action"] or "nan")
+    check("catenoid --tol R=%g action to 1e-10" % R, abs(a - act) <= 1e-10 * act, act, a)
+rc, out, err = batch("catenoid.scene", ttab, "--tol", "1e-8", "--adapt", "1e-8")
+check("--tol with --adapt: exit 2", rc == 2 and out == "", 2, (rc, err))
+
 # ---- a row whose integrand is singular inside the interval: as `solve` says (SG-1) -------
 stab = write("sing.csv", "c\n-1\n0.5\n2\n")
 rc, out, err = batch("singular.scene", stab)
