@@ -2,7 +2,8 @@
  * medium against the same medium as a formula, same mesh, same run, with Newton's iteration
  * counts; (2) building a 200^3 table from arrays; (3) reading a 200^3 CSV grid (written to a
  * temporary file first). Prints figures and ratios (a benchmark, not a test).
- * usage: bench_table [N]   (N^3 grid for (2) and (3), default 200)
+ * usage: bench_table [N [CSV]]   (N^3 grid for (2) and (3), default 200; CSV: read this
+ * file in (3) instead of writing one)
  * SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <stdio.h>
@@ -136,27 +137,29 @@ int main(int argc, char **argv) {
   cv_table_free(big);
 
   printf("\n(3) reading a %d^3 CSV grid (x, y, z, value; 17 significant digits)\n", N);
-  char path[] = "/tmp/bench_table_XXXXXX";
-  int fd = mkstemp(path);
-  FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
-  if (!f) return 1;
-  t0 = now();
-  fprintf(f, "x,y,z,v\n");
-  for (int i = 0; i < N; i++)
-    for (int j = 0; j < N; j++)
-      for (int k = 0; k < N; k++) {
-        double u[3] = {(double)i / (N - 1), (double)j / (N - 1), (double)k / (N - 1)};
-        fprintf(f, "%.17g,%.17g,%.17g,%.17g\n", u[0], u[1], u[2], fisheye(u, 3));
-      }
-  fclose(f);
-  t1 = now();
-  printf("  (writing it: %.2f s)\n", t1 - t0);
+  char tmp[] = "/tmp/bench_table_XXXXXX", *path = argc > 2 ? argv[2] : tmp;
+  if (argc <= 2) {
+    int fd = mkstemp(path);
+    FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (!f) return 1;
+    t0 = now();
+    fprintf(f, "x,y,z,v\n");
+    for (int i = 0; i < N; i++)
+      for (int j = 0; j < N; j++)
+        for (int k = 0; k < N; k++) {
+          double u[3] = {(double)i / (N - 1), (double)j / (N - 1), (double)k / (N - 1)};
+          fprintf(f, "%.17g,%.17g,%.17g,%.17g\n", u[0], u[1], u[2], fisheye(u, 3));
+        }
+    fclose(f);
+    t1 = now();
+    printf("  (writing it: %.2f s)\n", t1 - t0);
+  }
   char err[SC_ERRLEN] = "";
   t0 = now();
   cv_table *rt = sc_table_read(path, path, err, sizeof err);
   t1 = now();
   printf("  read and built: %.3f s (%s)\n", t1 - t0, rt ? "ok" : err);
   cv_table_free(rt);
-  remove(path);
+  if (argc <= 2) remove(path);
   return 0;
 }

@@ -18,6 +18,7 @@ typedef struct {
   int n;
   double *x;     /* coordinates, strictly increasing */
   double *h;     /* h[i] = x[i+1] - x[i] */
+  double *ih;    /* 1 / h[i] */
   double *lo;    /* sub-diagonal of the reduced system for M_1 .. M_n-2 (TB-3) */
   double *c, *r; /* its Thomas factors: c = super-diagonal / pivot, r = 1 / pivot */
   int uniform;   /* equal spacing within round-off: the cell is found in O(1) */
@@ -27,15 +28,16 @@ typedef struct {
 struct cv_table {
   atomic_int refs;
   int dim;
-  size_t size;         /* number of grid values */
-  size_t stride[3];    /* index of (i0, i1, i2) = i0*stride[0] + i1*stride[1] + i2 */
+  size_t size;      /* number of grid values */
+  size_t stride[3]; /* index of (i0, i1, i2) = i0*stride[0] + i1*stride[1] + i2 */
   tb_axis ax[3];
-  double *G[8];        /* G[mask], each `size` doubles */
+  double *G[8]; /* G[mask], each `size` doubles */
 };
 
 static void axis_free(tb_axis *a) {
   cv_free(a->x);
   cv_free(a->h);
+  cv_free(a->ih);
   cv_free(a->lo);
   cv_free(a->c);
   cv_free(a->r);
@@ -48,10 +50,11 @@ static int axis_init(tb_axis *a, int n, const double *x, char *msg, size_t len, 
   a->n = n;
   a->x = cv_malloc((size_t)n * sizeof *a->x);
   a->h = cv_malloc((size_t)n * sizeof *a->h);
+  a->ih = cv_malloc((size_t)n * sizeof *a->ih);
   a->c = cv_malloc((size_t)n * sizeof *a->c);
   a->r = cv_malloc((size_t)n * sizeof *a->r);
   a->lo = cv_malloc((size_t)n * sizeof *a->lo);
-  if (!a->x || !a->h || !a->c || !a->r || !a->lo) {
+  if (!a->x || !a->h || !a->ih || !a->c || !a->r || !a->lo) {
     cv_set_msg(msg, len, "out of memory");
     return -1;
   }
@@ -69,6 +72,7 @@ static int axis_init(tb_axis *a, int n, const double *x, char *msg, size_t len, 
   }
   for (int i = 0; i + 1 < n; i++) a->h[i] = x[i + 1] - x[i];
   a->h[n - 1] = a->h[n - 2];
+  for (int i = 0; i < n; i++) a->ih[i] = 1.0 / a->h[i];
   double span = x[n - 1] - x[0];
   a->h0 = span / (n - 1);
   a->ih0 = 1.0 / a->h0;
@@ -102,58 +106,81 @@ static int axis_init(tb_axis *a, int n, const double *x, char *msg, size_t len, 
 
 /* dst = second derivatives along one axis of the splines through src (TB-3), for every
  * line along that axis: element (o, i, k) at (o*n + i)*inner + k. The sweeps run over the
- * contiguous index k innermost, so strided axes stay cache friendly. */
+ * contiguous index k innermost, so strided axes stay cache friendly; a long k range is cut
+ * into blocks of columns whose n rows fit in the cache, so the back substitution and the
+ * ends re-read the forward sweep's output from the cache, not from memory. */
 static void axis_solve(const tb_axis *a, const double *src, double *dst, size_t outer,
                        size_t inner) {
   const int n = a->n;
   const double *h = a->h;
-  for (size_t o = 0; o < outer; o++) {
-    const double *f = src + o * (size_t)n * inner;
-    double *M = dst + o * (size_t)n * inner;
-    /* forward sweep: M_i = (rhs_i - l_i M_i-1) * r_i */
-    for (int i = 1; i <= n - 2; i++) {
-      double lr = a->lo[i];
-      double ia = 1.0 / h[i - 1], ib = 1.0 / h[i], r = a->r[i];
-      const double *fm = f + (size_t)(i - 1) * inner, *f0 = fm + inner, *fp = f0 + inner;
-      double *Mi = M + (size_t)i * inner;
-      const double *Mp = Mi - inner;
-      if (i == 1) /* no sub-diagonal (M_0 was eliminated): row 0 of M is not read */
-        for (size_t k = 0; k < inner; k++)
-          Mi[k] = 6.0 * ((fp[k] - f0[k]) * ib - (f0[k] - fm[k]) * ia) * r;
-      else
-        for (size_t k = 0; k < inner; k++) {
+  /* about 256 KiB of src and dst rows per block (at least 64 columns) */
+  size_t blk = (size_t)16384 / (size_t)n;
+  if (blk < 64) blk = 64;
+  for (size_t o = 0; o < outer; o++)
+    for (size_t k0 = 0; k0 < inner; k0 += blk) {
+      const size_t kn = inner - k0 < blk ? inner - k0 : blk;
+      const double *f = src + o * (size_t)n * inner + k0;
+      double *M = dst + o * (size_t)n * inner + k0;
+      /* forward sweep: M_i = (rhs_i - l_i M_i-1) * r_i (rows of one array never overlap,
+       * hence restrict: the loops over k vectorise) */
+      for (int i = 1; i <= n - 2; i++) {
+        const double lr = i == 1 ? 0.0 : a->lo[i]; /* row 1 has no sub-diagonal */
+        const double ia = a->ih[i - 1], ib = a->ih[i], r = a->r[i];
+        const double *restrict fm = f + (size_t)(i - 1) * inner;
+        const double *restrict f0 = fm + inner, *restrict fp = f0 + inner;
+        double *restrict Mi = M + (size_t)i * inner;
+        const double *restrict Mp = i == 1 ? f0 : Mi - inner; /* row 0 of M is not read */
+        for (size_t k = 0; k < kn; k++) {
           double rhs = 6.0 * ((fp[k] - f0[k]) * ib - (f0[k] - fm[k]) * ia);
           Mi[k] = (rhs - lr * Mp[k]) * r;
         }
+      }
+      /* back substitution: M_i -= c_i M_i+1 */
+      for (int i = n - 3; i >= 1; i--) {
+        const double c = a->c[i];
+        double *restrict Mi = M + (size_t)i * inner;
+        const double *restrict Mn = Mi + inner;
+        for (size_t k = 0; k < kn; k++) Mi[k] -= c * Mn[k];
+      }
+      /* the not-a-knot ends (TB-3) */
+      double *M0 = M, *M1 = M + inner, *M2 = M + 2 * inner;
+      double *Me = M + (size_t)(n - 1) * inner, *Ma = Me - inner, *Mb = Ma - inner;
+      double h0 = h[0], h1 = h[1], hb = h[n - 2], ha = h[n - 3];
+      for (size_t k = 0; k < kn; k++) {
+        M0[k] = ((h0 + h1) * M1[k] - h0 * M2[k]) / h1;
+        Me[k] = ((hb + ha) * Ma[k] - hb * Mb[k]) / ha;
+      }
     }
-    /* back substitution: M_i -= c_i M_i+1 */
-    for (int i = n - 3; i >= 1; i--) {
-      double c = a->c[i];
-      double *Mi = M + (size_t)i * inner;
-      const double *Mn = Mi + inner;
-      for (size_t k = 0; k < inner; k++) Mi[k] -= c * Mn[k];
-    }
-    /* the not-a-knot ends (TB-3) */
-    double *M0 = M, *M1 = M + inner, *M2 = M + 2 * inner;
-    double *Me = M + (size_t)(n - 1) * inner, *Ma = Me - inner, *Mb = Ma - inner;
-    double h0 = h[0], h1 = h[1], hb = h[n - 2], ha = h[n - 3];
-    for (size_t k = 0; k < inner; k++) {
-      M0[k] = ((h0 + h1) * M1[k] - h0 * M2[k]) / h1;
-      Me[k] = ((hb + ha) * Ma[k] - hb * Mb[k]) / ha;
-    }
-  }
 }
 
-cv_table *cv_table_new(int dim, const int *n, const double *const *coords,
-                       const double *values, cv_status *why) {
+static cv_table *table_build(int dim, const int *n, const double *const *coords,
+                             const double *values, double *owned, cv_status *why, char *msg,
+                             size_t len);
+
+cv_table *cv_table_new(int dim, const int *n, const double *const *coords, const double *values,
+                       cv_status *why) {
   return cv_table_new_msg(dim, n, coords, values, why, NULL, 0);
 }
 
-cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords,
-                           const double *values, cv_status *why, char *msg, size_t len) {
+cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords, const double *values,
+                           cv_status *why, char *msg, size_t len) {
+  return table_build(dim, n, coords, values, NULL, why, msg, len);
+}
+
+cv_table *cv_table_new_owned(int dim, const int *n, const double *const *coords, double *values,
+                             cv_status *why, char *msg, size_t len) {
+  return table_build(dim, n, coords, NULL, values, why, msg, len);
+}
+
+/* The common body: the values are copied from `values`, or `owned` (cv_malloc'ed, in
+ * grid order) becomes G[0] itself, no copy; `owned` is released on every failure. */
+static cv_table *table_build(int dim, const int *n, const double *const *coords,
+                             const double *values, double *owned, cv_status *why, char *msg,
+                             size_t len) {
   cv_status st = CVAR_EINVAL;
   cv_table *t = NULL;
   if (msg && len) msg[0] = 0;
+  if (owned) values = owned;
   if (dim < 1 || dim > 3 || !n || !coords || !values) {
     cv_set_msg(msg, len, "a table needs 1, 2 or 3 coordinates, their values and the data");
     goto fail;
@@ -161,8 +188,8 @@ cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords,
   size_t size = 1;
   for (int k = 0; k < dim; k++) {
     if (n[k] < 4) {
-      cv_set_msg(msg, len, "coordinate %d has %d value%s; a cubic spline needs at least 4",
-                 k + 1, n[k], n[k] == 1 ? "" : "s");
+      cv_set_msg(msg, len, "coordinate %d has %d value%s; a cubic spline needs at least 4", k + 1,
+                 n[k], n[k] == 1 ? "" : "s");
       goto fail;
     }
     if (!coords[k]) goto fail;
@@ -179,7 +206,8 @@ cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords,
   t->size = size;
   for (int k = 0; k < dim; k++)
     if (axis_init(&t->ax[k], n[k], coords[k], msg, len, k) != 0) {
-      if (!t->ax[k].x || !t->ax[k].r) goto nomem;
+      if (!t->ax[k].x || !t->ax[k].h || !t->ax[k].ih || !t->ax[k].c || !t->ax[k].r || !t->ax[k].lo)
+        goto nomem;
       goto fail;
     }
   for (size_t i = 0; i < size; i++)
@@ -190,15 +218,22 @@ cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords,
   t->stride[dim - 1] = 1;
   for (int k = dim - 2; k >= 0; k--) t->stride[k] = t->stride[k + 1] * (size_t)n[k + 1];
   for (int mask = 0; mask < (1 << dim); mask++) {
+    if (mask == 0 && owned) {
+      t->G[0] = owned;
+      owned = NULL;
+      continue;
+    }
     t->G[mask] = cv_malloc(size * sizeof(double));
     if (!t->G[mask]) goto nomem;
     if (mask == 0) {
       memcpy(t->G[0], values, size * sizeof(double));
       continue;
     }
-    int k = 0; /* the highest axis in mask: G[mask] from G[mask without it] */
-    for (int b = 0; b < dim; b++)
-      if (mask & (1 << b)) k = b;
+    /* the lowest axis in mask: G[mask] from G[mask without it]. The axis with the longest
+     * contiguous lines (the first) then does most of the 2^d - 1 solves; the order does
+     * not matter otherwise, the per-axis operators commute (TB-2). */
+    int k = 0;
+    while (!(mask & (1 << k))) k++;
     size_t inner = t->stride[k], outer = size / (inner * (size_t)n[k]);
     axis_solve(&t->ax[k], t->G[mask & ~(1 << k)], t->G[mask], outer, inner);
   }
@@ -208,6 +243,7 @@ nomem:
   st = CVAR_ENOMEM;
   cv_set_msg(msg, len, "out of memory");
 fail:
+  cv_free(owned);
   cv_table_free(t);
   if (why) *why = st;
   return NULL;
@@ -246,15 +282,19 @@ static int find_cell(const tb_axis *a, double u) {
     i = (int)s;
     if (i > n - 2) i = n - 2;
     /* round-off in s: step to the cell that really holds u */
-    if (i > 0 && u < x[i]) i--;
-    else if (i < n - 2 && u >= x[i + 1]) i++;
+    if (i > 0 && u < x[i])
+      i--;
+    else if (i < n - 2 && u >= x[i + 1])
+      i++;
     return i;
   }
   int lo = 0, hi = n - 1; /* x[lo] <= u <= x[hi] */
   while (hi - lo > 1) {
     int mid = lo + (hi - lo) / 2;
-    if (u < x[mid]) hi = mid;
-    else lo = mid;
+    if (u < x[mid])
+      hi = mid;
+    else
+      lo = mid;
   }
   return lo;
 }

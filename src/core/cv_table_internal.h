@@ -10,8 +10,12 @@
 /* Another reference to t (returned); cv_table_free releases each. */
 cv_table *cv_table_ref(cv_table *t);
 /* cv_table_new that also writes a sentence on failure (msg may be NULL). */
-cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords,
-                           const double *values, cv_status *why, char *msg, size_t len);
+cv_table *cv_table_new_msg(int dim, const int *n, const double *const *coords, const double *values,
+                           cv_status *why, char *msg, size_t len);
+/* cv_table_new_msg that takes `values` (cv_malloc'ed, grid order) as the table's own array
+ * of values instead of copying it; `values` is released on failure too. */
+cv_table *cv_table_new_owned(int dim, const int *n, const double *const *coords, double *values,
+                             cv_status *why, char *msg, size_t len);
 /* Several partials of t at the point u at once (one cell search, theory TB-2): out[j] has
  * the orders ord[j][0..dim-1]. Returns 0, or k + 1 when u is outside the grid along axis k
  * (then every out[j] is NaN). */
