@@ -51,10 +51,9 @@ int main(int argc, char **argv) {
         double ex = 1 - (exp((x[j] - 1) / eps) + exp(-x[j] / eps)) / (1 + exp(-1 / eps));
         err = fmax(err, fabs(y[j] - ex));
       }
-      printf("%8.0e %4d %9d %7d %11.2e %11.2e %9.4f %s\n", eps, deg,
-             cv_solver_get_num_elements(s), cv_solver_get_adapt_rounds(s),
-             cv_solver_get_error_estimate(s), err, cv_solver_get_time(s),
-             st ? cv_status_name(st) : "converged");
+      printf("%8.0e %4d %9d %7d %11.2e %11.2e %9.4f %s\n", eps, deg, cv_solver_get_num_elements(s),
+             cv_solver_get_adapt_rounds(s), cv_solver_get_error_estimate(s), err,
+             cv_solver_get_time(s), st ? cv_status_name(st) : "converged");
       free(x);
       free(y);
       cv_solver_free(s);

@@ -45,8 +45,8 @@ int main(int argc, char **argv) {
   };
   double *t1 = malloc(R * sizeof *t1), *ta = malloc(R * sizeof *ta);
   if (!t1 || !ta) return 1;
-  printf("%-16s %6s %6s %7s %11s %11s %7s  %s\n", "problem", "paths", "starts", "failed",
-         "solve_s", "all_s", "ratio", "stopped");
+  printf("%-16s %6s %6s %7s %11s %11s %7s  %s\n", "problem", "paths", "starts", "failed", "solve_s",
+         "all_s", "ratio", "stopped");
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     const bench_case *k = &cases[c];
     char err[256];
@@ -71,8 +71,8 @@ int main(int argc, char **argv) {
       cv_solver_get_search(s, &in);
     }
     double m1 = median(t1, R), ma = median(ta, R);
-    printf("%-16s %6d %6d %7d %11.3e %11.3e %7.1f  %s\n", k->name, np, in.starts, in.failed,
-           m1, ma, ma / m1, in.stop);
+    printf("%-16s %6d %6d %7d %11.3e %11.3e %7.1f  %s\n", k->name, np, in.starts, in.failed, m1, ma,
+           ma / m1, in.stop);
     cv_solver_free(s);
     cv_problem_free(p);
   }

@@ -24,28 +24,42 @@ static double now(void) {
 
 /* Fish-eye ray n = 2 / (1 + x^2 + y^2) from (-1, 0) to (1, 0)... as in the tests: on
  * [-1, 1] with y(+-1) = 0, 2 elements of degree 4 (max nodal error ~1e-8). */
-static int fisheye_F(int m, const double *x, const double *y, const double *dy,
-                     unsigned need, cv_partials *o, void *user) {
+static int fisheye_F(int m, const double *x, const double *y, const double *dy, unsigned need,
+                     cv_partials *o, void *user) {
   (void)need, (void)user;
   for (int k = 0; k < m; k++) {
     double p = dy[k], s = sqrt(1 + p * p), r = 1 + x[k] * x[k] + y[k] * y[k];
     double nn = 2 / r, ny = -4 * y[k] / (r * r);
     double nyy = -4 / (r * r) + 16 * y[k] * y[k] / (r * r * r);
     o->F[k] = nn * s;
-    if (o->Fy) { o->Fy[k] = ny * s; o->Fp[k] = nn * p / s; }
-    if (o->Fyy) { o->Fyy[k] = nyy * s; o->Fyp[k] = ny * p / s; o->Fpp[k] = nn / (s * s * s); }
+    if (o->Fy) {
+      o->Fy[k] = ny * s;
+      o->Fp[k] = nn * p / s;
+    }
+    if (o->Fyy) {
+      o->Fyy[k] = nyy * s;
+      o->Fyp[k] = ny * p / s;
+      o->Fpp[k] = nn / (s * s * s);
+    }
   }
   return 0;
 }
 
-static int catenary_F(int m, const double *x, const double *y, const double *dy,
-                      unsigned need, cv_partials *o, void *user) {
+static int catenary_F(int m, const double *x, const double *y, const double *dy, unsigned need,
+                      cv_partials *o, void *user) {
   (void)x, (void)need, (void)user;
   for (int k = 0; k < m; k++) {
     double s = sqrt(1 + dy[k] * dy[k]);
     o->F[k] = y[k] * s;
-    if (o->Fy) { o->Fy[k] = s; o->Fp[k] = y[k] * dy[k] / s; }
-    if (o->Fyy) { o->Fyy[k] = 0; o->Fyp[k] = dy[k] / s; o->Fpp[k] = y[k] / (s * s * s); }
+    if (o->Fy) {
+      o->Fy[k] = s;
+      o->Fp[k] = y[k] * dy[k] / s;
+    }
+    if (o->Fyy) {
+      o->Fyy[k] = 0;
+      o->Fyp[k] = dy[k] / s;
+      o->Fpp[k] = y[k] / (s * s * s);
+    }
   }
   return 0;
 }
@@ -84,8 +98,7 @@ int main(int argc, char **argv) {
   int N = argc > 1 ? atoi(argv[1]) : 41;
   if (N < 1) N = 1;
   double *cold = malloc((size_t)N * sizeof *cold), *warm = malloc((size_t)N * sizeof *warm);
-  const char *names[2] = {"fish-eye, 2 elements of degree 4",
-                          "catenary, 3 elements of degree 4"};
+  const char *names[2] = {"fish-eye, 2 elements of degree 4", "catenary, 3 elements of degree 4"};
   printf("%-34s %12s %12s %7s\n", "problem (median of N)", "cold [us]", "warm [us]", "ratio");
   for (int which = 0; which < 2; which++) {
     for (int i = 0; i < N; i++) {
@@ -101,8 +114,8 @@ int main(int argc, char **argv) {
     qsort(cold, (size_t)N, sizeof *cold, cmp);
     qsort(warm, (size_t)N, sizeof *warm, cmp);
     double c = cold[N / 2], w = warm[N / 2];
-    printf("%-34s %12.1f %12.1f %7.2f   (cold min %.1f max %.1f)\n", names[which], 1e6 * c,
-           1e6 * w, c / w, 1e6 * cold[0], 1e6 * cold[N - 1]);
+    printf("%-34s %12.1f %12.1f %7.2f   (cold min %.1f max %.1f)\n", names[which], 1e6 * c, 1e6 * w,
+           c / w, 1e6 * cold[0], 1e6 * cold[N - 1]);
   }
   free(cold);
   free(warm);

@@ -29,8 +29,8 @@ static int hand(int m, const double *x, const double *y, const double *dy, unsig
   return 0;
 }
 
-static double best_time(cv_integrand_fn f, void *user, int m, const double *x,
-                        const double *y, const double *dy, cv_partials *P) {
+static double best_time(cv_integrand_fn f, void *user, int m, const double *x, const double *y,
+                        const double *dy, cv_partials *P) {
   double best = INFINITY;
   for (int trial = 0; trial < 5; trial++) {
     double t0 = now();

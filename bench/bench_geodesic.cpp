@@ -30,15 +30,12 @@
 #define CV_DATA "bench/data"
 #endif
 
-static double now()
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
+static double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
 // Wall seconds of a shell command; -1 when it fails.
-static double timed(const std::string &cmd)
-{
+static double timed(const std::string &cmd) {
   double t0 = now();
   int rc = std::system(cmd.c_str());
   double t = now() - t0;
@@ -51,25 +48,21 @@ static double timed(const std::string &cmd)
 
 // Column `name` of a CSV file written by calcvar batch (the message, last, may hold commas
 // inside quotes; the columns asked for here come before it).
-static std::vector<std::string> column(const std::string &path, const char *name)
-{
+static std::vector<std::string> column(const std::string &path, const char *name) {
   std::vector<std::string> out;
   FILE *f = std::fopen(path.c_str(), "r");
-  if (!f)
-    return out;
+  if (!f) return out;
   char line[8192];
   int idx = -1;
   if (std::fgets(line, sizeof line, f)) {
     int k = 0;
     for (char *p = std::strtok(line, ",\n"); p; p = std::strtok(nullptr, ",\n"), k++)
-      if (std::strcmp(p, name) == 0)
-        idx = k;
+      if (std::strcmp(p, name) == 0) idx = k;
   }
   while (idx >= 0 && std::fgets(line, sizeof line, f)) {
     int k = 0;
     const char *p = line;
-    while (k < idx && (p = std::strchr(p, ',')))
-      p++, k++;
+    while (k < idx && (p = std::strchr(p, ','))) p++, k++;
     if (!p) {
       out.push_back("");
       continue;
@@ -86,8 +79,7 @@ struct Check {
   long wrong = 0, failed = 0;
 };
 
-static Check compare(const std::vector<double> &got, const std::vector<double> &ref)
-{
+static Check compare(const std::vector<double> &got, const std::vector<double> &ref) {
   Check c;
   for (size_t i = 0; i < ref.size(); i++) {
     if (i >= got.size() || !std::isfinite(got[i])) {
@@ -101,20 +93,16 @@ static Check compare(const std::vector<double> &got, const std::vector<double> &
   return c;
 }
 
-static std::vector<double> lengths(const std::string &path, const char *col)
-{
+static std::vector<double> lengths(const std::string &path, const char *col) {
   std::vector<double> v;
-  for (auto &s : column(path, col))
-    v.push_back(s.empty() ? NAN : std::atof(s.c_str()));
+  for (auto &s : column(path, col)) v.push_back(s.empty() ? NAN : std::atof(s.c_str()));
   return v;
 }
 
-int main(int argc, char **argv)
-{
+int main(int argc, char **argv) {
   long N = argc > 1 ? std::atol(argv[1]) : 10000, RAYS = argc > 2 ? std::atol(argv[2]) : 100000;
   std::string tmp = "/tmp/cv_bench_geodesic_" + std::to_string((long)getpid());
-  if (std::system(("mkdir -p " + tmp).c_str()) != 0)
-    return 1;
+  if (std::system(("mkdir -p " + tmp).c_str()) != 0) return 1;
   const GeographicLib::Geodesic &g = GeographicLib::Geodesic::WGS84();
   std::mt19937_64 rng(18);
   std::uniform_real_distribution<double> u(-1, 1), lon(-180, 180);
@@ -124,13 +112,13 @@ int main(int argc, char **argv)
     double a2 = std::asin(u(rng)) * 180 / M_PI, o2 = lon(rng);
     double s12;
     g.Inverse(a1, o1, a2, o2, s12);
-    if (s12 > 1e7)
-      continue; // the range; nearly antipodal pairs have several geodesics
+    if (s12 > 1e7) continue; // the range; nearly antipodal pairs have several geodesics
     P.insert(P.end(), {a1, o1, a2, o2});
     ref.push_back(s12);
   }
   std::printf("WGS84 geodesics: %ld random pairs, distances <= 1e7 m (uniform on the sphere, "
-              "longer pairs rejected)\n", N);
+              "longer pairs rejected)\n",
+              N);
 
   // GeographicLib's own Inverse, repeated to a measurable time.
   double t0 = now(), sink = 0;
@@ -144,14 +132,13 @@ int main(int argc, char **argv)
     reps++;
   } while (now() - t0 < 0.3);
   double us_lib = 1e6 * (now() - t0) / ((double)reps * N);
-  std::printf("  GeographicLib Geodesic::Inverse   %8.2f us/geodesic  (checksum %.3g)\n",
-              us_lib, sink);
+  std::printf("  GeographicLib Geodesic::Inverse   %8.2f us/geodesic  (checksum %.3g)\n", us_lib,
+              sink);
 
   // The tables: CSV for calcvar batch, whitespace for GeodSolve.
   std::string csv = tmp + "/pairs.csv", txt = tmp + "/pairs.txt";
   FILE *fc = std::fopen(csv.c_str(), "w"), *ft = std::fopen(txt.c_str(), "w");
-  if (!fc || !ft)
-    return 1;
+  if (!fc || !ft) return 1;
   std::fprintf(fc, "lat1,lon1,lat2,lon2\n");
   for (long i = 0; i < N; i++) {
     std::fprintf(fc, "%.17g,%.17g,%.17g,%.17g\n", P[4 * i], P[4 * i + 1], P[4 * i + 2],
@@ -171,12 +158,12 @@ int main(int argc, char **argv)
     long M = N < 200 ? N : 200;
     std::string sh = tmp + "/each.sh";
     FILE *fs = std::fopen(sh.c_str(), "w");
-    if (!fs)
-      return 1;
+    if (!fs) return 1;
     for (long i = 0; i < M; i++)
-      std::fprintf(fs, "%s solve %s --quiet --set lat1=%.17g --set lon1=%.17g --set lat2=%.17g "
-                   "--set lon2=%.17g || exit 1\n", CV_CALCVAR, scene.c_str(), P[4 * i],
-                   P[4 * i + 1], P[4 * i + 2], P[4 * i + 3]);
+      std::fprintf(fs,
+                   "%s solve %s --quiet --set lat1=%.17g --set lon1=%.17g --set lat2=%.17g "
+                   "--set lon2=%.17g || exit 1\n",
+                   CV_CALCVAR, scene.c_str(), P[4 * i], P[4 * i + 1], P[4 * i + 2], P[4 * i + 3]);
     std::fclose(fs);
     double te = timed("sh " + sh);
     std::printf("  calcvar solve --set, one process per pair %8.2f us/row  (%ld pairs)\n",
@@ -186,13 +173,13 @@ int main(int argc, char **argv)
   double t1 = timed(base + " --threads 1 --out " + tmp + "/r1.csv");
   Check c1 = compare(lengths(tmp + "/r1.csv", "s"), ref);
   std::printf("  calcvar batch, 1 thread           %8.2f us/row   %5.1fx GeodSolve -i   "
-              "max |error| %.2e m, %ld > 1 mm, %ld not converged\n", 1e6 * t1 / N,
-              t1 / t_gs, c1.maxerr, c1.wrong, c1.failed);
+              "max |error| %.2e m, %ld > 1 mm, %ld not converged\n",
+              1e6 * t1 / N, t1 / t_gs, c1.maxerr, c1.wrong, c1.failed);
   double t2 = timed(base + " --threads 2 --out " + tmp + "/r2.csv");
   Check c2 = compare(lengths(tmp + "/r2.csv", "s"), ref);
   std::printf("  calcvar batch, 2 threads          %8.2f us/row   speed-up %.2f  "
-              "max |error| %.2e m, %ld > 1 mm, %ld not converged\n", 1e6 * t2 / N, t1 / t2,
-              c2.maxerr, c2.wrong, c2.failed);
+              "max |error| %.2e m, %ld > 1 mm, %ld not converged\n",
+              1e6 * t2 / N, t1 / t2, c2.maxerr, c2.wrong, c2.failed);
 #ifdef CV_MPIRUN
   std::string mpi = std::string(CV_MPIRUN) + " --oversubscribe" +
                     (geteuid() == 0 ? " --allow-run-as-root" : "") + " -np ";
@@ -200,8 +187,8 @@ int main(int argc, char **argv)
   double m2 = timed(mpi + "2 " + base + " --threads 1 --out " + tmp + "/m2.csv");
   Check cm = compare(lengths(tmp + "/m2.csv", "s"), ref);
   std::printf("  mpirun -np 1 / -np 2 (1 thread)   %8.2f / %.2f us/row   speed-up %.2f  "
-              "max |error| %.2e m, %ld > 1 mm, %ld not converged\n", 1e6 * m1 / N,
-              1e6 * m2 / N, m1 / m2, cm.maxerr, cm.wrong, cm.failed);
+              "max |error| %.2e m, %ld > 1 mm, %ld not converged\n",
+              1e6 * m1 / N, 1e6 * m2 / N, m1 / m2, cm.maxerr, cm.wrong, cm.failed);
 #else
   std::printf("  mpirun: not measured (calcvar built without MPI)\n");
 #endif
@@ -216,16 +203,14 @@ int main(int argc, char **argv)
   }
   std::vector<cv_batch_result> res((size_t)N);
   std::vector<double> out((size_t)N);
-  for (long i = 0; i < N; i++)
-    res[(size_t)i].outputs = &out[(size_t)i];
+  for (long i = 0; i < N; i++) res[(size_t)i].outputs = &out[(size_t)i];
   for (int warm = 0; warm < 2; warm++) {
     cv_batch_set_warm_start(b, warm);
     double ta = now();
     cv_batch_solve(b, (int)N, P.data(), res.data());
     ta = now() - ta;
     long nw = 0;
-    for (auto &r : res)
-      nw += r.warm;
+    for (auto &r : res) nw += r.warm;
     std::vector<double> s((size_t)N);
     for (long i = 0; i < N; i++)
       s[(size_t)i] = res[(size_t)i].status == CVAR_OK ? out[(size_t)i] : NAN;
@@ -241,8 +226,7 @@ int main(int argc, char **argv)
   // [0.25, 1]; every ray is checked against its exact circle (error_max_nodal).
   std::string fan = tmp + "/fan.csv";
   FILE *ff = std::fopen(fan.c_str(), "w");
-  if (!ff)
-    return 1;
+  if (!ff) return 1;
   std::fprintf(ff, "yr\n");
   for (long i = 0; i < RAYS; i++)
     std::fprintf(ff, "%.15g\n", 0.25 + 0.5 * (double)i / (double)(RAYS > 1 ? RAYS - 1 : 1));
@@ -261,8 +245,8 @@ int main(int argc, char **argv)
   double tf3 = timed(fb + " --threads 2 --warm --out " + tmp + "/f3.csv");
   std::printf("Fish-eye ray fan: %ld rays: 1 thread %.0f rows/s, 2 threads %.0f rows/s "
               "(speed-up %.2f), 2 threads --warm %.0f rows/s; max nodal error %.2e, %ld not "
-              "converged\n", RAYS, RAYS / tf1, RAYS / tf2, tf1 / tf2, RAYS / tf3, emax, fails);
-  if (std::system(("rm -rf " + tmp).c_str()) != 0)
-    return 1;
+              "converged\n",
+              RAYS, RAYS / tf1, RAYS / tf2, tf1 / tf2, RAYS / tf3, emax, fails);
+  if (std::system(("rm -rf " + tmp).c_str()) != 0) return 1;
   return 0;
 }

@@ -56,19 +56,31 @@ static double floor_ns(long E) {
     if (step < 1e-10 * c) break;
   }
   double t = cv_now() - t0;
-  free(y); free(g); free(dg); free(od);
+  free(y);
+  free(g);
+  free(dg);
+  free(od);
   return 1e9 * t / (E * (double)it);
 }
 
 static int catenary(int m, const double *x, const double *y, const double *dy, unsigned need,
                     cv_partials *o, void *user) {
-  (void)x; (void)need; (void)user;
+  (void)x;
+  (void)need;
+  (void)user;
   /* one square root and one reciprocal per point, the arithmetic of the floor below */
   for (int k = 0; k < m; k++) {
     double p = dy[k], s = sqrt(1 + p * p), is = 1.0 / s;
     o->F[k] = y[k] * s;
-    if (o->Fy) { o->Fy[k] = s; o->Fp[k] = y[k] * p * is; }
-    if (o->Fyy) { o->Fyy[k] = 0; o->Fyp[k] = p * is; o->Fpp[k] = y[k] * is * is * is; }
+    if (o->Fy) {
+      o->Fy[k] = s;
+      o->Fp[k] = y[k] * p * is;
+    }
+    if (o->Fyy) {
+      o->Fyy[k] = 0;
+      o->Fyp[k] = p * is;
+      o->Fpp[k] = y[k] * is * is * is;
+    }
   }
   return 0;
 }
@@ -78,9 +90,8 @@ int main(int argc, char **argv) {
   int minexp = argc > 3 ? atoi(argv[3]) : 3;
   double c = 2 * cosh(0.5);
   printf("catenary, degree %d: per element per Newton iteration\n", deg);
-  printf("%10s %6s %12s %12s %12s %10s %12s %10s %7s %10s\n", "elements", "iters",
-         "assemble_ns", "ldlt_ns", "total_ns", "total_s", "max_err", "floor_ns", "ratio",
-         "peak_B_el");
+  printf("%10s %6s %12s %12s %12s %10s %12s %10s %7s %10s\n", "elements", "iters", "assemble_ns",
+         "ldlt_ns", "total_ns", "total_s", "max_err", "floor_ns", "ratio", "peak_B_el");
   /* One throwaway solve first: the first in a process also pays for resolving CHOLMOD's
    * symbols and growing the heap, which is not a cost per element. */
   {

@@ -11,15 +11,13 @@
 
 #include "calcvar.h"
 
-static double now(void)
-{
+static double now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static int one(const char *path, int elements, int degree)
-{
+static int one(const char *path, int elements, int degree) {
   char err[1024];
   cv_scene *sc = cv_scene_load_file(path, 0, NULL, err, sizeof err);
   if (!sc) {
@@ -49,8 +47,7 @@ done:
   return rc;
 }
 
-int main(int argc, char **argv)
-{
+int main(int argc, char **argv) {
   if (argc < 4) {
     fprintf(stderr, "usage: bench_scene_api SCENE ELEMENTS DEGREE [REPETITIONS]\n");
     return 2;
@@ -61,8 +58,7 @@ int main(int argc, char **argv)
   for (int round = 0; round < 5; round++) {
     double t0 = now();
     for (int r = 0; r < reps; r++)
-      if (one(argv[1], elements, degree) < 0)
-        return 1;
+      if (one(argv[1], elements, degree) < 0) return 1;
     double t = (now() - t0) / reps;
     best = t < best ? t : best;
   }

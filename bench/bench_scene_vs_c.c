@@ -35,8 +35,7 @@ static int sphere(int m, const double *x, const double *y, const double *dy, uns
     if (o->Fyy) {
       o->Fyy[k] = 2 * (cs * cs - sn * sn) * pp * pp;
       o->Fyy[m + k] = o->Fyy[2 * m + k] = o->Fyy[3 * m + k] = 0;
-      o->Fyp[k] = 0, o->Fyp[m + k] = 4 * sn * cs * pp, o->Fyp[2 * m + k] = 0,
-      o->Fyp[3 * m + k] = 0;
+      o->Fyp[k] = 0, o->Fyp[m + k] = 4 * sn * cs * pp, o->Fyp[2 * m + k] = 0, o->Fyp[3 * m + k] = 0;
       o->Fpp[k] = 2, o->Fpp[m + k] = o->Fpp[2 * m + k] = 0, o->Fpp[3 * m + k] = 2 * sn * sn;
     }
   }
@@ -69,8 +68,10 @@ static int pendula(int m, const double *x, const double *y, const double *dy, un
       if (o->Fyy)
         for (int j = 0; j < n; j++) {
           double h = 0;
-          if (i == j) h = -cos(yi) - (i > 0) - (i + 1 < n);
-          else if (j == i - 1 || j == i + 1) h = 1;
+          if (i == j)
+            h = -cos(yi) - (i > 0) - (i + 1 < n);
+          else if (j == i - 1 || j == i + 1)
+            h = 1;
           o->Fyy[(i * n + j) * m + k] = h;
           o->Fyp[(i * n + j) * m + k] = 0;
           o->Fpp[(i * n + j) * m + k] = i == j;

@@ -65,9 +65,9 @@ static int run(scene *s, const cv_problem *p, double tol, int elements, int degr
     r->rounds = cv_solver_get_adapt_rounds(sv);
     r->est = cv_solver_get_error_estimate(sv);
     r->err = NAN;
-    r->errA = s->has_exact_action
-                  ? fabs(cv_solver_get_action(sv) - s->exact_action) / fmax(1, fabs(s->exact_action))
-                  : NAN;
+    r->errA = s->has_exact_action ? fabs(cv_solver_get_action(sv) - s->exact_action) /
+                                        fmax(1, fabs(s->exact_action))
+                                  : NAN;
     int N = r->nodes, n = s->n, any = 0;
     for (int i = 0; i < n; i++) any |= s->exact[i] >= 0;
     double *x = malloc((size_t)N * sizeof *x), *y = malloc((size_t)N * n * sizeof *y);
@@ -77,7 +77,8 @@ static int run(scene *s, const cv_problem *p, double tol, int elements, int degr
       double m = 0;
       for (int i = 0; i < n; i++)
         if (s->exact[i] >= 0)
-          for (int j = 0; j < N; j++) m = fmax(m, fabs(y[(size_t)j * n + i] - ex[(size_t)i * N + j]));
+          for (int j = 0; j < N; j++)
+            m = fmax(m, fabs(y[(size_t)j * n + i] - ex[(size_t)i * N + j]));
       r->err = m;
     }
     free(x);
@@ -93,9 +94,9 @@ int main(int argc, char **argv) {
   const char *dir = argc > 1 ? argv[1] : CV_SCENE_DIR;
   printf("--tol on the reference problems (timings on a shared machine: noisy; the baseline\n"
          "is measured in the same run)\n");
-  printf("%-22s %-9s %7s %-9s %6s %6s %9s %9s %9s %9s | %-10s %9s %9s %6s\n", "problem",
-         "set", "tol", "status", "nodes", "rounds", "estimate", "true_max", "true_act",
-         "time_s", "hand mesh", "time_s", "true_max", "ratio");
+  printf("%-22s %-9s %7s %-9s %6s %6s %9s %9s %9s %9s | %-10s %9s %9s %6s\n", "problem", "set",
+         "tol", "status", "nodes", "rounds", "estimate", "true_max", "true_act", "time_s",
+         "hand mesh", "time_s", "true_max", "ratio");
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     const bench_case *bc = &cases[c];
     char path[1024], err[SC_ERRLEN], nm[64] = "", val[64] = "";

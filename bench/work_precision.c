@@ -47,16 +47,14 @@ typedef struct {
   double err, time;
 } point;
 
-static double now(void)
-{
+static double now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
 /* One mesh: fastest of repeated fresh solves, and the max nodal error of the last. */
-static int measure(const scene *s, const cv_problem *p, point *pt, double budget)
-{
+static int measure(const scene *s, const cv_problem *p, point *pt, double budget) {
   double best = INFINITY, spent = 0;
   int reps = 0;
   pt->err = NAN;
@@ -91,8 +89,7 @@ static int measure(const scene *s, const cv_problem *p, point *pt, double budget
     }
     cv_solver_free(sv);
     double t = now() - t0;
-    if (st != CVAR_OK)
-      return -1;
+    if (st != CVAR_OK) return -1;
     best = fmin(best, t);
     spent += t;
     reps++;
@@ -102,14 +99,12 @@ static int measure(const scene *s, const cv_problem *p, point *pt, double budget
 }
 
 /* The element counts: 1, 2, 3, 4, 5, 6, 8, 10, 13, 16, 20, 25, 32, ... */
-static int next_elements(int e)
-{
+static int next_elements(int e) {
   int f = (int)lround(e * 1.2599210498948732); /* 2^(1/3) */
   return f > e ? f : e + 1;
 }
 
-static int sweep(const scene *s0, const cv_problem *p, int degree, point *pts, int quick)
-{
+static int sweep(const scene *s0, const cv_problem *p, int degree, point *pts, int quick) {
   scene s = *s0;
   int np = 0, stale = 0;
   double best = INFINITY;
@@ -128,15 +123,13 @@ static int sweep(const scene *s0, const cv_problem *p, int degree, point *pts, i
      * when slow */
     stale = pt->err < 0.5 * best || best > 1e-9 ? 0 : stale + 1;
     best = fmin(best, pt->err);
-    if (pt->err < 0.5e-12 || stale >= 3 || pt->time > (quick ? 0.1 : 1.0))
-      break;
+    if (pt->err < 0.5e-12 || stale >= 3 || pt->time > (quick ? 0.1 : 1.0)) break;
   }
   return np;
 }
 
 /* Least time over the points at or below the target error; NAN if none. */
-static double time_to(const point *pts, int np, double target, int *elements)
-{
+static double time_to(const point *pts, int np, double target, int *elements) {
   double t = NAN;
   *elements = 0;
   for (int k = 0; k < np; k++)
@@ -149,8 +142,7 @@ static double time_to(const point *pts, int np, double target, int *elements)
 
 /* The Pareto front of solve_bvp's points for the picture: sorted by time, each point kept
  * only when its error is below every faster one's. */
-static int bvp_front(json_t *arr, double *x, double *y, int max)
-{
+static int bvp_front(json_t *arr, double *x, double *y, int max) {
   int n = 0;
   size_t m = json_array_size(arr);
   double *t = malloc((m + 1) * sizeof *t), *e = malloc((m + 1) * sizeof *e);
@@ -184,8 +176,7 @@ static int bvp_front(json_t *arr, double *x, double *y, int max)
 }
 
 static int draw(const char *dir, const char *name, const char *title, point pts[][MAXPTS],
-                const int *np, json_t *bvp)
-{
+                const int *np, json_t *bvp) {
   char path[4096];
   snprintf(path, sizeof path, "%s/work_precision_%s.svg", dir, name);
   double x[NDEG + 1][MAXPTS], y[NDEG + 1][MAXPTS];
@@ -211,12 +202,15 @@ static int draw(const char *dir, const char *name, const char *title, point pts[
   }
   char t[256];
   snprintf(t, sizeof t, "%s: work against precision", title);
-  cli_plot_panel pan = {.title = t, .xlabel = "run time of one solve [s]",
-                        .ylabel = "max nodal error", .logx = 1, .logy = 1, .nlines = nl,
+  cli_plot_panel pan = {.title = t,
+                        .xlabel = "run time of one solve [s]",
+                        .ylabel = "max nodal error",
+                        .logx = 1,
+                        .logy = 1,
+                        .nlines = nl,
                         .lines = lines};
   cli_outfile o;
-  if (cli_outfile_open(&o, path, NULL) < 0)
-    return -1;
+  if (cli_outfile_open(&o, path, NULL) < 0) return -1;
   if (cli_plot_write(&o, 1, &pan) < 0) {
     cli_outfile_abandon(&o);
     return -1;
@@ -225,8 +219,7 @@ static int draw(const char *dir, const char *name, const char *title, point pts[
   return 0;
 }
 
-int main(int argc, char **argv)
-{
+int main(int argc, char **argv) {
   const char *dir = CV_SCENE_DIR, *json_out = NULL, *bvp_in = NULL, *svg_dir = NULL;
   int quick = 0;
   for (int i = 1; i < argc; i++) {
@@ -242,7 +235,7 @@ int main(int argc, char **argv)
       dir = argv[i];
     else {
       fprintf(stderr, "usage: work_precision [--quick] [--json FILE] [--bvp FILE] "
-              "[--svg-dir DIR] [SCENE_DIR]\n");
+                      "[--svg-dir DIR] [SCENE_DIR]\n");
       return 2;
     }
   }
@@ -257,16 +250,15 @@ int main(int argc, char **argv)
   static point pts[NDEG][MAXPTS];
   printf("minimum time [s] of one solve to reach a max nodal error (elements in brackets)\n");
   printf("%-16s %7s", "problem", "error");
-  for (int d = 0; d < NDEG; d++)
-    printf("   p = %-13d", degrees[d]);
+  for (int d = 0; d < NDEG; d++) printf("   p = %-13d", degrees[d]);
   printf("   best\n");
   for (int k = 0; k < NPROB; k++) {
     char path[4096], err[SC_ERRLEN];
     snprintf(path, sizeof path, "%s/%s.scene", dir, problems[k]);
     scene *s = scene_load_file(path, 0, NULL, err, sizeof err);
-    cv_problem *p = s ? scene_problem_new(s, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS,
-                                          err, sizeof err)
-                      : NULL;
+    cv_problem *p =
+        s ? scene_problem_new(s, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, err, sizeof err)
+          : NULL;
     if (!p) {
       fprintf(stderr, "work_precision: %s\n", err);
       scene_free(s);
@@ -278,8 +270,8 @@ int main(int argc, char **argv)
       np[d] = sweep(s, p, degrees[d], pts[d], quick);
       json_t *a = json_array();
       for (int q = 0; q < np[d]; q++)
-        json_array_append_new(a, json_pack("[i,f,f]", pts[d][q].elements, pts[d][q].err,
-                                           pts[d][q].time));
+        json_array_append_new(
+            a, json_pack("[i,f,f]", pts[d][q].elements, pts[d][q].err, pts[d][q].time));
       char key[8];
       snprintf(key, sizeof key, "%d", degrees[d]);
       json_object_set_new(jp, key, a);
@@ -310,8 +302,7 @@ int main(int argc, char **argv)
         printf("   -\n");
     }
     if (svg_dir && draw(svg_dir, problems[k], s->title, pts, np, bvp) < 0)
-      fprintf(stderr, "work_precision: the picture for %s could not be written\n",
-              problems[k]);
+      fprintf(stderr, "work_precision: the picture for %s could not be written\n", problems[k]);
     cv_problem_free(p);
     scene_free(s);
     fflush(stdout);

@@ -60,8 +60,8 @@ static int solve_and_check(const char *how, cv_problem *p) {
   if (!t || !y || cv_solver_get_nodes(s, t) || cv_solver_get_values(s, y)) goto cleanup;
   double err = 0.0, action = cv_solver_get_action(s), exact = -g * g / 24.0;
   for (int j = 0; j < nn; j++) err = fmax(err, fabs(y[j] - g * t[j] * (1.0 - t[j]) / 2.0));
-  printf("%-9s action %.15f (exact %.15f), y(1/2) = %.15f, max nodal error %.1e\n", how,
-         action, exact, y[nn / 2], err);
+  printf("%-9s action %.15f (exact %.15f), y(1/2) = %.15f, max nodal error %.1e\n", how, action,
+         exact, y[nn / 2], err);
   rc = (err < 1e-13 && fabs(action - exact) < 1e-13) ? 0 : 1;
 cleanup:
   free(y);
@@ -76,8 +76,8 @@ int main(void) {
 
   /* 1. The integrand as a formula: derivatives are exact and symbolic. */
   cv_problem *p = cv_problem_new(1, 0.0, 1.0, NULL);
-  if (!p || cv_problem_set_integrand_expr(p, "t", "y", "y'^2/2 - g*y", "g = 9.81", err,
-                                          sizeof err) ||
+  if (!p ||
+      cv_problem_set_integrand_expr(p, "t", "y", "y'^2/2 - g*y", "g = 9.81", err, sizeof err) ||
       cv_problem_set_dirichlet(p, 0, 0.0, 0.0)) {
     fprintf(stderr, "formula: %s\n", err);
     rc = 1;

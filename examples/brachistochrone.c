@@ -20,8 +20,8 @@
 /* F = sqrt(u / y), u = 1 + y'^2:  F_y = -F/(2y), F_y' = y' F/u,  F_yy = 3F/(4y^2),
  * F_yy' = -y' F/(2 u y),  F_y'y' = F/u^2. y <= 0 is outside the domain: return 1 and the
  * line search shortens the step. */
-static int descent_time(int m, const double *x, const double *y, const double *dy,
-                        unsigned need, cv_partials *out, void *user) {
+static int descent_time(int m, const double *x, const double *y, const double *dy, unsigned need,
+                        cv_partials *out, void *user) {
   (void)x;
   (void)need;
   (void)user;
@@ -55,7 +55,10 @@ static double cycloid_y(double x) {
   double lo = 0.0, hi = PI, phi = fmin(cbrt(6.0 * x), PI);
   for (int it = 0; it < 100; it++) {
     double f = phi - sin(phi) - x;
-    if (f > 0.0) hi = phi; else lo = phi;
+    if (f > 0.0)
+      hi = phi;
+    else
+      lo = phi;
     double d = 1.0 - cos(phi), next = d > 0.0 ? phi - f / d : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
     if (fabs(next - phi) < 1e-16 * (1.0 + phi)) break;

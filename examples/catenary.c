@@ -52,8 +52,8 @@ int main(void) {
   double *x = NULL, *y = NULL;
   double ring = 2.0 * cosh(0.5);
   if ((st = cv_problem_set_integrand(p, catenary, NULL)) ||
-      (st = cv_problem_set_dirichlet(p, 0, ring, ring)) ||
-      (st = cv_solver_set_elements(s, 32)) || (st = cv_solver_set_degree(s, 4))) {
+      (st = cv_problem_set_dirichlet(p, 0, ring, ring)) || (st = cv_solver_set_elements(s, 32)) ||
+      (st = cv_solver_set_degree(s, 4))) {
     fprintf(stderr, "setup: %s\n", cv_strerror(st));
     goto cleanup;
   }

@@ -32,8 +32,8 @@ int main(void) {
   }
   int rc = 1;
   double *x = NULL, *y = NULL;
-  if ((st = cv_problem_set_integrand_expr(p, "x", "y", "2/(1 + x^2 + y^2) * sqrt(1 + y'^2)",
-                                          NULL, err_text, sizeof err_text)) ||
+  if ((st = cv_problem_set_integrand_expr(p, "x", "y", "2/(1 + x^2 + y^2) * sqrt(1 + y'^2)", NULL,
+                                          err_text, sizeof err_text)) ||
       (st = cv_problem_set_dirichlet(p, 0, y0, y0)) || (st = cv_solver_set_elements(s, 16)) ||
       (st = cv_solver_set_degree(s, 4))) {
     fprintf(stderr, "setup: %s (%s)\n", cv_strerror(st), err_text);

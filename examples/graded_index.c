@@ -54,8 +54,7 @@ int main(void) {
       cv_solver_get_qpoints(s, xq, NULL, NULL, dyq))
     goto cleanup;
   double err = 0.0, perr = 0.0;
-  for (int j = 0; j < nn; j++)
-    err = fmax(err, fabs(y[j] - (sqrt(0.75 + x[j]) - sqrt(0.75))));
+  for (int j = 0; j < nn; j++) err = fmax(err, fabs(y[j] - (sqrt(0.75 + x[j]) - sqrt(0.75))));
   for (int k = 0; k < nq; k++) {
     double mom = sqrt(1.0 + xq[k]) * dyq[k] / sqrt(1.0 + dyq[k] * dyq[k]);
     perr = fmax(perr, fabs(mom - 0.5));

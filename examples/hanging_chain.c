@@ -107,13 +107,10 @@ int main(void) {
   double err = 0.0;
   for (int j = 0; j < nn; j++) err = fmax(err, fabs(y[j] - (cosh(x[j]) - cosh(1.0))));
   double energy = cv_solver_get_action(s);
-  printf("hanging_chain: %d nodes, %d Newton iterations\n", nn,
-         cv_solver_get_num_iterations(s));
+  printf("hanging_chain: %d nodes, %d Newton iterations\n", nn, cv_solver_get_num_iterations(s));
   printf("  energy %.15f (exact %.15f), max nodal error %.2e\n", energy, exact_energy, err);
   printf("  multiplier mu %.15f (exact cosh 1 = %.15f)\n", mu, exact_mu);
-  rc = (err < 1e-10 && fabs(energy - exact_energy) < 1e-12 && fabs(mu - exact_mu) < 1e-9)
-           ? 0
-           : 1;
+  rc = (err < 1e-10 && fabs(energy - exact_energy) < 1e-12 && fabs(mu - exact_mu) < 1e-9) ? 0 : 1;
   if (rc) fprintf(stderr, "hanging_chain: answer outside its stated tolerance\n");
 cleanup:
   free(y);

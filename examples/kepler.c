@@ -28,8 +28,8 @@ static const double e_ = 0.5, mu_ = 1.0;
  * F_x' = x', F_y' = y';  F_xx = mu (3x^2 - r^2)/r^5, F_xy = 3 mu x y/r^5,
  * F_yy = mu (3y^2 - r^2)/r^5;  F_y'y' is the identity; no mixed partials. r = 0 (the sun)
  * cannot be evaluated: return 1 and the line search shortens the step. */
-static int lagrangian(int m, const double *t, const double *y, const double *dy,
-                      unsigned need, cv_partials *out, void *user) {
+static int lagrangian(int m, const double *t, const double *y, const double *dy, unsigned need,
+                      cv_partials *out, void *user) {
   (void)t;
   (void)need;
   (void)user;

@@ -19,9 +19,7 @@
 
 #include <calcvar.h>
 
-static double exact_y(double x) {
-  return x < 0.7 ? 4.0 * x / 3.0 : 14.0 / 15.0 + 0.75 * (x - 0.7);
-}
+static double exact_y(double x) { return x < 0.7 ? 4.0 * x / 3.0 : 14.0 / 15.0 + 0.75 * (x - 0.7); }
 
 /* Solve on 10 elements of degree 2, with or without the breakpoint; report the max nodal
  * error, the optical path and the worst deviation of n sin t from 4/5. */
@@ -89,8 +87,7 @@ int main(void) {
   double err, path, snell, err0, path0, snell0;
   printf("snell: air (n = 1) to water (n = 4/3) at x = 0.7, exact optical path 10/3\n");
   int rc = 1;
-  if (solve(p, 1, &err, &path, &snell) == CVAR_OK &&
-      solve(p, 0, &err0, &path0, &snell0) == CVAR_OK)
+  if (solve(p, 1, &err, &path, &snell) == CVAR_OK && solve(p, 0, &err0, &path0, &snell0) == CVAR_OK)
     rc = (err < 1e-12 && fabs(path - 10.0 / 3.0) < 1e-12 && snell < 1e-12) ? 0 : 1;
   if (rc) fprintf(stderr, "snell: answer outside its stated tolerance\n");
   cv_problem_free(p);

@@ -42,12 +42,12 @@ static int energy(int m, const double *x, const double *y, const double *dy, uns
     }
     if (out->Fyy) {
       for (int ij = 0; ij < 4; ij++) out->Fyy[ij * m + k] = out->Fyp[ij * m + k] = 0.0;
-      out->Fyy[k] = 2.0 * c2 * dph * dph;     /* (th, th) */
-      out->Fyp[1 * m + k] = 2.0 * s2 * dph;   /* (th, ph') */
-      out->Fpp[0 * m + k] = 2.0;              /* (th', th') */
-      out->Fpp[1 * m + k] = 0.0;              /* (th', ph') */
-      out->Fpp[2 * m + k] = 0.0;              /* (ph', th') */
-      out->Fpp[3 * m + k] = 2.0 * s * s;      /* (ph', ph') */
+      out->Fyy[k] = 2.0 * c2 * dph * dph;   /* (th, th) */
+      out->Fyp[1 * m + k] = 2.0 * s2 * dph; /* (th, ph') */
+      out->Fpp[0 * m + k] = 2.0;            /* (th', th') */
+      out->Fpp[1 * m + k] = 0.0;            /* (th', ph') */
+      out->Fpp[2 * m + k] = 0.0;            /* (ph', th') */
+      out->Fpp[3 * m + k] = 2.0 * s * s;    /* (ph', ph') */
     }
   }
   return 0;
@@ -81,8 +81,8 @@ int main(void) {
                dyc[6] = {0.7, -0.2, 0.4, 1.6, 1.2, 2.0};
   cv_derivcheck dc;
   if ((st = cv_problem_check_derivatives(p, 3, xc, yc, dyc, &dc)) || dc.worst > 1e-6) {
-    fprintf(stderr, "derivative check: %s, worst %s = %g against %g\n", cv_strerror(st),
-            dc.which, dc.analytic, dc.fd);
+    fprintf(stderr, "derivative check: %s, worst %s = %g against %g\n", cv_strerror(st), dc.which,
+            dc.analytic, dc.fd);
     goto cleanup;
   }
   if ((st = cv_solve(s, p)) != CVAR_OK) {
@@ -95,8 +95,8 @@ int main(void) {
   w = malloc(nq * sizeof *w);
   yq = malloc(2 * nq * sizeof *yq);
   dyq = malloc(2 * nq * sizeof *dyq);
-  if (!x || !y || !w || !yq || !dyq || cv_solver_get_nodes(s, x) ||
-      cv_solver_get_values(s, y) || cv_solver_get_qpoints(s, NULL, w, yq, dyq))
+  if (!x || !y || !w || !yq || !dyq || cv_solver_get_nodes(s, x) || cv_solver_get_values(s, y) ||
+      cv_solver_get_qpoints(s, NULL, w, yq, dyq))
     goto cleanup;
   double err = 0.0, length = 0.0;
   for (int j = 0; j < nn; j++) { /* node-major: y[j*2 + i] */
@@ -112,12 +112,11 @@ int main(void) {
   printf("sphere_geodesic: derivative check worst %.1e (%s); %d nodes, %d Newton iterations, "
          "Morse index %d\n",
          dc.worst, dc.which, nn, cv_solver_get_num_iterations(s), cv_solver_get_morse_index(s));
-  printf("  energy %.15f (exact pi^2/4 = %.15f), length %.15f (exact pi/2)\n", e,
-         exact_energy, length);
+  printf("  energy %.15f (exact pi^2/4 = %.15f), length %.15f (exact pi/2)\n", e, exact_energy,
+         length);
   printf("  max nodal error %.2e\n", err);
-  rc = (err < 1e-9 && fabs(e - exact_energy) < 1e-11 && fabs(length - exact_length) < 1e-11)
-           ? 0
-           : 1;
+  rc =
+      (err < 1e-9 && fabs(e - exact_energy) < 1e-11 && fabs(length - exact_length) < 1e-11) ? 0 : 1;
   if (rc) fprintf(stderr, "sphere_geodesic: answer outside its stated tolerance\n");
 cleanup:
   free(dyq);

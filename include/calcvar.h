@@ -74,7 +74,7 @@ extern "C" {
 #define CVAR_VERSION_MINOR 1 /**< minor version of this header */
 #define CVAR_VERSION_PATCH 0 /**< patch level of this header */
 /** Pack a version for `#if` tests: CVAR_VERSION_PACK(0, 1, 0). */
-#define CVAR_VERSION_PACK(a, b, c) ((a) * 10000 + (b) * 100 + (c))
+#define CVAR_VERSION_PACK(a, b, c) ((a)*10000 + (b)*100 + (c))
 /** This header's version, packed: compare with CVAR_VERSION_PACK(a, b, c) in `#if`. */
 #define CVAR_VERSION CVAR_VERSION_PACK(CVAR_VERSION_MAJOR, CVAR_VERSION_MINOR, CVAR_VERSION_PATCH)
 /** The library's version, to compare with the header's. Any pointer may be NULL. */
@@ -85,19 +85,19 @@ CVAR_API void cv_version(int *major, int *minor, int *patch);
  * One X-macro list generates the enum and the message table (cv_strerror). */
 /**@{*/
 /** The statuses in order, each with its cv_strerror sentence; CVAR_OK is 0. */
-#define CVAR_STATUS_LIST(X)                                                                    \
-  X(CVAR_OK, "success")                                                                       \
-  X(CVAR_EINVAL, "invalid argument")                                                          \
-  X(CVAR_ENOMEM, "out of memory")                                                             \
-  X(CVAR_ECALLBACK, "a user callback reported an error")                                      \
-  X(CVAR_ENONFINITE, "non-finite value in the integrand or an iterate")                       \
-  X(CVAR_ESINGULAR, "singular or degenerate Hessian")                                         \
-  X(CVAR_EMAXITER, "maximum number of iterations reached before convergence")                 \
-  X(CVAR_ESTALL, "no further progress possible (round-off or stagnation)")                    \
-  X(CVAR_EDIVERGED, "the iteration diverged")                                                 \
-  X(CVAR_ENOTMIN, "the stationary point is not a minimum")                                   \
-  X(CVAR_EDEPENDENCY, "failure inside a dependency (CHOLMOD, NLopt)")                         \
-  X(CVAR_ESTATE, "no solution available (call cv_solve first)")                              \
+#define CVAR_STATUS_LIST(X)                                                                        \
+  X(CVAR_OK, "success")                                                                            \
+  X(CVAR_EINVAL, "invalid argument")                                                               \
+  X(CVAR_ENOMEM, "out of memory")                                                                  \
+  X(CVAR_ECALLBACK, "a user callback reported an error")                                           \
+  X(CVAR_ENONFINITE, "non-finite value in the integrand or an iterate")                            \
+  X(CVAR_ESINGULAR, "singular or degenerate Hessian")                                              \
+  X(CVAR_EMAXITER, "maximum number of iterations reached before convergence")                      \
+  X(CVAR_ESTALL, "no further progress possible (round-off or stagnation)")                         \
+  X(CVAR_EDIVERGED, "the iteration diverged")                                                      \
+  X(CVAR_ENOTMIN, "the stationary point is not a minimum")                                         \
+  X(CVAR_EDEPENDENCY, "failure inside a dependency (CHOLMOD, NLopt)")                              \
+  X(CVAR_ESTATE, "no solution available (call cv_solve first)")                                    \
   X(CVAR_ECANCELLED, "cancelled by the progress callback")
 
 /** Turns one CVAR_STATUS_LIST entry into an enumerator (undefined again below). */
@@ -185,7 +185,7 @@ typedef void (*cv_release_fn)(void *user);
  * integrand set) calls release(user) when release is not NULL. On failure release(user) is
  * called before returning, so the caller never has to. */
 CVAR_API cv_status cv_problem_set_integrand_owned(cv_problem *p, cv_integrand_fn F, void *user,
-                                         cv_release_fn release);
+                                                  cv_release_fn release);
 /** Fix unknown k (0 <= k < n) to ya at a and yb at b. Values must be finite. */
 CVAR_API cv_status cv_problem_set_dirichlet(cv_problem *p, int k, double ya, double yb);
 /** Fix unknown k at one end: end 0 is a, end 1 is b. */
@@ -208,8 +208,8 @@ CVAR_API void cv_problem_get_interval(const cv_problem *p, double *a, double *b)
  * `name = constant expression`. On failure returns CVAR_EINVAL and writes a sentence to
  * err (errlen bytes, may be NULL/0). The problem owns the compiled integrand. */
 CVAR_API cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
-                                        const char *unknowns, const char *F,
-                                        const char *parameters, char *err, size_t errlen);
+                                                 const char *unknowns, const char *F,
+                                                 const char *parameters, char *err, size_t errlen);
 
 /** \name Tables: functions given as data
  * A table is the C^2 cubic spline (not-a-knot ends, tensor product in 2-D and 3-D) through
@@ -226,7 +226,7 @@ typedef struct cv_table cv_table;
  * values[(i0*n[1] + i1)*n[2] + i2]. Everything is copied. NULL on failure, with *why (may
  * be NULL) CVAR_EINVAL or CVAR_ENOMEM. Memory: 2^dim doubles per grid value. */
 CVAR_API cv_table *cv_table_new(int dim, const int *n, const double *const *coords,
-                       const double *values, cv_status *why);
+                                const double *values, cv_status *why);
 /** Release the caller's reference; NULL is a no-op. */
 CVAR_API void cv_table_free(cv_table *t);
 /** Number of coordinates (0 for NULL). */
@@ -250,39 +250,40 @@ CVAR_API cv_status cv_problem_add_table(cv_problem *p, const char *name, cv_tabl
  * (need & CVAR_NEED_GRAD) Gy[i*m + k] = dG/dy_i, (need & CVAR_NEED_HESS)
  * Gyy[(i*n + j)*m + k] = d2G/dy_i dy_j. Gy/Gyy are NULL when not asked for. Returns as
  * cv_integrand_fn does. */
-typedef int (*cv_constraint_fn)(int m, const double *x, const double *y, unsigned need,
-                                double *G, double *Gy, double *Gyy, void *user);
+typedef int (*cv_constraint_fn)(int m, const double *x, const double *y, unsigned need, double *G,
+                                double *Gy, double *Gyy, void *user);
 
 /** Add the pointwise constraint G(x, y(x)) = 0 for all x. It is imposed at every node
  * that has a free unknown, with one multiplier per node: the discrete multiplier field
  * lambda(x) of the Lagrangian F + lambda G (theory C-1). At an end where all unknowns are
  * fixed, the constraint must already hold (cv_solve returns CVAR_EINVAL otherwise).
  * *index (may be NULL) receives the constraint's number, 0, 1, ... */
-CVAR_API cv_status cv_problem_add_constraint(cv_problem *p, cv_constraint_fn G, void *user, int *index);
+CVAR_API cv_status cv_problem_add_constraint(cv_problem *p, cv_constraint_fn G, void *user,
+                                             int *index);
 /** Add the integral constraint  int_a^b K(x, y, y') dx = c, with one scalar multiplier
  * mu (Lagrangian F + mu K, theory C-2). K has the integrand's signature and must supply
  * the partials asked for. *index (may be NULL) receives its number, 0, 1, ... */
 CVAR_API cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, void *user, double c,
-                                  int *index);
+                                           int *index);
 /** cv_problem_add_constraint whose `user` the problem owns and
  * releases as in cv_problem_set_integrand_owned (also on failure). */
 CVAR_API cv_status cv_problem_add_constraint_owned(cv_problem *p, cv_constraint_fn G, void *user,
-                                          cv_release_fn release, int *index);
+                                                   cv_release_fn release, int *index);
 /** cv_problem_add_integral whose `user` the problem owns (see above). */
 CVAR_API cv_status cv_problem_add_integral_owned(cv_problem *p, cv_integrand_fn K, void *user,
-                                        cv_release_fn release, double c, int *index);
+                                                 cv_release_fn release, double c, int *index);
 /** The pointwise constraint G(x, y) = 0 as a formula (no callback, exact partials): the
  * arguments as cv_problem_set_integrand_expr's; G may not involve the derivatives y'.
  * On failure CVAR_EINVAL with a sentence in err. *index as cv_problem_add_constraint. */
 CVAR_API cv_status cv_problem_add_constraint_expr(cv_problem *p, const char *variable,
                                                   const char *unknowns, const char *G,
-                                                  const char *parameters, int *index,
-                                                  char *err, size_t errlen);
+                                                  const char *parameters, int *index, char *err,
+                                                  size_t errlen);
 /** The integral constraint int_a^b K(x, y, y') dx = c as a formula, as above. */
 CVAR_API cv_status cv_problem_add_integral_expr(cv_problem *p, const char *variable,
-                                                const char *unknowns, const char *K,
-                                                double c, const char *parameters, int *index,
-                                                char *err, size_t errlen);
+                                                const char *unknowns, const char *K, double c,
+                                                const char *parameters, int *index, char *err,
+                                                size_t errlen);
 /** The number of pointwise constraints added so far. */
 CVAR_API int cv_problem_get_num_constraints(const cv_problem *p);
 /** The number of integral constraints added so far. */
@@ -294,16 +295,15 @@ CVAR_API int cv_problem_get_num_integrals(const cv_problem *p);
  * CVAR_ENONFINITE when the callback returns < 0 or > 0 at some point, CVAR_ENOMEM or
  * CVAR_EINVAL; values are written as they come (the caller checks finiteness). */
 CVAR_API cv_status cv_problem_eval_energy(const cv_problem *p, int m, const double *x,
-                                          const double *y, const double *dy, double *H,
-                                          double *P);
+                                          const double *y, const double *dy, double *H, double *P);
 
 /** Outcome of cv_problem_check_derivatives. */
 typedef struct {
-  double worst;      /**< worst relative difference |analytic - FD| / max(1, |analytic|) */
-  int point;         /**< point index of the worst entry */
-  char which[32];    /**< e.g. "Fyp[1][0]" */
-  double analytic;   /**< the callback's value there */
-  double fd;         /**< the central finite-difference value */
+  double worst;    /**< worst relative difference |analytic - FD| / max(1, |analytic|) */
+  int point;       /**< point index of the worst entry */
+  char which[32];  /**< e.g. "Fyp[1][0]" */
+  double analytic; /**< the callback's value there */
+  double fd;       /**< the central finite-difference value */
 } cv_derivcheck;
 
 /** Compare the callback's first and second partials against central finite differences
@@ -311,8 +311,8 @@ typedef struct {
  * (x[k], y[i*m+k], dy[i*m+k]); 1 <= m <= 256. Fills *report with the worst entry.
  * Returns CVAR_ECALLBACK/CVAR_ENONFINITE if the callback fails at a point. */
 CVAR_API cv_status cv_problem_check_derivatives(const cv_problem *p, int m, const double *x,
-                                       const double *y, const double *dy,
-                                       cv_derivcheck *report);
+                                                const double *y, const double *dy,
+                                                cv_derivcheck *report);
 /**@}*/
 
 /** \name Solver: discretisation, options, results */
@@ -412,9 +412,8 @@ CVAR_API double cv_solver_get_error_estimate(const cv_solver *s);
  * and (if est_vertex is not NULL) the max over the element boundaries alone, or an error
  * with a sentence in msg (cv_solver_last_error is not changed) when the enriched solve
  * failed or landed on another stationary path (theory HP-3): no bound then, NaN. */
-CVAR_API cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p,
-                                            double *est, double *est_vertex, char *msg,
-                                            size_t len);
+CVAR_API cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p, double *est,
+                                            double *est_vertex, char *msg, size_t len);
 /** Refinement rounds of the last adaptive solve. */
 CVAR_API int cv_solver_get_adapt_rounds(const cv_solver *s);
 
@@ -497,10 +496,11 @@ CVAR_API int cv_solver_get_num_qpoints(const cv_solver *s);
  * Each output may be NULL. x, w: length nq; y, dy: n*nq, laid out y[i*nq + k] (structure of
  * arrays). Sum_k w[k] g(x[k]) is the solver's integral of g. */
 CVAR_API cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double *y,
-                                double *dy);
+                                         double *dy);
 /** Evaluate the last solution (degree-p interpolant) at m abscissae in [a, b]:
  * y[i*m + k] and, if dy != NULL, y'[i*m + k]. */
-CVAR_API cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y, double *dy);
+CVAR_API cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y,
+                                  double *dy);
 /**@}*/
 
 /** \name Scene files: a problem and its options from the scene format (docs/scenes.md)
@@ -516,8 +516,8 @@ typedef struct cv_scene cv_scene;
  * input (read once per process; "<stdin>" in messages). set: nset strings "name=value"
  * (value a constant expression) overriding [parameters]; NULL when nset is 0. NULL on
  * failure, with the sentence in err. */
-CVAR_API cv_scene *cv_scene_load_file(const char *path, int nset, const char *const *set,
-                                      char *err, size_t errlen);
+CVAR_API cv_scene *cv_scene_load_file(const char *path, int nset, const char *const *set, char *err,
+                                      size_t errlen);
 /** Load a scene from NUL-terminated text; name (NULL: "<text>") stands for the file in
  * messages. Otherwise as cv_scene_load_file. */
 CVAR_API cv_scene *cv_scene_load_text(const char *text, const char *name, int nset,
@@ -536,8 +536,8 @@ CVAR_API const char *cv_scene_get_variable(const cv_scene *sc);
  * cv_scene_configure_solver, as the command's options do: "elements", "degree",
  * "tolerance", "max_iterations", "adapt" (a number), "method" (a cv_method value).
  * CVAR_EINVAL for an unknown name or a value out of range, with a sentence in err. */
-CVAR_API cv_status cv_scene_set_option(cv_scene *sc, const char *name, double value,
-                                       char *err, size_t errlen);
+CVAR_API cv_status cv_scene_set_option(cv_scene *sc, const char *name, double value, char *err,
+                                       size_t errlen);
 /** A problem for the scene: integrand, ends, guess, [constraints], [integrals]. NULL on
  * failure (sentence in err). Free it (cv_problem_free) before the scene. */
 CVAR_API cv_problem *cv_scene_problem_new(const cv_scene *sc, char *err, size_t errlen);
@@ -551,8 +551,7 @@ typedef struct cv_report cv_report;
 /** The report of the last cv_solve of s on p, a problem of sc (s is not modified). Without
  * [exact] it estimates the nodal error by a reference solve (docs/cli.md), as the command
  * does. NULL on failure (*why, may be NULL: CVAR_ESTATE before a solve, CVAR_ENOMEM). */
-CVAR_API cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *s,
-                                  cv_status *why);
+CVAR_API cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *s, cv_status *why);
 /** The report as JSON text (UTF-8, NUL-terminated), owned by the report. */
 CVAR_API const char *cv_report_json(const cv_report *r);
 /** Release a report; NULL is a no-op. */
@@ -572,8 +571,7 @@ CVAR_API void cv_report_free(cv_report *r);
 typedef struct cv_equations cv_equations;
 /** Derive the equations of sc (theory (P-3)..(P-7)). NULL on failure, with *why (may be
  * NULL; CVAR_EINVAL for a NULL scene, CVAR_ENOMEM) and a sentence in err (may be NULL). */
-CVAR_API cv_equations *cv_equations_new(cv_scene *sc, cv_status *why, char *err,
-                                        size_t errlen);
+CVAR_API cv_equations *cv_equations_new(cv_scene *sc, cv_status *why, char *err, size_t errlen);
 /** Release; NULL is a no-op. */
 CVAR_API void cv_equations_free(cv_equations *e);
 /** The number of unknowns (as the scene's, in its order). */
@@ -683,8 +681,8 @@ CVAR_API int cv_batch_num_outputs(const cv_batch *b);
 CVAR_API const char *cv_batch_output_name(const cv_batch *b, int k);
 /** Which parameters a row gives, in order (default: none, i.e. the scene's values). Set
  * before the first cv_batch_solve (CVAR_EINVAL after it). */
-CVAR_API cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names,
-                                        char *err, size_t errlen);
+CVAR_API cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names, char *err,
+                                        size_t errlen);
 /** Threads (default 1; 0 = the cores available). */
 CVAR_API cv_status cv_batch_set_threads(cv_batch *b, int nthreads);
 /** Start each row from the previous row's solution on the same thread (default off); a
@@ -694,13 +692,11 @@ CVAR_API cv_status cv_batch_set_warm_start(cv_batch *b, int on);
 CVAR_API cv_status cv_batch_set_mesh(cv_batch *b, int elements, int degree);
 /** Check a row's values without solving: CVAR_EINVAL with a sentence when they make the
  * scene invalid (e.g. an interval with a >= b). */
-CVAR_API cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err,
-                                      size_t errlen);
+CVAR_API cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err, size_t errlen);
 /** Solve nrows rows (row r is rows[r*ncols .. r*ncols+ncols-1]); res[r] receives row r
  * whatever order the threads took them in. CVAR_OK when the rows were all attempted (each
  * has its own status), else an error for the whole call (e.g. CVAR_ENOMEM). */
-CVAR_API cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows,
-                                  cv_batch_result *res);
+CVAR_API cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_result *res);
 /**@}*/
 
 /** \name Every stationary path: deflation (theory DF-1..DF-5) */

@@ -20,8 +20,7 @@ static int bad(const char *cmd, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
-static int bad(const char *cmd, const char *fmt, ...)
-{
+static int bad(const char *cmd, const char *fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
   fprintf(stderr, "calcvar %s: ", cmd);
@@ -31,42 +30,35 @@ static int bad(const char *cmd, const char *fmt, ...)
   return EXIT_BADINPUT;
 }
 
-static int parse_int(const char *s, long lo, long hi, int *out)
-{
+static int parse_int(const char *s, long lo, long hi, int *out) {
   char *end;
-  if (!(*s >= '0' && *s <= '9') && *s != '+')
-    return -1;
+  if (!(*s >= '0' && *s <= '9') && *s != '+') return -1;
   errno = 0;
   long v = strtol(s, &end, 10);
-  if (errno || *end || v < lo || v > hi)
-    return -1;
+  if (errno || *end || v < lo || v > hi) return -1;
   *out = (int)v;
   return 0;
 }
 
-static int parse_pos_double(const char *s, double *out)
-{
+static int parse_pos_double(const char *s, double *out) {
   char *end;
   errno = 0;
   double v = strtod(s, &end);
-  if (end == s || *end || !isfinite(v) || !(v > 0))
-    return -1;
+  if (end == s || *end || !isfinite(v) || !(v > 0)) return -1;
   *out = v;
   return 0;
 }
 
 void cli_opts_free(cli_opts *o) { free(o->set); }
 
-int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
-{
+int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o) {
   memset(o, 0, sizeof *o);
   o->method = -1;
   for (int i = 0; i < argc; i++) {
     const char *a = argv[i], *v = NULL;
     char name[32];
     if (strcmp(a, "--") == 0 || a[0] != '-' || strcmp(a, "-") == 0) {
-      if (strcmp(a, "--") == 0 && ++i >= argc)
-        break;
+      if (strcmp(a, "--") == 0 && ++i >= argc) break;
       if (o->scene_path)
         return bad(cmd, "one scene file only: '%s' and '%s'", o->scene_path, argv[i]);
       o->scene_path = argv[i];
@@ -74,25 +66,22 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     }
     const char *eq = strchr(a, '=');
     size_t nl = eq ? (size_t)(eq - a) : strlen(a);
-    if (nl >= sizeof name)
-      return bad(cmd, "unknown option '%s'", a);
+    if (nl >= sizeof name) return bad(cmd, "unknown option '%s'", a);
     memcpy(name, a, nl);
     name[nl] = '\0';
     int flag = strcmp(name, "--quiet") == 0 || strcmp(name, "--help") == 0 ||
                strcmp(name, "-h") == 0 || strcmp(name, "--all") == 0 ||
                strcmp(name, "--verbose") == 0 || strcmp(name, "-v") == 0;
     static const char *const valued[] = {
-      "--elements", "--degree", "--method", "--tolerance", "--max-iterations", "--set",
-      "--adapt", "--tol", "--continue", "--json", "--csv", "--plot", "--max", "--work",
-      "--max-elements", NULL};
+        "--elements", "--degree", "--method", "--tolerance", "--max-iterations",
+        "--set",      "--adapt",  "--tol",    "--continue",  "--json",
+        "--csv",      "--plot",   "--max",    "--work",      "--max-elements",
+        NULL};
     int known = flag;
-    for (int k = 0; valued[k]; k++)
-      known |= strcmp(name, valued[k]) == 0;
-    if (!known)
-      return bad(cmd, "unknown option '%s' (see calcvar --help)", name);
+    for (int k = 0; valued[k]; k++) known |= strcmp(name, valued[k]) == 0;
+    if (!known) return bad(cmd, "unknown option '%s' (see calcvar --help)", name);
     if (flag) {
-      if (eq)
-        return bad(cmd, "%s takes no value", name);
+      if (eq) return bad(cmd, "%s takes no value", name);
       if (strcmp(name, "--quiet") == 0)
         o->quiet = 1;
       else if (strcmp(name, "--all") == 0)
@@ -129,14 +118,18 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
     } else if (strcmp(name, "--method") == 0) {
       cv_method m;
       if (cv_method_from_name(v, &m) != CVAR_OK)
-        return bad(cmd, "unknown method '%s' (known: newton, lbfgs, tnewton, mma, ccsaq, "
-                   "slsqp, auglag)", v);
+        return bad(cmd,
+                   "unknown method '%s' (known: newton, lbfgs, tnewton, mma, ccsaq, "
+                   "slsqp, auglag)",
+                   v);
       o->method = (int)m;
     } else if (strcmp(name, "--tolerance") == 0) {
       if (parse_pos_double(v, &o->tolerance) < 0 || o->tolerance < 10 * DBL_EPSILON ||
           o->tolerance >= 1)
-        return bad(cmd, "--tolerance needs a number from 2.2e-15 (10 eps) to below 1, "
-                   "got '%s'", v);
+        return bad(cmd,
+                   "--tolerance needs a number from 2.2e-15 (10 eps) to below 1, "
+                   "got '%s'",
+                   v);
     } else if (strcmp(name, "--max-elements") == 0) {
       if (parse_int(v, 1, INT_MAX / 9, &o->max_elements) < 0)
         return bad(cmd, "--max-elements needs a whole number >= 1, got '%s'", v);
@@ -148,11 +141,9 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
         return bad(cmd, "--tol needs a target max nodal error > 0, got '%s'", v);
     } else if (strcmp(name, "--set") == 0) {
       const char *e = strchr(v, '=');
-      if (!e || e == v || !e[1])
-        return bad(cmd, "--set needs name=value, got '%s'", v);
+      if (!e || e == v || !e[1]) return bad(cmd, "--set needs name=value, got '%s'", v);
       sc_set *ns = realloc(o->set, (size_t)(o->nset + 1) * sizeof *ns);
-      if (!ns)
-        return bad(cmd, "out of memory");
+      if (!ns) return bad(cmd, "out of memory");
       o->set = ns;
       /* Split in place: argv strings are writable (C11 5.1.2.2.1). */
       *(char *)e = '\0';
@@ -165,11 +156,9 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
       if (!e || e == v || !c || c == e + 1 || !c[1])
         return bad(cmd, "--continue needs name=from:to, got '%s'", v);
       strtod(e + 1, &end);
-      if (end != c)
-        return bad(cmd, "--continue name=from:to: 'from' is not a number in '%s'", v);
+      if (end != c) return bad(cmd, "--continue name=from:to: 'from' is not a number in '%s'", v);
       strtod(c + 1, &end);
-      if (*end)
-        return bad(cmd, "--continue name=from:to: 'to' is not a number in '%s'", v);
+      if (*end) return bad(cmd, "--continue name=from:to: 'to' is not a number in '%s'", v);
       o->cont = v;
     } else if (strcmp(name, "--json") == 0) {
       o->json = v;
@@ -181,16 +170,13 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
         return bad(cmd, "--plot FILE must end in .png or .svg, got '%s'", v);
       o->plot = v;
     }
-    if (!*v)
-      return bad(cmd, "%s needs a non-empty value", name);
+    if (!*v) return bad(cmd, "%s needs a non-empty value", name);
   }
-  if (o->help)
-    return 0;
-  if (!o->scene_path)
-    return bad(cmd, "a scene file is missing: calcvar %s SCENE [options]", cmd);
+  if (o->help) return 0;
+  if (!o->scene_path) return bad(cmd, "a scene file is missing: calcvar %s SCENE [options]", cmd);
   if (o->tol > 0 && o->adapt > 0)
     return bad(cmd, "--tol and --adapt cannot be combined (--tol chooses the mesh and the "
-               "degrees, --adapt the mesh at one degree)");
+                    "degrees, --adapt the mesh at one degree)");
   if ((o->max_paths || o->work > 0) && !o->all)
     return bad(cmd, "--max and --work belong to --all; give --all too");
   if (o->json && o->csv && strcmp(o->json, "-") == 0 && strcmp(o->csv, "-") == 0)
@@ -202,61 +188,49 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o)
 
 /* For commands that only read a scene (equations, modes): reject solve-only options. */
 int cli_scene_command_start(const char *cmd, int argc, char **argv, void (*usage)(FILE *),
-                            cli_opts *o, scene **s, cli_outfile *jf)
-{
+                            cli_opts *o, scene **s, cli_outfile *jf) {
   char err[SC_ERRLEN] = "";
   *s = NULL;
   int rc = cli_args_parse(cmd, argc, argv, o);
   if (rc != 0 || o->help) {
-    if (o->help)
-      usage(stdout);
+    if (o->help) usage(stdout);
     return rc;
   }
-  if ((rc = cli_only_scene_options(cmd, o)) != 0)
-    return rc;
+  if ((rc = cli_only_scene_options(cmd, o)) != 0) return rc;
   if (!(*s = scene_load_file(o->scene_path, o->nset, o->set, err, sizeof err))) {
     fprintf(stderr, "%s\n", err);
     return EXIT_BADINPUT;
   }
   /* Output files are opened before the work: an unwritable path is bad input. */
-  if (o->json && cli_outfile_open(jf, o->json, o->scene_path) < 0)
-    return EXIT_BADINPUT;
+  if (o->json && cli_outfile_open(jf, o->json, o->scene_path) < 0) return EXIT_BADINPUT;
   return -1;
 }
 
-int cli_apply_accuracy(const cli_opts *o, scene *s)
-{
+int cli_apply_accuracy(const cli_opts *o, scene *s) {
   if ((o->tol > 0 && s->adapt > 0) || (o->adapt > 0 && s->tol > 0)) {
     fprintf(stderr, "%s:%d: [mesh] %s cannot be combined with %s\n", s->file,
             s->tol > 0 ? s->tol_line : s->adapt_line, s->tol > 0 ? "tol" : "adapt",
             s->tol > 0 ? "--adapt" : "--tol");
     return EXIT_BADINPUT;
   }
-  if (o->adapt > 0)
-    s->adapt = o->adapt;
+  if (o->adapt > 0) s->adapt = o->adapt;
   double tol = o->tol > 0 ? o->tol : s->tol;
   if (tol > 0) { /* automatic accuracy: the scene's or the flags' mesh is only the start */
     s->tol = tol;
     if (!o->elements && !s->elements_line && s->grading <= 0)
       s->elements = SCENE_TOL_START_ELEMENTS;
-    if (!o->degree && !s->degree_line)
-      s->degree = SCENE_TOL_START_DEGREE;
+    if (!o->degree && !s->degree_line) s->degree = SCENE_TOL_START_DEGREE;
   }
   return 0;
 }
 
-void cli_apply_solver_options(const cli_opts *o, scene *s)
-{
-  if (o->method >= 0)
-    s->method = (cv_method)o->method;
-  if (o->tolerance > 0)
-    s->tolerance = o->tolerance;
-  if (o->max_iterations)
-    s->max_iterations = o->max_iterations;
+void cli_apply_solver_options(const cli_opts *o, scene *s) {
+  if (o->method >= 0) s->method = (cv_method)o->method;
+  if (o->tolerance > 0) s->tolerance = o->tolerance;
+  if (o->max_iterations) s->max_iterations = o->max_iterations;
 }
 
-int cli_only_scene_options(const char *cmd, const cli_opts *o)
-{
+int cli_only_scene_options(const char *cmd, const cli_opts *o) {
   if (o->csv || o->plot || o->adapt > 0 || o->tol > 0 || o->cont || o->elements || o->degree ||
       o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all || o->max_elements ||
       o->verbose) {

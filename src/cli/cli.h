@@ -20,7 +20,7 @@ typedef struct {
   int method; /* cv_method or -1 */
   double tolerance;
   double adapt;
-  double tol; /* --tol: automatic accuracy (hp) */
+  double tol;       /* --tol: automatic accuracy (hp) */
   int max_elements; /* --max-elements: the adaptive cap (0: 2e6) */
   const char *cont; /* --continue name=from:to */
   int nset;
@@ -138,7 +138,7 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, int a
 
 /* Subcommands. */
 int cli_converge(int argc, char **argv);
-int cli_batch(int argc, char **argv);     /* cli_batch.c */
+int cli_batch(int argc, char **argv); /* cli_batch.c */
 int cli_gallery(void);
 int cli_solve(int argc, char **argv);
 int cli_check(int argc, char **argv);

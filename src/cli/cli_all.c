@@ -26,18 +26,15 @@ typedef struct {
   double a, b;
 } path_guess;
 
-static int guess_from_path(int m, const double *x, double *y, void *user)
-{
+static int guess_from_path(int m, const double *x, double *y, void *user) {
   const path_guess *g = user;
   double xc[256];
-  for (int k = 0; k < m; k++)
-    xc[k] = fmin(g->b, fmax(g->a, x[k]));
+  for (int k = 0; k < m; k++) xc[k] = fmin(g->b, fmax(g->a, x[k]));
   return cv_solver_eval(g->sv, m, xc, y, NULL) == CVAR_OK ? 0 : 1;
 }
 
 /* Max difference of two paths at the nodes of the first (the second interpolated). */
-static double path_distance(const cli_report *r1, cv_solver *sv, int k2, int n)
-{
+static double path_distance(const cli_report *r1, cv_solver *sv, int k2, int n) {
   double *y = malloc((size_t)r1->nodes * n * sizeof *y), d = INFINITY;
   if (!y || cv_solver_select_solution(sv, k2) != CVAR_OK ||
       cv_solver_eval(sv, r1->nodes, r1->x, y, NULL) != CVAR_OK) {
@@ -52,11 +49,9 @@ static double path_distance(const cli_report *r1, cv_solver *sv, int k2, int n)
   return d;
 }
 
-static json_t *search_json(const cv_search_info *in, int listed)
-{
+static json_t *search_json(const cv_search_info *in, int listed) {
   json_t *o = json_object();
-  if (!o)
-    return NULL;
+  if (!o) return NULL;
   json_object_set_new(o, "starts", json_integer(in->starts));
   json_object_set_new(o, "failed", json_integer(in->failed));
   json_object_set_new(o, "duplicates", json_integer(in->duplicates + (in->found - listed)));
@@ -66,8 +61,7 @@ static json_t *search_json(const cv_search_info *in, int listed)
 }
 
 static int write_json(FILE *f, cli_report *r, const int *keep, int np, const cv_search_info *in,
-                      int listed)
-{
+                      int listed) {
   json_t *o = json_object(), *a = json_array();
   if (!o || !a) {
     json_decref(o);
@@ -75,27 +69,23 @@ static int write_json(FILE *f, cli_report *r, const int *keep, int np, const cv_
     return -1;
   }
   for (int k = 0; k < np; k++)
-    if (keep[k])
-      json_array_append_new(a, cli_report_json_object(&r[k]));
+    if (keep[k]) json_array_append_new(a, cli_report_json_object(&r[k]));
   json_object_set_new(o, "solutions", a);
   json_object_set_new(o, "search", search_json(in, listed));
   int rc = json_dumpf(o, f, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
-  if (rc == 0 && fputc('\n', f) == EOF)
-    rc = -1;
+  if (rc == 0 && fputc('\n', f) == EOF) rc = -1;
   json_decref(o);
   return rc;
 }
 
 /* One table: the plain solve's CSV of each path with `solution` (1, 2, ...) in front. */
-static int write_csv(FILE *f, cli_report *r, const int *keep, int np, const scene *s)
-{
+static int write_csv(FILE *f, cli_report *r, const int *keep, int np, const scene *s) {
   int num = 0, header = 0;
   for (int k = 0; k < np || !header; k++) {
     char *buf = NULL;
     size_t len = 0;
     FILE *m = open_memstream(&buf, &len);
-    if (!m)
-      return -1;
+    if (!m) return -1;
     int bad = 0;
     if (k < np && keep[k]) {
       bad = cli_report_csv(m, &r[k]) < 0;
@@ -119,8 +109,7 @@ static int write_csv(FILE *f, cli_report *r, const int *keep, int np, const scen
     while (*line && (nl = strchr(line, '\n'))) {
       *nl = '\0';
       if (first) {
-        if (!header)
-          fprintf(f, "solution,%s\n", line);
+        if (!header) fprintf(f, "solution,%s\n", line);
         header = 1;
         first = 0;
       } else {
@@ -129,28 +118,23 @@ static int write_csv(FILE *f, cli_report *r, const int *keep, int np, const scen
       line = nl + 1;
     }
     free(buf);
-    if (k >= np)
-      break;
+    if (k >= np) break;
   }
   return ferror(f) ? -1 : 0;
 }
 
 static int write_plot(cli_outfile *o, cli_report *r, const int *keep, int np, cv_solver *sv,
-                      const scene *s)
-{
+                      const scene *s) {
   int n = s->n, nl = 0, rc = -1;
   double *xs = malloc(NPLOT * sizeof *xs);
   double *ys = malloc((size_t)NPLOT * n * (np ? np : 1) * sizeof *ys);
   cli_plot_line *lines = calloc((size_t)n * (np ? np : 1), sizeof *lines);
   char(*labels)[128] = calloc((size_t)n * (np ? np : 1), sizeof *labels);
-  if (!xs || !ys || !lines || !labels)
-    goto done;
-  for (int k = 0; k < NPLOT; k++)
-    xs[k] = s->a + (s->b - s->a) * k / (NPLOT - 1);
+  if (!xs || !ys || !lines || !labels) goto done;
+  for (int k = 0; k < NPLOT; k++) xs[k] = s->a + (s->b - s->a) * k / (NPLOT - 1);
   xs[NPLOT - 1] = s->b;
   for (int k = 0, num = 0; k < np; k++) {
-    if (!keep[k])
-      continue;
+    if (!keep[k]) continue;
     num++;
     double *yk = ys + (size_t)k * NPLOT * n;
     if (cv_solver_select_solution(sv, k) != CVAR_OK || cv_solver_eval(sv, NPLOT, xs, yk, NULL))
@@ -189,8 +173,7 @@ done:
 }
 
 int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, int adaptive,
-                cli_outfile *jf, cli_outfile *cf, cli_outfile *pf)
-{
+                cli_outfile *jf, cli_outfile *cf, cli_outfile *pf) {
   int max = o->max_paths > 0 ? o->max_paths : 8, rc = EXIT_UNSOLVED;
   if (o->work > 0 && cv_solver_set_search_work(sv, o->work) != CVAR_OK) {
     fprintf(stderr, "calcvar solve: invalid --work %g\n", o->work);
@@ -208,11 +191,9 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, int a
   cli_report *r = calloc((size_t)(np ? np : 1), sizeof *r);
   int *keep = calloc((size_t)(np ? np : 1), sizeof *keep);
   path_guess pg = {sv, s->a, s->b};
-  if (!r || !keep)
-    goto oom;
+  if (!r || !keep) goto oom;
   /* every later solve on p (the estimates' reference solves) starts from the selected path */
-  if (np > 0 && cv_problem_set_guess(p, guess_from_path, &pg) != CVAR_OK)
-    goto oom;
+  if (np > 0 && cv_problem_set_guess(p, guess_from_path, &pg) != CVAR_OK) goto oom;
   for (int k = 0; k < np; k++) {
     if (cv_solver_select_solution(sv, k) != CVAR_OK ||
         cli_report_build(&r[k], s, p, sv, CVAR_OK, adaptive) < 0)
@@ -222,15 +203,11 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, int a
   /* distinct only beyond the error estimate of either (paths are in increasing action) */
   for (int k = 0; k < np; k++)
     for (int l = 0; l < k && keep[k]; l++) {
-      if (!keep[l])
-        continue;
-      double e = fmax(r[k].has_err_est ? r[k].err_est : 0.0,
-                      r[l].has_err_est ? r[l].err_est : 0.0);
-      if (path_distance(&r[k], sv, l, s->n) <= e)
-        keep[k] = 0;
+      if (!keep[l]) continue;
+      double e = fmax(r[k].has_err_est ? r[k].err_est : 0.0, r[l].has_err_est ? r[l].err_est : 0.0);
+      if (path_distance(&r[k], sv, l, s->n) <= e) keep[k] = 0;
     }
-  for (int k = 0; k < np; k++)
-    listed += keep[k];
+  for (int k = 0; k < np; k++) listed += keep[k];
   rc = listed > 0 ? EXIT_SOLVED : EXIT_UNSOLVED;
   if (jf->f && cli_outfile_finish(jf, write_json(jf->f, r, keep, np, &in, listed)) < 0) {
     fprintf(stderr, "calcvar solve: the JSON report could not be written\n");
@@ -248,9 +225,10 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, int a
   if (!o->quiet && !stdout_taken) {
     printf("%s\n", s->title);
     printf("  search      %d stationary path%s from %d start%s (%d failed, %d duplicate%s); "
-           "%s\n", listed, listed == 1 ? "" : "s", in.starts, in.starts == 1 ? "" : "s",
-           in.failed, in.duplicates + (in.found - listed),
-           in.duplicates + (in.found - listed) == 1 ? "" : "s", in.stop);
+           "%s\n",
+           listed, listed == 1 ? "" : "s", in.starts, in.starts == 1 ? "" : "s", in.failed,
+           in.duplicates + (in.found - listed), in.duplicates + (in.found - listed) == 1 ? "" : "s",
+           in.stop);
     for (int k = 0, num = 0; k < np; k++)
       if (keep[k]) {
         printf("  path %-6d action %.15g, Morse index %d, %s", ++num, r[k].action, r[k].morse,
@@ -263,16 +241,16 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, int a
       }
   }
   if (listed == 0)
-    fprintf(stderr, "calcvar solve: %s: --all found no converged stationary path (%d start%s "
-            "tried): %s\n", s->file, in.starts, in.starts == 1 ? "" : "s",
-            cv_solver_last_error(sv));
+    fprintf(stderr,
+            "calcvar solve: %s: --all found no converged stationary path (%d start%s "
+            "tried): %s\n",
+            s->file, in.starts, in.starts == 1 ? "" : "s", cv_solver_last_error(sv));
   goto done;
 oom:
   fprintf(stderr, "calcvar solve: out of memory while reporting the paths\n");
   rc = EXIT_UNSOLVED;
 done:
-  for (int k = 0; r && k < np; k++)
-    cli_report_free(&r[k]);
+  for (int k = 0; r && k < np; k++) cli_report_free(&r[k]);
   free(r);
   free(keep);
   return rc;

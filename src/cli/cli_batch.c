@@ -25,8 +25,7 @@
 
 enum { ROWS_PER_THREAD = 32 }; /* window = threads x this (x ranks under MPI) */
 
-static void usage(FILE *f)
-{
+static void usage(FILE *f) {
   fputs("usage: calcvar batch SCENE TABLE.csv [options]\n"
         "  TABLE.csv            header of parameter names, one row of values per problem\n"
         "  --out FILE           the result table (default stdout)\n"
@@ -37,14 +36,13 @@ static void usage(FILE *f)
         "Output: the input columns, status, action, iterations, time_s, morse_index,\n"
         "error_max_nodal (with [exact]), error_estimate (with --adapt, always with --tol),\n"
         "one column per [report] entry and integral multiplier (mu_NAME), message.\n"
-        "exit status: 0 every row converged, 1 some did not, 2 bad input\n", f);
+        "exit status: 0 every row converged, 1 some did not, 2 bad input\n",
+        f);
 }
 
-int cli_cores_available(void)
-{
+int cli_cores_available(void) {
   cpu_set_t set;
-  if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0)
-    return CPU_COUNT(&set);
+  if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) return CPU_COUNT(&set);
   long c = sysconf(_SC_NPROCESSORS_ONLN);
   return c > 0 ? (int)c : 1;
 }
@@ -58,53 +56,40 @@ typedef struct {
   size_t cap;
   int lineno;
   int ncols;
-  char **names;  /* header */
-  char **field;  /* fields of the current row (point into line) */
+  char **names; /* header */
+  char **field; /* fields of the current row (point into line) */
 } table;
 
 /* Next non-blank line split at commas into t->field; returns the field count, 0 at the
  * end, -1 on a read error. Fields are trimmed of blanks; the line's end is removed. */
-static int next_line(table *t, int maxf)
-{
+static int next_line(table *t, int maxf) {
   for (;;) {
     ssize_t len = getline(&t->line, &t->cap, t->f);
-    if (len < 0)
-      return ferror(t->f) ? -1 : 0;
+    if (len < 0) return ferror(t->f) ? -1 : 0;
     t->lineno++;
-    while (len > 0 && (t->line[len - 1] == '\n' || t->line[len - 1] == '\r'))
-      t->line[--len] = '\0';
+    while (len > 0 && (t->line[len - 1] == '\n' || t->line[len - 1] == '\r')) t->line[--len] = '\0';
     char *p = t->line;
-    while (*p == ' ' || *p == '\t')
-      p++;
-    if (!*p)
-      continue; /* blank lines are skipped */
+    while (*p == ' ' || *p == '\t') p++;
+    if (!*p) continue; /* blank lines are skipped */
     int k = 0;
     for (;;) {
       char *c = strchr(p, ',');
-      if (c)
-        *c = '\0';
-      while (*p == ' ' || *p == '\t')
-        p++;
+      if (c) *c = '\0';
+      while (*p == ' ' || *p == '\t') p++;
       char *e = p + strlen(p);
-      while (e > p && (e[-1] == ' ' || e[-1] == '\t'))
-        *--e = '\0';
-      if (k < maxf)
-        t->field[k] = p;
+      while (e > p && (e[-1] == ' ' || e[-1] == '\t')) *--e = '\0';
+      if (k < maxf) t->field[k] = p;
       k++;
-      if (!c)
-        break;
+      if (!c) break;
       p = c + 1;
     }
     return k;
   }
 }
 
-static void table_close(table *t)
-{
-  if (t->f)
-    fclose(t->f);
-  for (int c = 0; t->names && c < t->ncols; c++)
-    free(t->names[c]);
+static void table_close(table *t) {
+  if (t->f) fclose(t->f);
+  for (int c = 0; t->names && c < t->ncols; c++) free(t->names[c]);
   free(t->names);
   free(t->field);
   free(t->line);
@@ -112,8 +97,7 @@ static void table_close(table *t)
 }
 
 /* Open and read the header. 0, or EXIT_BADINPUT after a message. */
-static int table_open(table *t, const char *path, cv_batch *b)
-{
+static int table_open(table *t, const char *path, cv_batch *b) {
   char err[512];
   memset(t, 0, sizeof *t);
   t->path = path;
@@ -130,22 +114,21 @@ static int table_open(table *t, const char *path, cv_batch *b)
   int k = next_line(t, maxf);
   if (k <= 0) {
     fprintf(stderr, "%s:%d: %s\n", path, t->lineno > 0 ? t->lineno : 1,
-            k < 0 ? "read error" : "the table is empty (it needs a header of parameter "
-                                   "names)");
+            k < 0 ? "read error"
+                  : "the table is empty (it needs a header of parameter "
+                    "names)");
     return EXIT_BADINPUT;
   }
   if (k > np) {
-    fprintf(stderr, "%s:%d: the header has %d columns but %s has %d parameter%s\n", path,
-            t->lineno, k, scene_batch_scene(b)->file, np, np == 1 ? "" : "s");
+    fprintf(stderr, "%s:%d: the header has %d columns but %s has %d parameter%s\n", path, t->lineno,
+            k, scene_batch_scene(b)->file, np, np == 1 ? "" : "s");
     return EXIT_BADINPUT;
   }
   t->names = calloc((size_t)k, sizeof *t->names);
-  if (!t->names)
-    return EXIT_BADINPUT;
+  if (!t->names) return EXIT_BADINPUT;
   t->ncols = k;
   for (int c = 0; c < k; c++)
-    if (!(t->names[c] = strdup(t->field[c])))
-      return EXIT_BADINPUT;
+    if (!(t->names[c] = strdup(t->field[c]))) return EXIT_BADINPUT;
   if (cv_batch_set_columns(b, k, (const char *const *)t->names, err, sizeof err) != CVAR_OK) {
     fprintf(stderr, "%s:%d: %s\n", path, t->lineno, err[0] ? err : "out of memory");
     return EXIT_BADINPUT;
@@ -155,18 +138,16 @@ static int table_open(table *t, const char *path, cv_batch *b)
 
 /* Next row into vals (ncols numbers): 1, 0 at the end, or EXIT_BADINPUT (negated: -2)
  * after a message. */
-static int table_row(table *t, double *vals)
-{
+static int table_row(table *t, double *vals) {
   int k = next_line(t, t->ncols);
-  if (k == 0)
-    return 0;
+  if (k == 0) return 0;
   if (k < 0) {
     fprintf(stderr, "%s:%d: read error\n", t->path, t->lineno);
     return -EXIT_BADINPUT;
   }
   if (k != t->ncols) {
-    fprintf(stderr, "%s:%d: %d value%s, but the header has %d column%s\n", t->path,
-            t->lineno, k, k == 1 ? "" : "s", t->ncols, t->ncols == 1 ? "" : "s");
+    fprintf(stderr, "%s:%d: %d value%s, but the header has %d column%s\n", t->path, t->lineno, k,
+            k == 1 ? "" : "s", t->ncols, t->ncols == 1 ? "" : "s");
     return -EXIT_BADINPUT;
   }
   for (int c = 0; c < k; c++) {
@@ -174,8 +155,8 @@ static int table_row(table *t, double *vals)
     errno = 0;
     vals[c] = strtod(t->field[c], &end);
     if (end == t->field[c] || *end || !isfinite(vals[c])) {
-      fprintf(stderr, "%s:%d: column '%s': '%s' is not a finite number\n", t->path,
-              t->lineno, t->names[c], t->field[c]);
+      fprintf(stderr, "%s:%d: column '%s': '%s' is not a finite number\n", t->path, t->lineno,
+              t->names[c], t->field[c]);
       return -EXIT_BADINPUT;
     }
   }
@@ -184,32 +165,24 @@ static int table_row(table *t, double *vals)
 
 /* ---- one output row ----------------------------------------------------------------- */
 
-static void num(cli_buf *o, double v, const char *fmt)
-{
+static void num(cli_buf *o, double v, const char *fmt) {
   cli_buf_printf(o, ",");
-  if (isfinite(v))
-    cli_buf_printf(o, fmt, v);
+  if (isfinite(v)) cli_buf_printf(o, fmt, v);
 }
 
 /* The row's output line (input fields as given) appended to o. */
 static void format_row(cli_buf *o, const cli_batch_cols *cols, char *const *in,
-                       const cv_batch_result *r)
-{
-  for (int c = 0; c < cols->ncols; c++)
-    cli_buf_printf(o, "%s%s", c ? "," : "", in[c]);
+                       const cv_batch_result *r) {
+  for (int c = 0; c < cols->ncols; c++) cli_buf_printf(o, "%s%s", c ? "," : "", in[c]);
   cli_buf_printf(o, "%s%s", cols->ncols ? "," : "", cli_status_string(r->status));
   num(o, r->has_result ? r->action : NAN, "%.17g");
   cli_buf_printf(o, ",%d", r->iterations);
   num(o, r->time_s, "%.6f");
   cli_buf_printf(o, ",");
-  if (r->has_result && r->morse_index >= 0)
-    cli_buf_printf(o, "%d", r->morse_index);
-  if (cols->err_nodal)
-    num(o, r->has_result ? r->error_max_nodal : NAN, "%.3e");
-  if (cols->err_est)
-    num(o, r->has_result ? r->error_estimate : NAN, "%.3e");
-  for (int k = 0; k < cols->nout; k++)
-    num(o, r->has_result ? r->outputs[k] : NAN, "%.17g");
+  if (r->has_result && r->morse_index >= 0) cli_buf_printf(o, "%d", r->morse_index);
+  if (cols->err_nodal) num(o, r->has_result ? r->error_max_nodal : NAN, "%.3e");
+  if (cols->err_est) num(o, r->has_result ? r->error_estimate : NAN, "%.3e");
+  for (int k = 0; k < cols->nout; k++) num(o, r->has_result ? r->outputs[k] : NAN, "%.17g");
   /* the message as one quoted CSV field */
   cli_buf_printf(o, ",\"");
   for (const char *m = r->message; *m; m++) {
@@ -221,8 +194,7 @@ static void format_row(cli_buf *o, const cli_batch_cols *cols, char *const *in,
   cli_buf_printf(o, "\"\n");
 }
 
-int cli_buf_printf(cli_buf *o, const char *fmt, ...)
-{
+int cli_buf_printf(cli_buf *o, const char *fmt, ...) {
   va_list ap;
   for (;;) {
     size_t room = o->cap - o->len;
@@ -235,8 +207,7 @@ int cli_buf_printf(cli_buf *o, const char *fmt, ...)
     }
     size_t need = o->len + (k > 0 ? (size_t)k : 64) + 1;
     size_t ncap = o->cap ? o->cap : 1024;
-    while (ncap < need)
-      ncap *= 2;
+    while (ncap < need) ncap *= 2;
     char *nd = realloc(o->data, ncap);
     if (!nd) {
       o->failed = 1;
@@ -249,8 +220,7 @@ int cli_buf_printf(cli_buf *o, const char *fmt, ...)
 
 /* ---- the command -------------------------------------------------------------------- */
 
-static double wall(void)
-{
+static double wall(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
@@ -259,8 +229,7 @@ static double wall(void)
 /* Take batch's own options out of argv (the rest goes to the solve option parser).
  * Returns 0, or EXIT_BADINPUT after a message. */
 static int own_args(int argc, char **argv, char **rest, int *nrest, const char **table_path,
-                    const char **out, int *threads, int *warm, int *help)
-{
+                    const char **out, int *threads, int *warm, int *help) {
   int npos = 0;
   *nrest = 0;
   for (int i = 0; i < argc; i++) {
@@ -280,8 +249,10 @@ static int own_args(int argc, char **argv, char **rest, int *nrest, const char *
       char *end;
       long t = v ? strtol(v, &end, 10) : 0;
       if (!v || !*v || *end || t < 1 || t > 1024) {
-        fprintf(stderr, "calcvar batch: --threads needs a whole number from 1 to 1024, got "
-                "'%s'\n", v ? v : "");
+        fprintf(stderr,
+                "calcvar batch: --threads needs a whole number from 1 to 1024, got "
+                "'%s'\n",
+                v ? v : "");
         return EXIT_BADINPUT;
       }
       *threads = (int)t;
@@ -301,31 +272,27 @@ static int own_args(int argc, char **argv, char **rest, int *nrest, const char *
   return 0;
 }
 
-int cli_batch(int argc, char **argv)
-{
+int cli_batch(int argc, char **argv) {
   cli_opts o;
   memset(&o, 0, sizeof o);
   char **rest = malloc(((size_t)argc + 1) * sizeof *rest);
   const char *table_path = NULL, *out_path = NULL;
   int threads = 0, warm = 0, help = 0, nrest = 0, rc;
-  if (!rest)
-    return EXIT_BADINPUT;
+  if (!rest) return EXIT_BADINPUT;
   cli_mpi mpi;
   cli_mpi_init(&mpi);
   rc = own_args(argc, argv, rest, &nrest, &table_path, &out_path, &threads, &warm, &help);
-  if (rc == 0)
-    rc = cli_args_parse("batch", nrest, rest, &o);
+  if (rc == 0) rc = cli_args_parse("batch", nrest, rest, &o);
   free(rest);
   if (rc != 0 || help || o.help) {
-    if (rc == 0 && mpi.rank == 0)
-      usage(stdout);
+    if (rc == 0 && mpi.rank == 0) usage(stdout);
     cli_opts_free(&o);
     cli_mpi_finish(&mpi);
     return rc;
   }
   if (!o.scene_path || !table_path) {
     fprintf(stderr, "calcvar batch: needs a scene and a table: calcvar batch SCENE "
-            "TABLE.csv [options]\n");
+                    "TABLE.csv [options]\n");
     cli_opts_free(&o);
     cli_mpi_finish(&mpi);
     return EXIT_BADINPUT;
@@ -333,7 +300,7 @@ int cli_batch(int argc, char **argv)
   if (o.verbose) {
     /* rows are solved on several threads (and ranks): per-iteration lines would interleave */
     fprintf(stderr, "calcvar batch: --verbose is not available for batch yet; run calcvar "
-            "solve --verbose --set ... on a row to see its iterations\n");
+                    "solve --verbose --set ... on a row to see its iterations\n");
     cli_opts_free(&o);
     cli_mpi_finish(&mpi);
     return EXIT_BADINPUT;
@@ -341,8 +308,14 @@ int cli_batch(int argc, char **argv)
   if (o.cont || o.json || o.csv || o.plot || o.all || o.max_paths || o.work > 0 ||
       o.max_elements > 0) {
     fprintf(stderr, "calcvar batch: --%s is an option of calcvar solve, not of batch\n",
-            o.cont ? "continue" : o.json ? "json" : o.csv ? "csv" : o.plot ? "plot"
-            : o.all ? "all" : o.max_paths ? "max" : o.work > 0 ? "work" : "max-elements");
+            o.cont        ? "continue"
+            : o.json      ? "json"
+            : o.csv       ? "csv"
+            : o.plot      ? "plot"
+            : o.all       ? "all"
+            : o.max_paths ? "max"
+            : o.work > 0  ? "work"
+                          : "max-elements");
     cli_opts_free(&o);
     cli_mpi_finish(&mpi);
     return EXIT_BADINPUT;
@@ -353,9 +326,8 @@ int cli_batch(int argc, char **argv)
   return rc;
 }
 
-int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_path,
-                  int threads, int warm, cli_mpi *mpi)
-{
+int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_path, int threads,
+                  int warm, cli_mpi *mpi) {
   char err[SC_ERRLEN];
   int rc = EXIT_BADINPUT;
   table t;
@@ -372,10 +344,8 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     fprintf(stderr, "%s\n", err);
     goto done;
   }
-  if (o->elements)
-    s->elements = o->elements;
-  if (o->degree)
-    s->degree = o->degree;
+  if (o->elements) s->elements = o->elements;
+  if (o->degree) s->degree = o->degree;
   cli_apply_solver_options(o, s);
   if (cli_apply_accuracy(o, s) != 0) {
     scene_free(s);
@@ -383,8 +353,10 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
   }
   if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) &&
       (s->ncons > 0 || s->nints > 0)) {
-    fprintf(stderr, "calcvar batch: method %s cannot impose constraints; use mma, ccsaq, "
-            "slsqp, auglag or newton\n", cv_method_name(s->method));
+    fprintf(stderr,
+            "calcvar batch: method %s cannot impose constraints; use mma, ccsaq, "
+            "slsqp, auglag or newton\n",
+            cv_method_name(s->method));
     scene_free(s);
     goto done;
   }
@@ -394,29 +366,26 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     fprintf(stderr, "%s\n", err);
     goto done;
   }
-  if ((rc = table_open(&t, table_path, b)) != 0)
-    goto done;
+  if ((rc = table_open(&t, table_path, b)) != 0) goto done;
   rc = EXIT_BADINPUT;
   if (settings_line && t.ncols > 0) {
     /* a [mesh]/[solver] number computed from a parameter: it would have to follow the
      * row, which this build does not do (docs/cli.md) */
-    fprintf(stderr, "%s:%d: a [mesh] or [solver] value uses a parameter; calcvar batch "
-            "keeps one mesh and solver setting for every row\n", scene_file,
-            settings_line > 0 ? settings_line : 0);
+    fprintf(stderr,
+            "%s:%d: a [mesh] or [solver] value uses a parameter; calcvar batch "
+            "keeps one mesh and solver setting for every row\n",
+            scene_file, settings_line > 0 ? settings_line : 0);
     goto done;
   }
   int nc = t.ncols;
   vals = malloc(((size_t)nc + 1) * sizeof *vals);
-  if (!vals)
-    goto done;
+  if (!vals) goto done;
   /* Pass 1: the whole table is checked before anything is written. */
   long nrows = 0;
   for (;;) {
     int k = table_row(&t, vals);
-    if (k < 0)
-      goto done;
-    if (k == 0)
-      break;
+    if (k < 0) goto done;
+    if (k == 0) break;
     if (cv_batch_check_row(b, vals, err, sizeof err) != CVAR_OK) {
       /* the scene's message names the scene; the row is where the values came from */
       fprintf(stderr, "%s:%d: %s\n", t.path, t.lineno, err);
@@ -429,38 +398,29 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     goto done;
   }
   table_close(&t);
-  if ((rc = table_open(&t, table_path, b)) != 0)
-    goto done;
+  if ((rc = table_open(&t, table_path, b)) != 0) goto done;
   rc = EXIT_BADINPUT;
-  if (threads == 0)
-    threads = cli_cores_available();
+  if (threads == 0) threads = cli_cores_available();
   cv_batch_set_threads(b, threads);
   cv_batch_set_warm_start(b, warm);
   if (out_path && strcmp(out_path, table_path) == 0) {
-    fprintf(stderr, "calcvar batch: --out %s would overwrite the table being read\n",
-            out_path);
+    fprintf(stderr, "calcvar batch: --out %s would overwrite the table being read\n", out_path);
     goto done;
   }
-  if (mpi->rank == 0 && out_path && cli_outfile_open(&of, out_path, o->scene_path) < 0)
-    goto done;
+  if (mpi->rank == 0 && out_path && cli_outfile_open(&of, out_path, o->scene_path) < 0) goto done;
   FILE *f = mpi->rank == 0 ? (out_path ? of.f : stdout) : NULL;
 
   cli_batch_cols cols = {nc, 0, 0, cv_batch_num_outputs(b)};
   const scene *sc = scene_batch_scene(b);
-  for (int i = 0; i < sc->n; i++)
-    cols.err_nodal |= sc->exact[i] >= 0;
+  for (int i = 0; i < sc->n; i++) cols.err_nodal |= sc->exact[i] >= 0;
   /* the estimate where it applies: --adapt without [exact], and --tol always (its target) */
   cols.err_est = (!cols.err_nodal && sc->adapt > 0) || sc->tol > 0;
   if (f) {
-    for (int c = 0; c < nc; c++)
-      fprintf(f, "%s,", t.names[c]);
+    for (int c = 0; c < nc; c++) fprintf(f, "%s,", t.names[c]);
     fprintf(f, "status,action,iterations,time_s,morse_index");
-    if (cols.err_nodal)
-      fprintf(f, ",error_max_nodal");
-    if (cols.err_est)
-      fprintf(f, ",error_estimate");
-    for (int k = 0; k < cols.nout; k++)
-      fprintf(f, ",%s", cv_batch_output_name(b, k));
+    if (cols.err_nodal) fprintf(f, ",error_max_nodal");
+    if (cols.err_est) fprintf(f, ",error_estimate");
+    for (int k = 0; k < cols.nout; k++) fprintf(f, ",%s", cv_batch_output_name(b, k));
     fprintf(f, ",message\n");
   }
 
@@ -476,8 +436,7 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     free(wvals);
     goto done;
   }
-  for (int r = 0; r < W; r++)
-    res[r].outputs = outs + (size_t)r * cols.nout;
+  for (int r = 0; r < W; r++) res[r].outputs = outs + (size_t)r * cols.nout;
   long done_rows = 0, failures = 0;
   int tty = mpi->rank == 0 && isatty(2);
   double t0 = wall();
@@ -501,14 +460,12 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
         ok = 0;
         break;
       }
-      if (r < m0 || r >= m0 + W)
-        continue;
+      if (r < m0 || r >= m0 + W) continue;
       for (int c = 0; c < nc; c++) {
         size_t l = strlen(t.field[c]) + 1;
         if (slen + l > scap) {
           size_t ncap = scap ? 2 * scap : 4096;
-          while (ncap < slen + l)
-            ncap *= 2;
+          while (ncap < slen + l) ncap *= 2;
           char *ns = realloc(store, ncap);
           if (!ns) {
             ok = 0;
@@ -528,8 +485,7 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
       break;
     }
     for (long r = 0; r < mine; r++)
-      for (int c = 0; c < nc; c++)
-        text[r * nc + c] = store + off[r * nc + c];
+      for (int c = 0; c < nc; c++) text[r * nc + c] = store + off[r * nc + c];
     free(off);
     if (mine > 0 && cv_batch_solve(b, (int)mine, wvals, res) != CVAR_OK) {
       fprintf(stderr, "calcvar batch: out of memory\n");
@@ -552,14 +508,13 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     done_rows += wn;
     if (tty) {
       double el = wall() - t0;
-      fprintf(stderr, "\rcalcvar batch: %ld/%ld rows, %.1f rows/s, %ld failed", done_rows,
-              nrows, el > 0 ? done_rows / el : 0.0, failures);
+      fprintf(stderr, "\rcalcvar batch: %ld/%ld rows, %.1f rows/s, %ld failed", done_rows, nrows,
+              el > 0 ? done_rows / el : 0.0, failures);
     }
   }
   free(wvals);
   free(store);
-  if (tty)
-    fputc('\n', stderr);
+  if (tty) fputc('\n', stderr);
   if (!ok) {
     rc = EXIT_UNSOLVED;
     goto done;

@@ -41,7 +41,7 @@ int cli_mpi_gather_write(cli_mpi *m, FILE *f, const cli_buf *rows);
 long cli_mpi_reduce_failures(cli_mpi *m, long failures);
 
 int cli_cores_available(void);
-int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_path,
-                  int threads, int warm, cli_mpi *mpi);
+int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_path, int threads,
+                  int warm, cli_mpi *mpi);
 
 #endif /* CV_CLI_BATCH_H */

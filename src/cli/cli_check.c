@@ -17,22 +17,19 @@ enum { NSAMPLE = 7 };
  * derivative, not round-off. */
 static const double CHECK_TOL = 1e-5;
 
-static void print_end(const sc_boundary *bc, int end)
-{
+static void print_end(const sc_boundary *bc, int end) {
   if (bc->free_end[end])
     printf("free (natural)");
   else
     printf("%.15g", bc->value[end]);
 }
 
-int cli_check(int argc, char **argv)
-{
+int cli_check(int argc, char **argv) {
   cli_opts o;
   char err[SC_ERRLEN];
   int rc = cli_args_parse("check", argc, argv, &o);
   if (rc != 0 || o.help) {
-    if (o.help)
-      printf("usage: calcvar check SCENE [--set name=value] [--method M]\n");
+    if (o.help) printf("usage: calcvar check SCENE [--set name=value] [--method M]\n");
     cli_opts_free(&o);
     return rc;
   }
@@ -48,17 +45,16 @@ int cli_check(int argc, char **argv)
     cli_opts_free(&o);
     return EXIT_BADINPUT;
   }
-  if (o.method >= 0)
-    s->method = (cv_method)o.method;
+  if (o.method >= 0) s->method = (cv_method)o.method;
   int n = s->n;
   printf("%s (%s)\n", s->title, s->file);
   printf("  variable     %s on [%.15g, %.15g]\n", s->variable, s->a, s->b);
   printf("  unknowns    ");
-  for (int i = 0; i < n; i++)
-    printf(" %s", s->unknowns[i]);
+  for (int i = 0; i < n; i++) printf(" %s", s->unknowns[i]);
   printf("\n  constraints  %d pointwise, %d integral\n", s->ncons, s->nints);
   printf("  freedom      %d unknown function%s - %d pointwise constraint%s = %d degree%s of "
-         "freedom\n", n, n == 1 ? "" : "s", s->ncons, s->ncons == 1 ? "" : "s", n - s->ncons,
+         "freedom\n",
+         n, n == 1 ? "" : "s", s->ncons, s->ncons == 1 ? "" : "s", n - s->ncons,
          n - s->ncons == 1 ? "" : "s");
   for (int i = 0; i < n; i++) {
     printf("  boundary     %s: ", s->unknowns[i]);
@@ -67,25 +63,23 @@ int cli_check(int argc, char **argv)
     print_end(&s->bc[i], 1);
     printf(" at %s = %.15g\n", s->variable, s->b);
   }
-  printf("  integrand    %s explicit %s", scene_F_depends_on_variable(s) ? "depends on" :
-         "has no", s->variable);
-  if (!scene_F_depends_on_variable(s))
-    printf(" (energy H = y'.dF/dy' - F is conserved)");
+  printf("  integrand    %s explicit %s", scene_F_depends_on_variable(s) ? "depends on" : "has no",
+         s->variable);
+  if (!scene_F_depends_on_variable(s)) printf(" (energy H = y'.dF/dy' - F is conserved)");
   printf("\n  cyclic      ");
   int ncyc = 0;
   for (int i = 0; i < n; i++)
-    if (!scene_F_depends_on_unknown(s, i))
-      printf(" %s", s->unknowns[i]), ncyc++;
+    if (!scene_F_depends_on_unknown(s, i)) printf(" %s", s->unknowns[i]), ncyc++;
   printf("%s\n", ncyc ? " (their momenta dF/dy' are conserved)" : " none");
   if ((ncyc || !scene_F_depends_on_variable(s)) && s->ncons + s->nints > 0)
     printf("               (these conservation laws hold for F alone: constraints that "
-           "involve %s or the unknowns can break them)\n", s->variable);
+           "involve %s or the unknowns can break them)\n",
+           s->variable);
   unsigned need = scene_method_need(s->method);
   printf("  method       %s needs F, dF/dy, dF/dy'%s\n", cv_method_name(s->method),
          need & CVAR_NEED_HESS ? " and the second partials (y,y), (y,y'), (y',y')" : "");
 
-  if (!(p = scene_problem_new(s, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, err,
-                              sizeof err))) {
+  if (!(p = scene_problem_new(s, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, err, sizeof err))) {
     fprintf(stderr, "%s\n", err);
     rc = EXIT_BADINPUT;
     goto done;
@@ -110,8 +104,7 @@ int cli_check(int argc, char **argv)
     rc = EXIT_UNSOLVED;
     goto done;
   }
-  for (size_t k = 0; k < (size_t)n * NSAMPLE; k++)
-    dy[k] = (yp[k] - dy[k]) / (2 * h);
+  for (size_t k = 0; k < (size_t)n * NSAMPLE; k++) dy[k] = (yp[k] - dy[k]) / (2 * h);
   cv_derivcheck dc;
   cv_status st = cv_problem_check_derivatives(p, NSAMPLE, x, y, dy, &dc);
   free(y);
@@ -120,13 +113,13 @@ int cli_check(int argc, char **argv)
     rc = EXIT_UNSOLVED;
   } else if (!(dc.worst <= CHECK_TOL)) {
     printf("  derivatives  WRONG: %s at point %d is %.10g, finite differences give %.10g "
-           "(relative difference %.2g > %.0e)\n", dc.which, dc.point, dc.analytic, dc.fd,
-           dc.worst, CHECK_TOL);
+           "(relative difference %.2g > %.0e)\n",
+           dc.which, dc.point, dc.analytic, dc.fd, dc.worst, CHECK_TOL);
     rc = EXIT_UNSOLVED;
   } else {
     printf("  derivatives  agree with finite differences at %d points along the guess "
-           "(worst relative difference %.2g, in %s; tolerance %.0e)\n", NSAMPLE, dc.worst,
-           dc.which, CHECK_TOL);
+           "(worst relative difference %.2g, in %s; tolerance %.0e)\n",
+           NSAMPLE, dc.worst, dc.which, CHECK_TOL);
     rc = EXIT_SOLVED;
   }
 done:

@@ -9,7 +9,7 @@
 #include "cli/cli.h"
 #include "scene/scene_batch.h"
 
-#define FIRST_STEPS 10
+#define FIRST_STEPS  10
 #define MIN_FRACTION (1.0 / 4096)
 
 /* The scene (read once by the caller) compiled once, its parameters as inputs (issue 18):
@@ -58,8 +58,8 @@ static int carry_over(cv_solver *from, cv_solver *to, int n) {
  * (the one to report); the return value is the status of the last solve, or -1 with err
  * set when the input is bad (exit 2). cont_msg receives what was done. */
 int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene **sp,
-                       cv_problem **pp, cv_solver **svp, cv_status *stp, char *cont_msg, size_t cmlen,
-                       char *err, size_t errlen) {
+                       cv_problem **pp, cv_solver **svp, cv_status *stp, char *cont_msg,
+                       size_t cmlen, char *err, size_t errlen) {
   char name[128];
   const char *e = strchr(o->cont, '='), *c = strchr(e, ':');
   size_t ln = (size_t)(e - o->cont) < sizeof name ? (size_t)(e - o->cont) : sizeof name - 1;
@@ -111,16 +111,15 @@ int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene 
     }
   }
   if (st == CVAR_OK)
-    snprintf(cont_msg, cmlen, "reached by continuation in %s from %g to %g in %d steps", name,
-             from, to, steps);
+    snprintf(cont_msg, cmlen, "reached by continuation in %s from %g to %g in %d steps", name, from,
+             to, steps);
   else if (steps > 0)
     snprintf(cont_msg, cmlen,
              "continuation in %s from %g to %g stalled at %s = %.6g after %d steps: no "
              "stationary path found beyond it",
              name, from, to, name, done_at, steps);
   else
-    snprintf(cont_msg, cmlen, "continuation in %s could not start at %s = %g", name, name,
-             from);
+    snprintf(cont_msg, cmlen, "continuation in %s could not start at %s = %g", name, name, from);
   if (st == CVAR_OK || steps == 0) {
     *stp = st;
   } else {

@@ -14,19 +14,17 @@
 #include "cli/cli.h"
 #include "scene/scene_mechanics.h"
 
-static void usage(FILE *f)
-{
+static void usage(FILE *f) {
   fputs("usage: calcvar equations SCENE [--set name=value] [--json FILE] [--quiet]\n"
         "  prints, for each unknown y, the momentum p = dF/dy', the Euler-Lagrange\n"
         "  equation d/dx dF/dy' - dF/dy = 0 expanded with y'', the Hamiltonian\n"
         "  H = sum y' dF/dy' - F, the cyclic unknowns and whether F depends on the variable\n"
-        "  --json FILE   the same as JSON ('-' for stdout)\n", f);
+        "  --json FILE   the same as JSON ('-' for stdout)\n",
+        f);
 }
 
 /* The JSON of the library (scene_mechanics_json.c, also cv_equations_json) and a newline. */
-static int write_json(FILE *f, const scene *s, const mech_equations *eq,
-                      const scene_eq_texts *t)
-{
+static int write_json(FILE *f, const scene *s, const mech_equations *eq, const scene_eq_texts *t) {
   char *text = scene_equations_json(s, eq, t);
   int rc = text && fputs(text, f) != EOF && fputc('\n', f) != EOF ? 0 : -1;
   free(text); /* from json_dumps: jansson's allocator */
@@ -34,19 +32,15 @@ static int write_json(FILE *f, const scene *s, const mech_equations *eq,
 }
 
 /* The shortest decimal that reads back as v (as the expressions print their numbers). */
-static const char *shortest(double v, char *buf, size_t len)
-{
+static const char *shortest(double v, char *buf, size_t len) {
   for (int prec = 1; prec <= 17; prec++) {
     snprintf(buf, len, "%.*g", prec, v);
-    if (strtod(buf, NULL) == v)
-      break;
+    if (strtod(buf, NULL) == v) break;
   }
   return buf;
 }
 
-static void write_text(FILE *f, const scene *s, const mech_equations *eq,
-                       const scene_eq_texts *t)
-{
+static void write_text(FILE *f, const scene *s, const mech_equations *eq, const scene_eq_texts *t) {
   int n = s->n, ncyc = 0;
   char num[32];
   fprintf(f, "%s (%s)\n", s->title, s->file);
@@ -63,35 +57,33 @@ static void write_text(FILE *f, const scene *s, const mech_equations *eq,
     fprintf(f, "\n  %s\n", u);
     fprintf(f, "    momentum         p_%s = dF/d%s' = %s\n", u, u, t->mom[i]);
     fprintf(f, "    Euler-Lagrange   %s = 0\n", t->el[i]);
-    if (eq->cyclic[i])
-      ncyc++;
+    if (eq->cyclic[i]) ncyc++;
   }
   if (s->ncons + s->nints > 0) {
     fprintf(f, "\n  multipliers  the equations are those of F");
     for (int c = 0; c < s->ncons; c++)
       fprintf(f, " + %s*(%s constraint)", eq->names[1 + 3 * n + c], s->cons[c].name);
     for (int r = 0; r < s->nints; r++)
-      fprintf(f, " + %s*(%s integrand)", eq->names[1 + 3 * n + s->ncons + r],
-              s->ints[r].name);
+      fprintf(f, " + %s*(%s integrand)", eq->names[1 + 3 * n + s->ncons + r], s->ints[r].name);
     fprintf(f, "\n");
   }
   fprintf(f, "\n  Hamiltonian  H = %s\n", t->H);
-  fprintf(f, "  autonomous   %s\n", eq->autonomous
-          ? "yes: F has no explicit dependence on the variable, so H is conserved"
-          : "no: F depends explicitly on the variable, so H is not conserved in general");
+  fprintf(f, "  autonomous   %s\n",
+          eq->autonomous
+              ? "yes: F has no explicit dependence on the variable, so H is conserved"
+              : "no: F depends explicitly on the variable, so H is not conserved in general");
   fprintf(f, "  cyclic      ");
   for (int i = 0; i < n; i++)
-    if (eq->cyclic[i])
-      fprintf(f, " %s", s->unknowns[i]);
-  fprintf(f, "%s\n", ncyc ? " (F does not depend on them: their momenta are conserved)"
-                          : " none");
+    if (eq->cyclic[i]) fprintf(f, " %s", s->unknowns[i]);
+  fprintf(f, "%s\n", ncyc ? " (F does not depend on them: their momenta are conserved)" : " none");
   if ((ncyc || eq->autonomous) && s->ncons + s->nints > 0)
-    fprintf(f, "               (for F alone: constraints that involve %s or the unknowns can "
-            "break these conservation laws)\n", s->variable);
+    fprintf(f,
+            "               (for F alone: constraints that involve %s or the unknowns can "
+            "break these conservation laws)\n",
+            s->variable);
 }
 
-int cli_equations(int argc, char **argv)
-{
+int cli_equations(int argc, char **argv) {
   cli_opts o;
   char err[SC_ERRLEN] = "";
   scene *s = NULL;
@@ -101,8 +93,7 @@ int cli_equations(int argc, char **argv)
   memset(&eq, 0, sizeof eq);
   memset(&t, 0, sizeof t);
   int rc = cli_scene_command_start("equations", argc, argv, usage, &o, &s, &jf);
-  if (rc >= 0)
-    goto done;
+  if (rc >= 0) goto done;
   if (scene_equations_new(s, &eq, err, sizeof err) != CVAR_OK ||
       scene_eq_texts_make(&t, s, &eq) < 0) {
     fprintf(stderr, "%s\n", err[0] ? err : "calcvar equations: out of memory");
@@ -116,8 +107,7 @@ int cli_equations(int argc, char **argv)
       goto done;
     }
   }
-  if (!o.quiet && (!o.json || strcmp(o.json, "-") != 0))
-    write_text(stdout, s, &eq, &t);
+  if (!o.quiet && (!o.json || strcmp(o.json, "-") != 0)) write_text(stdout, s, &eq, &t);
   rc = EXIT_SOLVED;
 done:
   cli_outfile_abandon(&jf);

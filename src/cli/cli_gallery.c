@@ -12,13 +12,11 @@
 enum { TITLE_W = 60 };
 
 /* One gallery row; returns 0 when the scene converged. */
-static int run_one(const cli_gallery_scene *g)
-{
+static int run_one(const cli_gallery_scene *g) {
   char err[SC_ERRLEN], name[64];
   snprintf(name, sizeof name, "gallery:%s", g->name);
   scene *s = scene_load_buffer(g->text, strlen(g->text), name, 0, NULL, err, sizeof err);
-  cv_problem *p = s ? scene_problem_new(s, scene_method_need(s->method), err, sizeof err)
-                    : NULL;
+  cv_problem *p = s ? scene_problem_new(s, scene_method_need(s->method), err, sizeof err) : NULL;
   cv_status why;
   cv_solver *sv = p ? cv_solver_new(&why) : NULL;
   int rc = 1;
@@ -34,26 +32,22 @@ static int run_one(const cli_gallery_scene *g)
     goto done;
   }
   int any_exact = 0;
-  for (int i = 0; i < s->n; i++)
-    any_exact |= s->exact[i] >= 0;
+  for (int i = 0; i < s->n; i++) any_exact |= s->exact[i] >= 0;
   if (!any_exact && !r.has_err_action && cli_report_estimate(&r, sv, p) < 0) {
     printf("%-*s  out of memory\n", TITLE_W, s->title);
     cli_report_free(&r);
     goto done;
   }
   char act[32] = "-", errs[32] = "-", morse[8] = "-", tm[16] = "-";
-  if (r.has_action)
-    snprintf(act, sizeof act, "%.12f", r.action);
+  if (r.has_action) snprintf(act, sizeof act, "%.12f", r.action);
   if (r.has_err_nodal)
     snprintf(errs, sizeof errs, "%.1e nodal", r.err_nodal);
   else if (r.has_err_action)
     snprintf(errs, sizeof errs, "%.1e action", r.err_action);
   else if (r.has_err_est)
     snprintf(errs, sizeof errs, "~%.1e est.", r.err_est); /* an estimate, marked as such */
-  if (r.has_morse)
-    snprintf(morse, sizeof morse, "%d", r.morse);
-  if (r.has_time)
-    snprintf(tm, sizeof tm, "%.4f", r.time_s);
+  if (r.has_morse) snprintf(morse, sizeof morse, "%d", r.morse);
+  if (r.has_time) snprintf(tm, sizeof tm, "%.4f", r.time_s);
   printf("%-*s %-14s %17s %16s %5s %9s\n", TITLE_W, s->title, r.status, act, errs, morse, tm);
   rc = st == CVAR_OK ? 0 : 1;
   cli_report_free(&r);
@@ -64,16 +58,13 @@ done:
   return rc;
 }
 
-int cli_gallery(void)
-{
+int cli_gallery(void) {
   int failed = 0;
   printf("calcvar gallery: variational problems solved by direct discretisation\n"
          "(calcvar --help for the commands; calcvar solve SCENE for your own)\n\n");
-  printf("%-*s %-14s %17s %16s %5s %9s\n", TITLE_W, "scene", "status", "action", "error",
-         "Morse", "time [s]");
-  for (int i = 0; i < cli_gallery_count; i++)
-    failed += run_one(&cli_gallery_scenes[i]);
-  if (failed)
-    printf("\n%d scene%s did not converge.\n", failed, failed == 1 ? "" : "s");
+  printf("%-*s %-14s %17s %16s %5s %9s\n", TITLE_W, "scene", "status", "action", "error", "Morse",
+         "time [s]");
+  for (int i = 0; i < cli_gallery_count; i++) failed += run_one(&cli_gallery_scenes[i]);
+  if (failed) printf("\n%d scene%s did not converge.\n", failed, failed == 1 ? "" : "s");
   return failed ? EXIT_UNSOLVED : EXIT_SOLVED;
 }

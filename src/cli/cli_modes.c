@@ -18,8 +18,7 @@
 
 static const double TWO_PI = 6.28318530717958647692;
 
-static void usage(FILE *f)
-{
+static void usage(FILE *f) {
   fputs("usage: calcvar modes SCENE [--set name=value] [--json FILE] [--quiet]\n"
         "  finds an equilibrium dL/dy = 0 (y' = 0) from the guess at the start of the\n"
         "  interval, forms M = d2L/dy'dy' and K = -d2L/dydy there and prints each w^2 of\n"
@@ -28,54 +27,53 @@ static void usage(FILE *f)
         "  gyroscopic terms (L_y'y not symmetric) also the motions of M y'' + G y' + K y = 0;\n"
         "  with [constraints] G(y) = 0 the equilibrium on them, the multipliers, and the\n"
         "  modes along them\n"
-        "  --json FILE   the same as JSON ('-' for stdout)\n", f);
+        "  --json FILE   the same as JSON ('-' for stdout)\n",
+        f);
 }
 
-static const char *kind_name(mech_mode_kind k)
-{
-  return scene_mode_kind_name(k);
-}
+static const char *kind_name(mech_mode_kind k) { return scene_mode_kind_name(k); }
 
 /* The JSON of the library (scene_mechanics_json.c, also cv_modes_json) and a newline. */
-static int write_json(FILE *f, const scene *s, const mech_modes *md)
-{
+static int write_json(FILE *f, const scene *s, const mech_modes *md) {
   char *text = scene_modes_json(s, md);
   int rc = text && fputs(text, f) != EOF && fputc('\n', f) != EOF ? 0 : -1;
   free(text); /* from json_dumps: jansson's allocator */
   return rc;
 }
 
-static void print_matrix(FILE *f, const char *label, int n, const double *A)
-{
+static void print_matrix(FILE *f, const char *label, int n, const double *A) {
   for (int i = 0; i < n; i++) {
     fprintf(f, "  %-14s", i == 0 ? label : "");
-    for (int j = 0; j < n; j++)
-      fprintf(f, " %14.8g", A[i * n + j]);
+    for (int j = 0; j < n; j++) fprintf(f, " %14.8g", A[i * n + j]);
     fprintf(f, "\n");
   }
 }
 
-static void write_text(FILE *f, const scene *s, const mech_modes *md)
-{
+static void write_text(FILE *f, const scene *s, const mech_modes *md) {
   int n = s->n;
   fprintf(f, "%s (%s)\n", s->title, s->file);
   fprintf(f, "  equilibrium ");
   for (int i = 0; i < n; i++)
     fprintf(f, " %s = %.15g%s", s->unknowns[i], md->equilibrium[i], i + 1 < n ? "," : "");
-  fprintf(f, "\n               (Newton from the guess at %s = %.15g: %d iteration%s, "
-          "max |dL/dy%s| = %.2g)\n", s->variable, s->a, md->iterations,
-          md->iterations == 1 ? "" : "s", md->nc ? " + lambda.dG/dy|, |G" : "", md->residual);
+  fprintf(f,
+          "\n               (Newton from the guess at %s = %.15g: %d iteration%s, "
+          "max |dL/dy%s| = %.2g)\n",
+          s->variable, s->a, md->iterations, md->iterations == 1 ? "" : "s",
+          md->nc ? " + lambda.dG/dy|, |G" : "", md->residual);
   for (int c = 0; c < md->nc; c++)
     fprintf(f, "  %-12s lambda_%s = %.15g (multiplier of the constraint %s = 0)\n",
             c ? "" : "multipliers", s->cons[c].name, md->multipliers[c], s->cons[c].name);
   if (md->nc > 0)
-    fprintf(f, "  %-12s %d mode%s on the constraints' tangent space (%d unknowns - %d "
-            "constraint%s)\n", "constrained", md->nmodes, md->nmodes == 1 ? "" : "s", n,
-            md->nc, md->nc == 1 ? "" : "s");
+    fprintf(f,
+            "  %-12s %d mode%s on the constraints' tangent space (%d unknowns - %d "
+            "constraint%s)\n",
+            "constrained", md->nmodes, md->nmodes == 1 ? "" : "s", n, md->nc,
+            md->nc == 1 ? "" : "s");
   print_matrix(f, "M = L_y'y'", n, md->mass);
   print_matrix(f, md->nc ? "K = -(L+l.G)_yy" : "K = -L_yy", n, md->stiffness);
   if (md->gyroscopic > 0)
-    fprintf(f, "  note         L has gyroscopic terms (L_y'y not symmetric, max |G| = %.3g): "
+    fprintf(f,
+            "  note         L has gyroscopic terms (L_y'y not symmetric, max |G| = %.3g): "
             "the modes of K v = w^2 M v below leave them out; the motions with them follow\n",
             md->gyroscopic);
   fprintf(f, "\n  %-4s %-22s %-9s %-32s %s\n", "mode", "omega^2", "kind", "frequency or growth",
@@ -90,12 +88,10 @@ static void write_text(FILE *f, const scene *s, const mech_modes *md)
     else
       snprintf(what, sizeof what, "free motion");
     fprintf(f, "  %-4d %-22.15g %-9s %-32s", k + 1, w2, kind_name(md->kind[k]), what);
-    for (int i = 0; i < n; i++)
-      fprintf(f, " %s %.6g", s->unknowns[i], md->shape[k * n + i]);
+    for (int i = 0; i < n; i++) fprintf(f, " %s %.6g", s->unknowns[i], md->shape[k * n + i]);
     fprintf(f, "\n");
   }
-  if (md->ngyro == 0)
-    return;
+  if (md->ngyro == 0) return;
   fprintf(f, "\n  with the gyroscopic terms, M y'' + G y' + K y = 0 (G = L_y'y - L_y'y^T):\n");
   fprintf(f, "  %-4s %-9s %s\n", "", "kind", "frequency or growth");
   for (int k = 0; k < md->ngyro; k++) {
@@ -113,8 +109,7 @@ static void write_text(FILE *f, const scene *s, const mech_modes *md)
   }
 }
 
-int cli_modes(int argc, char **argv)
-{
+int cli_modes(int argc, char **argv) {
   cli_opts o;
   char err[SC_ERRLEN] = "";
   scene *s = NULL;
@@ -122,8 +117,7 @@ int cli_modes(int argc, char **argv)
   cli_outfile jf = {0};
   memset(&md, 0, sizeof md);
   int rc = cli_scene_command_start("modes", argc, argv, usage, &o, &s, &jf);
-  if (rc >= 0)
-    goto done;
+  if (rc >= 0) goto done;
   cv_status st = scene_modes_new(s, &md, err, sizeof err);
   if (st != CVAR_OK) {
     fprintf(stderr, "%s\n", err);
@@ -137,8 +131,7 @@ int cli_modes(int argc, char **argv)
       goto done;
     }
   }
-  if (!o.quiet && (!o.json || strcmp(o.json, "-") != 0))
-    write_text(stdout, s, &md);
+  if (!o.quiet && (!o.json || strcmp(o.json, "-") != 0)) write_text(stdout, s, &md);
   rc = EXIT_SOLVED;
 done:
   cli_outfile_abandon(&jf);

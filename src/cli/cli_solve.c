@@ -14,8 +14,7 @@
 #include "cli/cli.h"
 #include "scene/scene_batch.h"
 
-static void usage(FILE *f)
-{
+static void usage(FILE *f) {
   fputs("usage: calcvar solve SCENE [options]\n"
         "  --elements N         uniform elements (scene's [mesh] elements, default 100)\n"
         "  --degree P           polynomial degree 1..8 of the elements\n"
@@ -38,54 +37,59 @@ static void usage(FILE *f)
         "  --quiet              no summary on stdout\n"
         "  -v, --verbose        one line per Newton iteration and adaptive round on stderr\n"
         "  -h, --help           this text\n"
-        "exit status: 0 converged, 1 not solved, 2 bad input, 3 write error\n", f);
+        "exit status: 0 converged, 1 not solved, 2 bad input, 3 write error\n",
+        f);
 }
 
 /* Combinations that cannot be honoured: refuse (exit 2, nothing written) rather than
  * ignore a request. */
-static int unsupported(const cli_opts *o, const scene *s)
-{
+static int unsupported(const cli_opts *o, const scene *s) {
   if (o->cont && (o->adapt > 0 || s->adapt > 0 || o->tol > 0 || s->tol > 0)) {
     fprintf(stderr, "calcvar solve: --continue and adaptive refinement cannot be combined "
-            "(continuation keeps one mesh)\n");
+                    "(continuation keeps one mesh)\n");
     return EXIT_BADINPUT;
   }
   if (o->max_elements > 0 && !(o->adapt > 0 || s->adapt > 0)) {
     fprintf(stderr, "calcvar solve: --max-elements applies to adaptive refinement only "
-            "(--adapt TOL or [mesh] adapt)\n");
+                    "(--adapt TOL or [mesh] adapt)\n");
     return EXIT_BADINPUT;
   }
   if (o->all && o->cont) {
     fprintf(stderr, "calcvar solve: --all and --continue cannot be combined (the search "
-            "keeps one scene)\n");
+                    "keeps one scene)\n");
     return EXIT_BADINPUT;
   }
   if (o->all && s->method != CVAR_METHOD_NEWTON) {
-    fprintf(stderr, "calcvar solve: --all needs the Newton engine (method %s finds minima "
-            "only, not the saddles the search is for)\n", cv_method_name(s->method));
+    fprintf(stderr,
+            "calcvar solve: --all needs the Newton engine (method %s finds minima "
+            "only, not the saddles the search is for)\n",
+            cv_method_name(s->method));
     return EXIT_BADINPUT;
   }
-  if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) && (s->ncons > 0 || s->nints > 0)) {
+  if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) &&
+      (s->ncons > 0 || s->nints > 0)) {
     /* an unconstrained minimiser cannot impose [constraints] or [integrals] */
     if (o->method >= 0)
-      fprintf(stderr, "calcvar solve: --method %s cannot impose constraints; use mma, ccsaq, "
-              "slsqp, auglag or newton\n", cv_method_name(s->method));
+      fprintf(stderr,
+              "calcvar solve: --method %s cannot impose constraints; use mma, ccsaq, "
+              "slsqp, auglag or newton\n",
+              cv_method_name(s->method));
     else
-      fprintf(stderr, "%s:%d: method %s cannot impose constraints; use mma, ccsaq, slsqp, "
-              "auglag or newton\n", s->file, s->method_line, cv_method_name(s->method));
+      fprintf(stderr,
+              "%s:%d: method %s cannot impose constraints; use mma, ccsaq, slsqp, "
+              "auglag or newton\n",
+              s->file, s->method_line, cv_method_name(s->method));
     return EXIT_BADINPUT;
   }
   return 0;
 }
 
-int cli_solve(int argc, char **argv)
-{
+int cli_solve(int argc, char **argv) {
   cli_opts o;
   char err[SC_ERRLEN];
   int rc = cli_args_parse("solve", argc, argv, &o);
   if (rc != 0 || o.help) {
-    if (o.help)
-      usage(stdout);
+    if (o.help) usage(stdout);
     cli_opts_free(&o);
     return rc;
   }
@@ -103,15 +107,11 @@ int cli_solve(int argc, char **argv)
     rc = EXIT_BADINPUT;
     goto done;
   }
-  if (o.elements)
-    s->elements = o.elements;
-  if (o.degree)
-    s->degree = o.degree;
+  if (o.elements) s->elements = o.elements;
+  if (o.degree) s->degree = o.degree;
   cli_apply_solver_options(&o, s);
-  if ((rc = unsupported(&o, s)) != 0)
-    goto done;
-  if ((rc = cli_apply_accuracy(&o, s)) != 0)
-    goto done;
+  if ((rc = unsupported(&o, s)) != 0) goto done;
+  if ((rc = cli_apply_accuracy(&o, s)) != 0) goto done;
   double tol = s->tol;
   cv_status why;
   if ((!o.cont && !(p = scene_problem_new(s, scene_method_need(s->method), err, sizeof err))) ||
@@ -184,12 +184,13 @@ int cli_solve(int argc, char **argv)
              "the integrand is singular at %s = %.6g inside the interval: along the path "
              "|F| grows like |%s - %.6g|^(-%.2f), so the action is infinite and the discrete "
              "answer (which changes with the mesh) is no stationary path; split the interval "
-             "there or remove the singularity", s->variable, xs, s->variable, xs, alpha);
+             "there or remove the singularity",
+             s->variable, xs, s->variable, xs, alpha);
   }
   if (cont_msg[0]) {
     size_t used = st == CVAR_OK ? strlen(r.message) : 0;
-    char c0 = cont_msg[0] >= 'a' && cont_msg[0] <= 'z' ? (char)(cont_msg[0] - 'a' + 'A')
-                                                      : cont_msg[0];
+    char c0 =
+        cont_msg[0] >= 'a' && cont_msg[0] <= 'z' ? (char)(cont_msg[0] - 'a' + 'A') : cont_msg[0];
     snprintf(r.message + used, sizeof r.message - used, "%s%c%s.", used ? " " : "", c0,
              cont_msg + 1);
   }
@@ -208,8 +209,7 @@ int cli_solve(int argc, char **argv)
   }
   /* stdout carries the data when a report goes there; the summary would corrupt it. */
   int stdout_taken = (o.json && strcmp(o.json, "-") == 0) || (o.csv && strcmp(o.csv, "-") == 0);
-  if (!o.quiet && !stdout_taken)
-    cli_report_text(stdout, &r);
+  if (!o.quiet && !stdout_taken) cli_report_text(stdout, &r);
   if (st != CVAR_OK)
     fprintf(stderr, "calcvar solve: %s: not solved (%s): %s\n", s->file, r.status, r.message);
 done:
@@ -219,8 +219,7 @@ done:
   cli_report_free(&r);
   cv_solver_free(sv);
   cv_problem_free(p);
-  if (!cb)
-    scene_free(s);
+  if (!cb) scene_free(s);
   cv_batch_free(cb);
   cli_opts_free(&o);
   return rc;

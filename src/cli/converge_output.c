@@ -12,17 +12,13 @@
 
 #include "cli/cli.h"
 
-static void set_real(json_t *o, const char *key, double v)
-{
-  if (isfinite(v))
-    json_object_set_new(o, key, json_real(v));
+static void set_real(json_t *o, const char *key, double v) {
+  if (isfinite(v)) json_object_set_new(o, key, json_real(v));
 }
 
-int cli_converge_json(FILE *f, const cli_conv_row *rows, int nrows)
-{
+int cli_converge_json(FILE *f, const cli_conv_row *rows, int nrows) {
   json_t *a = json_array();
-  if (!a)
-    return -1;
+  if (!a) return -1;
   for (int k = 0; k < nrows; k++) {
     const cli_conv_row *row = &rows[k];
     json_t *o = cli_report_json_object(&row->r);
@@ -38,37 +34,29 @@ int cli_converge_json(FILE *f, const cli_conv_row *rows, int nrows)
       }
       set_real(e, "max_vertex", row->err_v);
     }
-    if (row->estimated && row->has_err_v)
-      set_real(o, "error_estimate_vertex", row->err_v);
-    if (row->has_order)
-      set_real(o, "order", row->order);
-    if (row->has_order_v)
-      set_real(o, "order_vertex", row->order_v);
+    if (row->estimated && row->has_err_v) set_real(o, "error_estimate_vertex", row->err_v);
+    if (row->has_order) set_real(o, "order", row->order);
+    if (row->has_order_v) set_real(o, "order_vertex", row->order_v);
     json_array_append_new(a, o);
   }
   int rc = json_dumpf(a, f, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
-  if (rc == 0 && fputc('\n', f) == EOF)
-    rc = -1;
+  if (rc == 0 && fputc('\n', f) == EOF) rc = -1;
   json_decref(a);
   return rc;
 }
 
-static void num(FILE *f, int has, double v, const char *fmt, int width)
-{
+static void num(FILE *f, int has, double v, const char *fmt, int width) {
   if (has && isfinite(v))
     fprintf(f, fmt, width, v);
   else
     fprintf(f, "%*s", width, "-");
 }
 
-int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows)
-{
-  if (nrows <= 0)
-    return 0;
+int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows) {
+  if (nrows <= 0) return 0;
   const scene *s = rows[0].r.sc;
   int est = 0;
-  for (int k = 0; k < nrows; k++)
-    est |= rows[k].estimated;
+  for (int k = 0; k < nrows; k++) est |= rows[k].estimated;
   fprintf(f, "%s\n", s->title);
   if (est)
     fprintf(f, "  errors are ESTIMATES (no [exact]): from a reference solve on a finer mesh\n");
@@ -83,8 +71,7 @@ int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows)
   for (int k = 0; k < nrows; k++) {
     const cli_conv_row *row = &rows[k];
     const cli_report *r = &row->r;
-    if (k > 0 && r->degree != rows[k - 1].r.degree)
-      fputc('\n', f);
+    if (k > 0 && r->degree != rows[k - 1].r.degree) fputc('\n', f);
     fprintf(f, "%9d %6d %9d ", r->elements, r->degree, r->nodes);
     num(f, row->has_err, row->err, "%*.3e", 12);
     fputc(' ', f);
@@ -95,8 +82,7 @@ int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows)
     num(f, row->has_order_v, row->order_v, "%*.2f", 14);
     fprintf(f, " %10d ", r->iterations);
     num(f, r->has_time, r->time_s, "%*.3e", 10);
-    if (r->st != CVAR_OK)
-      fprintf(f, "  %s", r->status);
+    if (r->st != CVAR_OK) fprintf(f, "  %s", r->status);
     fputc('\n', f);
   }
   return ferror(f) ? -1 : 0;

@@ -8,8 +8,7 @@
 
 #include "cli/cli.h"
 
-static void usage(FILE *f)
-{
+static void usage(FILE *f) {
   fputs("usage:\n"
         "  calcvar                         run the built-in demo gallery\n"
         "  calcvar solve SCENE [options]   solve one scene (calcvar solve --help)\n"
@@ -28,8 +27,7 @@ static void usage(FILE *f)
 
 /* Standard output is checked like any output file: a full disk, /dev/full or a closed
  * pipe must not pass for success (exit 3, docs/cli.md). */
-static int finish(int rc)
-{
+static int finish(int rc) {
   errno = 0;
   int bad = fflush(stdout) != 0 || ferror(stdout);
   int e = errno;
@@ -37,8 +35,7 @@ static int finish(int rc)
     bad = 1;
     e = errno;
   }
-  if (!bad)
-    return rc;
+  if (!bad) return rc;
   fprintf(stderr, "calcvar: cannot write standard output: %s\n", e ? strerror(e) : "write error");
   return rc == EXIT_BADINPUT ? rc : EXIT_IOERROR;
 }
@@ -47,10 +44,8 @@ static int run(int argc, char **argv);
 
 int main(int argc, char **argv) { return finish(run(argc, argv)); }
 
-static int run(int argc, char **argv)
-{
-  if (argc < 2)
-    return cli_gallery();
+static int run(int argc, char **argv) {
+  if (argc < 2) return cli_gallery();
   const char *cmd = argv[1];
   if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {
     usage(stdout);
@@ -65,18 +60,12 @@ static int run(int argc, char **argv)
     printf("calcvar %d.%d.%d\nlinked with %s, PLplot %s\n", a, b, c, deps, pl);
     return EXIT_SOLVED;
   }
-  if (strcmp(cmd, "solve") == 0)
-    return cli_solve(argc - 2, argv + 2);
-  if (strcmp(cmd, "check") == 0)
-    return cli_check(argc - 2, argv + 2);
-  if (strcmp(cmd, "equations") == 0)
-    return cli_equations(argc - 2, argv + 2);
-  if (strcmp(cmd, "modes") == 0)
-    return cli_modes(argc - 2, argv + 2);
-  if (strcmp(cmd, "batch") == 0)
-    return cli_batch(argc - 2, argv + 2);
-  if (strcmp(cmd, "converge") == 0)
-    return cli_converge(argc - 2, argv + 2);
+  if (strcmp(cmd, "solve") == 0) return cli_solve(argc - 2, argv + 2);
+  if (strcmp(cmd, "check") == 0) return cli_check(argc - 2, argv + 2);
+  if (strcmp(cmd, "equations") == 0) return cli_equations(argc - 2, argv + 2);
+  if (strcmp(cmd, "modes") == 0) return cli_modes(argc - 2, argv + 2);
+  if (strcmp(cmd, "batch") == 0) return cli_batch(argc - 2, argv + 2);
+  if (strcmp(cmd, "converge") == 0) return cli_converge(argc - 2, argv + 2);
   fprintf(stderr, "calcvar: unknown command '%s' (calcvar --help lists them)\n", cmd);
   return EXIT_BADINPUT;
 }

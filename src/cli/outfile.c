@@ -31,8 +31,7 @@ enum { MAX_LINKS = 40 }; /* as the kernel's own limit on nested symbolic links *
 
 /* The final target of path after following symbolic links (the target need not exist).
  * Returns a malloc'd path, or NULL with errno set. */
-static char *follow_links(const char *path)
-{
+static char *follow_links(const char *path) {
   char *cur = strdup(path);
   for (int hop = 0; cur && hop <= MAX_LINKS; hop++) {
     struct stat st;
@@ -67,29 +66,25 @@ static char *follow_links(const char *path)
   return NULL;
 }
 
-static int fail(cli_outfile *o, const char *why)
-{
+static int fail(cli_outfile *o, const char *why) {
   fprintf(stderr, "calcvar: cannot write %s: %s\n", o->path, why);
   cli_outfile_abandon(o);
   return -1;
 }
 
 /* A device, FIFO or socket: stream into it (opening a FIFO waits for its reader). */
-static int open_stream(cli_outfile *o, const char *path)
-{
+static int open_stream(cli_outfile *o, const char *path) {
   int fd = open(path, O_WRONLY | O_NOCTTY);
   if (fd < 0 || !(o->f = fdopen(fd, "w"))) {
     int e = errno;
-    if (fd >= 0)
-      close(fd);
+    if (fd >= 0) close(fd);
     return fail(o, strerror(e));
   }
   o->stream = 1;
   return 0;
 }
 
-int cli_outfile_open(cli_outfile *o, const char *path, const char *input)
-{
+int cli_outfile_open(cli_outfile *o, const char *path, const char *input) {
   memset(o, 0, sizeof *o);
   o->path = path;
   if (strcmp(path, "-") == 0) {
@@ -97,33 +92,25 @@ int cli_outfile_open(cli_outfile *o, const char *path, const char *input)
     return 0;
   }
   size_t n = strlen(path);
-  if (n == 0)
-    return fail(o, "empty file name");
-  if (path[n - 1] == '/')
-    return fail(o, "the name ends in '/' (a directory); give a file name");
+  if (n == 0) return fail(o, "empty file name");
+  if (path[n - 1] == '/') return fail(o, "the name ends in '/' (a directory); give a file name");
   struct stat st, si;
   /* What the kernel reaches through the path (links, and /proc's "magic" links such as
    * /dev/stdout on a pipe, which readlink cannot name): a device, FIFO or socket is a
    * stream, whatever the path looks like. */
   if (stat(path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
     return open_stream(o, path);
-  if (!(o->dest = follow_links(path)))
-    return fail(o, strerror(errno));
+  if (!(o->dest = follow_links(path))) return fail(o, strerror(errno));
   int exists = stat(o->dest, &st) == 0;
-  if (!exists && errno != ENOENT)
-    return fail(o, strerror(errno));
-  if (exists && S_ISDIR(st.st_mode))
-    return fail(o, "it is a directory; give a file name");
-  int have_in = input && (strcmp(input, "-") == 0 ? fstat(STDIN_FILENO, &si) == 0
-                                                  : stat(input, &si) == 0);
-  if (exists && have_in && si.st_dev == st.st_dev && si.st_ino == st.st_ino &&
-      S_ISREG(st.st_mode))
+  if (!exists && errno != ENOENT) return fail(o, strerror(errno));
+  if (exists && S_ISDIR(st.st_mode)) return fail(o, "it is a directory; give a file name");
+  int have_in =
+      input && (strcmp(input, "-") == 0 ? fstat(STDIN_FILENO, &si) == 0 : stat(input, &si) == 0);
+  if (exists && have_in && si.st_dev == st.st_dev && si.st_ino == st.st_ino && S_ISREG(st.st_mode))
     return fail(o, "it is the scene being read (the report would destroy it)");
-  if (exists && !S_ISREG(st.st_mode))
-    return open_stream(o, o->dest);
+  if (exists && !S_ISREG(st.st_mode)) return open_stream(o, o->dest);
   size_t dn = strlen(o->dest);
-  if (!(o->tmp = malloc(dn + 16)))
-    return fail(o, "out of memory");
+  if (!(o->tmp = malloc(dn + 16))) return fail(o, "out of memory");
   memcpy(o->tmp, o->dest, dn);
   memcpy(o->tmp + dn, ".tmp.XXXXXX", 12);
   int fd = mkstemp(o->tmp);
@@ -147,8 +134,7 @@ int cli_outfile_open(cli_outfile *o, const char *path, const char *input)
 }
 
 /* Flush and close the stream; 0, or -1 with errno. */
-static int close_checked(FILE *f)
-{
+static int close_checked(FILE *f) {
   int bad = fflush(f) != 0 || ferror(f);
   int e = errno;
   if (fclose(f) != 0 && !bad) {
@@ -159,10 +145,8 @@ static int close_checked(FILE *f)
   return bad ? -1 : 0;
 }
 
-int cli_outfile_commit(cli_outfile *o)
-{
-  if (!o->f)
-    return 0;
+int cli_outfile_commit(cli_outfile *o) {
+  if (!o->f) return 0;
   if (o->f == stdout) {
     o->f = NULL;
     if (fflush(stdout) != 0 || ferror(stdout)) {
@@ -174,23 +158,18 @@ int cli_outfile_commit(cli_outfile *o)
   }
   FILE *f = o->f;
   o->f = NULL;
-  if (close_checked(f) != 0)
-    return fail(o, strerror(errno));
-  if (o->tmp && rename(o->tmp, o->dest) != 0)
-    return fail(o, strerror(errno));
+  if (close_checked(f) != 0) return fail(o, strerror(errno));
+  if (o->tmp && rename(o->tmp, o->dest) != 0) return fail(o, strerror(errno));
   free(o->tmp);
   o->tmp = NULL;
   cli_outfile_abandon(o); /* nothing left to remove: frees the names */
   return 0;
 }
 
-int cli_outfile_finish(cli_outfile *o, int wrote)
-{
-  if (wrote >= 0)
-    return cli_outfile_commit(o);
+int cli_outfile_finish(cli_outfile *o, int wrote) {
+  if (wrote >= 0) return cli_outfile_commit(o);
   int e = errno;
-  if (o->f && o->f != stdout && ferror(o->f))
-    return fail(o, strerror(e ? e : EIO));
+  if (o->f && o->f != stdout && ferror(o->f)) return fail(o, strerror(e ? e : EIO));
   if (o->f == stdout && ferror(stdout)) {
     fprintf(stderr, "calcvar: cannot write standard output: %s\n", strerror(e ? e : EIO));
     clearerr(stdout);
@@ -199,26 +178,21 @@ int cli_outfile_finish(cli_outfile *o, int wrote)
   return -1;
 }
 
-int cli_outfile_render_name(cli_outfile *o, const char **name)
-{
+int cli_outfile_render_name(cli_outfile *o, const char **name) {
   *name = NULL;
-  if (!o->f || o->f == stdout)
-    return -1;
+  if (!o->f || o->f == stdout) return -1;
   if (!o->stream) {
     /* the library writes the temporary file by name: close our handle on it */
     FILE *f = o->f;
     o->f = NULL;
-    if (fclose(f) != 0)
-      return fail(o, strerror(errno));
+    if (fclose(f) != 0) return fail(o, strerror(errno));
     *name = o->tmp;
     return 0;
   }
   const char *dir = getenv("TMPDIR");
-  if (!dir || !dir[0])
-    dir = "/tmp";
+  if (!dir || !dir[0]) dir = "/tmp";
   size_t n = strlen(dir);
-  if (!(o->scratch = malloc(n + 24)))
-    return fail(o, "out of memory");
+  if (!(o->scratch = malloc(n + 24))) return fail(o, "out of memory");
   snprintf(o->scratch, n + 24, "%s/calcvar-out.XXXXXX", dir);
   int fd = mkstemp(o->scratch);
   if (fd < 0) {
@@ -232,42 +206,32 @@ int cli_outfile_render_name(cli_outfile *o, const char **name)
   return 0;
 }
 
-int cli_outfile_commit_rendered(cli_outfile *o)
-{
+int cli_outfile_commit_rendered(cli_outfile *o) {
   if (!o->stream) {
-    if (!o->tmp || access(o->tmp, F_OK) != 0)
-      return fail(o, "the plotting library wrote nothing");
-    if (rename(o->tmp, o->dest) != 0)
-      return fail(o, strerror(errno));
+    if (!o->tmp || access(o->tmp, F_OK) != 0) return fail(o, "the plotting library wrote nothing");
+    if (rename(o->tmp, o->dest) != 0) return fail(o, strerror(errno));
     free(o->tmp);
     o->tmp = NULL;
     cli_outfile_abandon(o);
     return 0;
   }
   FILE *in = o->scratch ? fopen(o->scratch, "rb") : NULL;
-  if (!in)
-    return fail(o, "the plotting library wrote nothing");
+  if (!in) return fail(o, "the plotting library wrote nothing");
   char buf[65536];
   size_t k;
   int bad = 0;
-  while (!bad && (k = fread(buf, 1, sizeof buf, in)) > 0)
-    bad = fwrite(buf, 1, k, o->f) != k;
+  while (!bad && (k = fread(buf, 1, sizeof buf, in)) > 0) bad = fwrite(buf, 1, k, o->f) != k;
   bad |= ferror(in);
   int e = errno;
   fclose(in);
-  if (bad)
-    return fail(o, strerror(e ? e : EIO));
+  if (bad) return fail(o, strerror(e ? e : EIO));
   return cli_outfile_commit(o);
 }
 
-void cli_outfile_abandon(cli_outfile *o)
-{
-  if (o->f && o->f != stdout)
-    fclose(o->f);
-  if (o->tmp)
-    unlink(o->tmp);
-  if (o->scratch)
-    unlink(o->scratch);
+void cli_outfile_abandon(cli_outfile *o) {
+  if (o->f && o->f != stdout) fclose(o->f);
+  if (o->tmp) unlink(o->tmp);
+  if (o->scratch) unlink(o->scratch);
   free(o->tmp);
   free(o->scratch);
   free(o->dest);

@@ -27,49 +27,41 @@ enum { NPAL = (int)(sizeof pal_r / sizeof pal_r[0]), FIRST_LINE_COLOUR = 3 };
 #define MARK "#(728)" /* a filled circle, as a PLplot Hershey escape */
 
 static double chr_factor = 1.0; /* character scale of the page being drawn */
-static const char *exit_tmp; /* the temporary file to remove if PLplot gives up */
+static const char *exit_tmp;    /* the temporary file to remove if PLplot gives up */
 
-static int plplot_exit(PLCHAR_VECTOR msg)
-{
+static int plplot_exit(PLCHAR_VECTOR msg) {
   fprintf(stderr, "calcvar: the plotting library failed: %s\n", msg);
-  if (exit_tmp)
-    unlink(exit_tmp);
+  if (exit_tmp) unlink(exit_tmp);
   return EXIT_UNSOLVED;
 }
 
-int cli_plot_path_ok(const char *path)
-{
+int cli_plot_path_ok(const char *path) {
   size_t n = strlen(path);
   return n >= 5 && (strcmp(path + n - 4, ".svg") == 0 || strcmp(path + n - 4, ".png") == 0);
 }
 
 /* cmap0 index of a line colour; negative is the text colour (black). */
-static PLINT colour_index(int colour)
-{
+static PLINT colour_index(int colour) {
   return colour < 0 ? 1 : FIRST_LINE_COLOUR + colour % (NPAL - FIRST_LINE_COLOUR);
 }
 
 /* Value as drawn: log10 on a logarithmic axis; NaN where it cannot be drawn. */
-static double coord(double v, int logscale)
-{
-  if (!isfinite(v))
-    return NAN;
-  if (logscale)
-    return v > 0 ? log10(v) : NAN;
+static double coord(double v, int logscale) {
+  if (!isfinite(v)) return NAN;
+  if (logscale) return v > 0 ? log10(v) : NAN;
   return v;
 }
 
 /* Data range of a panel along x (which = 0) or y (1), in drawn coordinates, padded. */
-static void panel_range(const cli_plot_panel *p, int which, double *lo, double *hi)
-{
+static void panel_range(const cli_plot_panel *p, int which, double *lo, double *hi) {
   int logscale = which ? p->logy : p->logx;
   *lo = INFINITY;
   *hi = -INFINITY;
   for (int l = 0; l < p->nlines; l++)
     for (int k = 0; k < p->lines[l].n; k++) {
       double v = coord(which ? p->lines[l].y[k] : p->lines[l].x[k], logscale);
-      if (isfinite(v) && isfinite(coord(which ? p->lines[l].x[k] : p->lines[l].y[k],
-                                        which ? p->logx : p->logy))) {
+      if (isfinite(v) &&
+          isfinite(coord(which ? p->lines[l].x[k] : p->lines[l].y[k], which ? p->logx : p->logy))) {
         *lo = fmin(*lo, v);
         *hi = fmax(*hi, v);
       }
@@ -83,12 +75,10 @@ static void panel_range(const cli_plot_panel *p, int which, double *lo, double *
     /* whole decades keep the logarithmic tick labels readable */
     *lo = floor(*lo - 0.05);
     *hi = ceil(*hi + 0.05);
-    if (*hi - *lo < 1)
-      *hi = *lo + 1;
+    if (*hi - *lo < 1) *hi = *lo + 1;
   } else {
     double pad = span > 0 ? 0.05 * span : (fabs(*lo) > 0 ? 0.1 * fabs(*lo) : 1);
-    if (which == 0 && span > 0)
-      pad = 0; /* the variable's interval is drawn exactly */
+    if (which == 0 && span > 0) pad = 0; /* the variable's interval is drawn exactly */
     *lo -= pad;
     *hi += pad;
   }
@@ -96,8 +86,7 @@ static void panel_range(const cli_plot_panel *p, int which, double *lo, double *
 
 /* Draw one curve as its runs of drawable points (a NaN or a non-positive value on a
  * logarithmic axis breaks the line instead of ending the picture). */
-static void draw_line(const cli_plot_panel *p, const cli_plot_line *ln)
-{
+static void draw_line(const cli_plot_panel *p, const cli_plot_line *ln) {
   PLFLT *x = malloc((size_t)(ln->n > 0 ? ln->n : 1) * sizeof *x);
   PLFLT *y = malloc((size_t)(ln->n > 0 ? ln->n : 1) * sizeof *y);
   if (!x || !y) {
@@ -118,8 +107,7 @@ static void draw_line(const cli_plot_panel *p, const cli_plot_line *ln)
       m++;
       continue;
     }
-    if (m > 1)
-      plline(m, x, y);
+    if (m > 1) plline(m, x, y);
     if (m > 0 && (ln->symbol || m == 1)) /* a lone point would be invisible as a line */
       plstring(m, x, y, MARK);
     m = 0;
@@ -133,26 +121,20 @@ static void draw_line(const cli_plot_panel *p, const cli_plot_line *ln)
 /* The inside corner of the axes where the legend covers the fewest drawn points: bits of
  * PL_POSITION_* (TOP or BOTTOM with LEFT or RIGHT). The legend box is taken as 40% of the
  * width and 7% of the height per line. */
-static PLINT legend_corner(const cli_plot_panel *p, double x0, double x1, double y0,
-                           double y1)
-{
-  static const PLINT corners[4] = {PL_POSITION_TOP | PL_POSITION_RIGHT,
-                                   PL_POSITION_TOP | PL_POSITION_LEFT,
-                                   PL_POSITION_BOTTOM | PL_POSITION_RIGHT,
-                                   PL_POSITION_BOTTOM | PL_POSITION_LEFT};
+static PLINT legend_corner(const cli_plot_panel *p, double x0, double x1, double y0, double y1) {
+  static const PLINT corners[4] = {
+      PL_POSITION_TOP | PL_POSITION_RIGHT, PL_POSITION_TOP | PL_POSITION_LEFT,
+      PL_POSITION_BOTTOM | PL_POSITION_RIGHT, PL_POSITION_BOTTOM | PL_POSITION_LEFT};
   double bh = fmin(0.9, 0.05 + 0.07 * p->nlines), bw = 0.4;
   long count[4] = {0, 0, 0, 0};
   for (int l = 0; l < p->nlines; l++)
     for (int k = 0; k < p->lines[l].n; k++) {
       double u = (coord(p->lines[l].x[k], p->logx) - x0) / (x1 - x0);
       double v = (coord(p->lines[l].y[k], p->logy) - y0) / (y1 - y0);
-      if (!isfinite(u) || !isfinite(v))
-        continue;
-      if (p->xdown)
-        u = 1 - u;
-      if (p->ydown)
-        v = 1 - v;
-      int right = u > 1 - bw, left = u < bw, top = v > 1 - bh, bottom = v < bh;
+      if (!isfinite(u) || !isfinite(v)) continue;
+      if (p->xdown) u = 1 - u;
+      if (p->ydown) v = 1 - v;
+      int right = u > 1 - bw, left = u<bw, top = v> 1 - bh, bottom = v < bh;
       count[0] += top && right;
       count[1] += top && left;
       count[2] += bottom && right;
@@ -160,24 +142,20 @@ static PLINT legend_corner(const cli_plot_panel *p, double x0, double x1, double
     }
   int best = 0;
   for (int c = 1; c < 4; c++)
-    if (count[c] < count[best])
-      best = c;
+    if (count[c] < count[best]) best = c;
   return corners[best];
 }
 
 /* The decimals a linear axis over [lo, hi] needs when its values share leading digits
  * (an offset far larger than the range), else -1: PLplot's own choice is right then. */
-static int axis_decimals(double lo, double hi)
-{
+static int axis_decimals(double lo, double hi) {
   double range = fabs(hi - lo), mid = fmax(fabs(lo), fabs(hi));
-  if (!(range > 0) || mid < 100 * range)
-    return -1;
+  if (!(range > 0) || mid < 100 * range) return -1;
   int d = (int)ceil(-log10(range / 5));
   return d < 0 ? -1 : d > 12 ? 12 : d;
 }
 
-static void draw_panel(const cli_plot_panel *p)
-{
+static void draw_panel(const cli_plot_panel *p) {
   double x0, x1, y0, y1;
   panel_range(p, 0, &x0, &x1);
   panel_range(p, 1, &y0, &y1);
@@ -195,10 +173,8 @@ static void draw_panel(const cli_plot_panel *p)
   PLINT corner = legend_corner(p, x0, x1, y0, y1);
   plwind(p->xdown ? x1 : x0, p->xdown ? x0 : x1, p->ydown ? y1 : y0, p->ydown ? y0 : y1);
   char xo[16] = "bcnst", yo[16] = "bcnstv";
-  if (p->logx)
-    strcat(xo, "l");
-  if (p->logy)
-    strcat(yo, "l");
+  if (p->logx) strcat(xo, "l");
+  if (p->logy) strcat(yo, "l");
   plcol0(2);
   plbox("g", 0, 0, "g", 0, 0);
   plcol0(1);
@@ -210,13 +186,11 @@ static void draw_panel(const cli_plot_panel *p)
   plbox("", 0, 0, yo, 0, 0);
   plprec(0, 0);
   pllab(p->xlabel, p->ylabel, p->title);
-  for (int l = 0; l < p->nlines; l++)
-    draw_line(p, &p->lines[l]);
+  for (int l = 0; l < p->nlines; l++) draw_line(p, &p->lines[l]);
 
   /* legend: one entry per curve, inside the axes in the emptiest corner */
   int n = p->nlines;
-  if (n <= 0 || p->no_legend)
-    return;
+  if (n <= 0 || p->no_legend) return;
   PLINT *opt = calloc((size_t)n, sizeof *opt), *tc = calloc((size_t)n, sizeof *tc);
   PLINT *lc = calloc((size_t)n, sizeof *lc), *ls = calloc((size_t)n, sizeof *ls);
   PLINT *sc = calloc((size_t)n, sizeof *sc), *sn = calloc((size_t)n, sizeof *sn);
@@ -237,9 +211,9 @@ static void draw_panel(const cli_plot_panel *p)
     }
     PLFLT w, h;
     pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-             corner | PL_POSITION_INSIDE | PL_POSITION_VIEWPORT, 0.02, 0.02, 0.05, 0, 1, 1,
-             0, 0, n, opt, 0.7 * chr_factor, 0.8 * chr_factor, 1.6, 0.0, tc, text, NULL, NULL, NULL, NULL, lc, ls, lw,
-             sc, ss, sn, sym);
+             corner | PL_POSITION_INSIDE | PL_POSITION_VIEWPORT, 0.02, 0.02, 0.05, 0, 1, 1, 0, 0, n,
+             opt, 0.7 * chr_factor, 0.8 * chr_factor, 1.6, 0.0, tc, text, NULL, NULL, NULL, NULL,
+             lc, ls, lw, sc, ss, sn, sym);
   }
   free(opt);
   free(tc);
@@ -253,8 +227,7 @@ static void draw_panel(const cli_plot_panel *p)
   free(sym);
 }
 
-int cli_plot_write(cli_outfile *o, int npanels, cli_plot_panel *panels)
-{
+int cli_plot_write(cli_outfile *o, int npanels, cli_plot_panel *panels) {
   /* stacked: panel k takes the k-th band from the top, with room for its labels */
   for (int k = 0; k < npanels; k++) {
     double top = 1.0 - (double)k / npanels, bot = 1.0 - (double)(k + 1) / npanels;
@@ -268,11 +241,9 @@ int cli_plot_write(cli_outfile *o, int npanels, cli_plot_panel *panels)
 }
 
 int cli_plot_write_page(cli_outfile *o, int width, int height, int npanels,
-                        const cli_plot_panel *panels)
-{
+                        const cli_plot_panel *panels) {
   const char *name;
-  if (npanels < 1 || cli_outfile_render_name(o, &name) < 0)
-    return -1;
+  if (npanels < 1 || cli_outfile_render_name(o, &name) < 0) return -1;
   /* PLplot opens the file itself, by name: hand it the temporary (or scratch) file. */
   size_t n = strlen(o->path);
   int svg = n >= 4 && strcmp(o->path + n - 4, ".svg") == 0;
@@ -290,8 +261,7 @@ int cli_plot_write_page(cli_outfile *o, int width, int height, int npanels,
   chr_factor = height > 560 ? pow(560.0 / height, 0.7) : 1.0;
   plschr(0, 0.95 * chr_factor);
   pladv(0); /* one page; every panel draws into its own viewport on it */
-  for (int k = 0; k < npanels; k++)
-    draw_panel(&panels[k]);
+  for (int k = 0; k < npanels; k++) draw_panel(&panels[k]);
   plend();
   exit_tmp = NULL;
   return cli_outfile_commit_rendered(o);

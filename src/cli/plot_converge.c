@@ -12,16 +12,13 @@
 
 #include "cli/cli.h"
 
-int cli_plot_converge(cli_outfile *o, const cli_conv_row *rows, int nrows)
-{
-  if (nrows <= 0)
-    return -1;
+int cli_plot_converge(cli_outfile *o, const cli_conv_row *rows, int nrows) {
+  if (nrows <= 0) return -1;
   double *t = malloc((size_t)nrows * sizeof *t), *e = malloc((size_t)nrows * sizeof *e);
   cli_plot_line *lines = calloc((size_t)nrows, sizeof *lines);
-  char (*labels)[48] = calloc((size_t)nrows, sizeof *labels);
+  char(*labels)[48] = calloc((size_t)nrows, sizeof *labels);
   int nl = 0, est = 0, rc = -1;
-  if (!t || !e || !lines || !labels)
-    goto done;
+  if (!t || !e || !lines || !labels) goto done;
   for (int k = 0; k < nrows; k++) {
     const cli_conv_row *row = &rows[k];
     t[k] = row->r.has_time ? row->r.time_s : NAN;

@@ -26,15 +26,12 @@ enum { NPLOT = 801, MAXPANELS = 4 };
 
 /* The exact values of a slot at the NPLOT abscissae xs (the variable: xs itself), or NULL
  * when the scene gives no [exact] for it. */
-static const double *exact_slot(const scene *s, int slot, const double *xs, const double *ex)
-{
-  if (slot == 0)
-    return xs;
+static const double *exact_slot(const scene *s, int slot, const double *xs, const double *ex) {
+  if (slot == 0) return xs;
   return s->exact[slot - 1] >= 0 ? ex + (size_t)(slot - 1) * NPLOT : NULL;
 }
 
-int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv)
-{
+int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv) {
   const scene *s = r->sc;
   int n = s->n, nn = r->nodes, nc = r->lam ? s->ncons : 0, rc = -1, nl = 0;
   int nmax = 4 * n + nc + 2;
@@ -43,34 +40,28 @@ int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv)
   double *er = malloc((size_t)NPLOT * n * sizeof *er);
   double *yn = malloc((size_t)(nn > 0 ? nn : 1) * n * sizeof *yn);
   cli_plot_line *lines = calloc((size_t)nmax, sizeof *lines);
-  char (*labels)[96] = calloc((size_t)nmax, sizeof *labels);
-  if (!xs || !ys || !ex || !er || !yn || !lines || !labels)
-    goto done;
-  for (int k = 0; k < NPLOT; k++)
-    xs[k] = s->a + (s->b - s->a) * k / (NPLOT - 1);
+  char(*labels)[96] = calloc((size_t)nmax, sizeof *labels);
+  if (!xs || !ys || !ex || !er || !yn || !lines || !labels) goto done;
+  for (int k = 0; k < NPLOT; k++) xs[k] = s->a + (s->b - s->a) * k / (NPLOT - 1);
   xs[NPLOT - 1] = s->b;
   /* the interpolant; after a failed solve it may not evaluate: then the nodal values */
   int dense = cv_solver_eval(sv, NPLOT, xs, ys, NULL) == CVAR_OK;
   for (int i = 0; i < n; i++)
-    for (int j = 0; j < nn; j++)
-      yn[(size_t)i * nn + j] = r->y[(size_t)j * n + i];
+    for (int j = 0; j < nn; j++) yn[(size_t)i * nn + j] = r->y[(size_t)j * n + i];
   int any_exact = 0;
-  for (int i = 0; i < n; i++)
-    any_exact |= s->exact[i] >= 0;
-  if (any_exact && scene_eval_exact(s, NPLOT, xs, ex) < 0)
-    goto done;
+  for (int i = 0; i < n; i++) any_exact |= s->exact[i] >= 0;
+  if (any_exact && scene_eval_exact(s, NPLOT, xs, ex) < 0) goto done;
   int np = dense ? NPLOT : nn;
   const double *xv = dense ? xs : r->x;
   /* slot 0 is the variable, 1 + i unknown i: the drawn values, the exact ones or NULL */
-#define SLOT_Y(slot) ((slot) == 0 ? xv : (dense ? ys : yn) + (size_t)((slot) - 1) * np)
-#define SLOT_NAME(slot) ((slot) == 0 ? s->variable : s->unknowns[(slot) - 1])
+#define SLOT_Y(slot)    ((slot) == 0 ? xv : (dense ? ys : yn) + (size_t)((slot)-1) * np)
+#define SLOT_NAME(slot) ((slot) == 0 ? s->variable : s->unknowns[(slot)-1])
 
   cli_plot_panel pan[MAXPANELS];
   memset(pan, 0, sizeof pan);
   int npan = 0, path = -1;
   int pu = s->plot_path[0], pv = s->plot_path[1];
-  if (pu < 0 && n >= 2)
-    pu = 1, pv = 2;
+  if (pu < 0 && n >= 2) pu = 1, pv = 2;
   int components = !(pu >= 0 && n == 1 && (pu == 0 || pv == 0));
   char pathlabel[2][64];
   if (pu >= 0) {
@@ -148,8 +139,7 @@ int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv)
     cli_plot_panel *P = &pan[npan++];
     P->lines = lines + nl;
     for (int i = 0; i < n; i++) {
-      if (s->exact[i] < 0)
-        continue;
+      if (s->exact[i] < 0) continue;
       for (int k = 0; k < NPLOT; k++)
         er[(size_t)i * NPLOT + k] = fabs(ys[(size_t)i * NPLOT + k] - ex[(size_t)i * NPLOT + k]);
       cli_plot_line *ln = &lines[nl];
@@ -157,8 +147,7 @@ int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv)
       ln->x = xs;
       ln->y = er + (size_t)i * NPLOT;
       ln->colour = i;
-      snprintf(labels[nl], sizeof labels[nl], "|%s - %s exact|", s->unknowns[i],
-               s->unknowns[i]);
+      snprintf(labels[nl], sizeof labels[nl], "|%s - %s exact|", s->unknowns[i], s->unknowns[i]);
       ln->label = labels[nl++];
     }
     P->nlines = (int)(lines + nl - P->lines);
@@ -193,8 +182,7 @@ int cli_plot_solution(cli_outfile *o, const cli_report *r, const cv_solver *sv)
     pan[path].vp[2] = 1.5 * m;
     pan[path].vp[3] = 1.0 - m;
     for (int k = 0, q = 0; k < npan; k++) {
-      if (k == path)
-        continue;
+      if (k == path) continue;
       double top = 1.0 - (double)q / right, bot = 1.0 - (double)(q + 1) / right;
       pan[k].vp[0] = 0.55;
       pan[k].vp[1] = 0.97;

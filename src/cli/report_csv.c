@@ -11,21 +11,16 @@
 
 #include "cli/cli.h"
 
-static void field(FILE *f, double v)
-{
-  if (isfinite(v))
-    fprintf(f, "%.17g", v);
+static void field(FILE *f, double v) {
+  if (isfinite(v)) fprintf(f, "%.17g", v);
 }
 
-int cli_report_csv(FILE *f, const cli_report *r)
-{
+int cli_report_csv(FILE *f, const cli_report *r) {
   const scene *s = r->sc;
   int n = s->n;
   fprintf(f, "%s", s->variable);
-  for (int i = 0; i < n; i++)
-    fprintf(f, ",%s", s->unknowns[i]);
-  for (int c = 0; c < s->ncons; c++)
-    fprintf(f, ",lambda_%s", s->cons[c].name);
+  for (int i = 0; i < n; i++) fprintf(f, ",%s", s->unknowns[i]);
+  for (int c = 0; c < s->ncons; c++) fprintf(f, ",lambda_%s", s->cons[c].name);
   fputc('\n', f);
   for (int j = 0; j < r->nodes; j++) {
     field(f, r->x[j]);
@@ -35,8 +30,7 @@ int cli_report_csv(FILE *f, const cli_report *r)
     }
     for (int c = 0; c < s->ncons; c++) {
       fputc(',', f);
-      if (r->lam)
-        field(f, r->lam[(size_t)c * r->nodes + j]);
+      if (r->lam) field(f, r->lam[(size_t)c * r->nodes + j]);
     }
     fputc('\n', f);
   }

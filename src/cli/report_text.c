@@ -2,15 +2,13 @@
  * SPDX-License-Identifier: MIT */
 #include "cli/cli.h"
 
-void cli_report_text(FILE *f, const cli_report *r)
-{
+void cli_report_text(FILE *f, const cli_report *r) {
   const scene *s = r->sc;
   fprintf(f, "%s\n", s->title);
   fprintf(f, "  status      %s: %s\n", r->status, r->message);
   fprintf(f, "  method      %s, %d iteration%s", cv_method_name(r->method), r->iterations,
           r->iterations == 1 ? "" : "s");
-  if (r->has_time)
-    fprintf(f, ", %.3g s", r->time_s);
+  if (r->has_time) fprintf(f, ", %.3g s", r->time_s);
   fputc('\n', f);
   int dmin = r->degree;
   for (int e = 0; r->degrees && e < r->elements; e++)
@@ -21,24 +19,24 @@ void cli_report_text(FILE *f, const cli_report *r)
   else if (r->nodes > 0)
     fprintf(f, "  mesh        %d elements of degree %d, %d nodes\n", r->elements, r->degree,
             r->nodes);
-  if (r->has_action)
-    fprintf(f, "  action      %.15g\n", r->action);
+  if (r->has_action) fprintf(f, "  action      %.15g\n", r->action);
   if (r->has_gradient_norm) {
     fprintf(f, "  residual    %.3g (max-norm of the scaled Euler-Lagrange residual)\n",
             r->gradient_norm);
     /* Newton's convergence test is on the step, not on this number, which on fine meshes
      * sits at a round-off floor that grows with the number of elements (docs/faq.md). */
     if (r->method == CVAR_METHOD_NEWTON && r->st == CVAR_OK)
-      fprintf(f, "  test        Newton step within %.3g (relative to |y|); the residual is "
-              "not tested\n", s->tolerance);
+      fprintf(f,
+              "  test        Newton step within %.3g (relative to |y|); the residual is "
+              "not tested\n",
+              s->tolerance);
   }
-  if (r->has_morse)
-    fprintf(f, "  stationary  %s (Morse index %d)\n", r->kind, r->morse);
+  if (r->has_morse) fprintf(f, "  stationary  %s (Morse index %d)\n", r->kind, r->morse);
   if (r->has_err_nodal)
     fprintf(f, "  error       %.3g max at the nodes (against [exact])\n", r->err_nodal);
   if (r->has_err_action)
-    fprintf(f, "  error       %.3g in the action (against [exact] action = %.17g)\n",
-            r->err_action, s->exact_action);
+    fprintf(f, "  error       %.3g in the action (against [exact] action = %.17g)\n", r->err_action,
+            s->exact_action);
   if (r->has_err_est)
     fprintf(f, "  estimate    %.3g max nodal error (from a solve with higher degrees)\n",
             r->err_est);
@@ -50,6 +48,5 @@ void cli_report_text(FILE *f, const cli_report *r)
       fprintf(f, "  momentum    dF/d%s' from %.15g to %.15g (%s is cyclic)\n", s->unknowns[i],
               r->mom_min[i], r->mom_max[i], s->unknowns[i]);
   for (int k = 0; k < s->nreports; k++)
-    if (r->has_rep[k])
-      fprintf(f, "  report      %s = %.15g\n", s->reports[k].name, r->rep[k]);
+    if (r->has_rep[k]) fprintf(f, "  report      %s = %.15g\n", s->reports[k].name, r->rep[k]);
 }

@@ -13,7 +13,7 @@
  * near the round-off floor, many before it (bisecting towards a thin layer leaves the
  * estimate flat for as many rounds as the layer is halvings thin). */
 #define STALL_ROUNDS_FLOOR 3
-#define STALL_ROUNDS 40
+#define STALL_ROUNDS       40
 
 cv_status cv_solver_set_tol(cv_solver *s, double tol, int max_nodes) {
   if (!s || !(tol >= 0) || !isfinite(tol) || max_nodes < 2) return CVAR_EINVAL;
@@ -32,8 +32,7 @@ cv_status cv_solver_set_adapt(cv_solver *s, double tol, int max_elements) {
 }
 
 /* The starting mesh of the rounds on [0, 1] with its degrees, from the caller's settings. */
-static cv_status start_mesh(cv_solver *s, const cv_problem *p, int *E, double **t,
-                            int **deg) {
+static cv_status start_mesh(cv_solver *s, const cv_problem *p, int *E, double **t, int **deg) {
   double *xe = NULL;
   cv_status st = cv_mesh_build(&s->mesh, p->a, p->b, E, &xe, s->msg, sizeof s->msg);
   if (st) return st;
@@ -46,7 +45,8 @@ static cv_status start_mesh(cv_solver *s, const cv_problem *p, int *E, double **
   for (int i = 0; i <= *E; i++) (*t)[i] = (xe[i] - p->a) / (p->b - p->a);
   (*t)[0] = 0.0;
   (*t)[*E] = 1.0;
-  if (s->mesh.degrees) cv_mesh_degrees(&s->mesh, p->a, p->b, *E, xe, *deg);
+  if (s->mesh.degrees)
+    cv_mesh_degrees(&s->mesh, p->a, p->b, *E, xe, *deg);
   else
     for (int e = 0; e < *E; e++) (*deg)[e] = s->degree;
   cv_free(xe);
@@ -67,7 +67,8 @@ static int stop_rule(cv_solver *s, double est, double best, double floor_, int s
                      int next_size) {
   double tol = s->adapt_tol;
   const char *what = s->hp ? "nodes" : "elements";
-  if ((best <= floor_ && tol < floor_) || (stalled >= STALL_ROUNDS_FLOOR && best <= 10.0 * floor_)) {
+  if ((best <= floor_ && tol < floor_) ||
+      (stalled >= STALL_ROUNDS_FLOOR && best <= 10.0 * floor_)) {
     cv_set_msg(s->msg, sizeof s->msg,
                "the error estimate reached %.2g > %.2g and can go no lower: that is the "
                "round-off floor of double precision for this solution (about %.1g, from "
@@ -96,8 +97,8 @@ static int stop_rule(cv_solver *s, double est, double best, double floor_, int s
   }
   if (s->rounds >= MAX_ROUNDS) {
     cv_set_msg(s->msg, sizeof s->msg,
-               "no estimate below %.2g after %d refinement rounds (estimate %.2g)", tol,
-               MAX_ROUNDS, est);
+               "no estimate below %.2g after %d refinement rounds (estimate %.2g)", tol, MAX_ROUNDS,
+               est);
     return 1;
   }
   return 0;
@@ -144,8 +145,8 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       memcpy(why, s->msg, sizeof why);
       why[sizeof why - 1] = '\0';
       cv_set_msg(s->msg, sizeof s->msg, "%s, round %d (%d elements, %d nodes): %s",
-                 s->hp ? "automatic accuracy" : "adaptive refinement", s->rounds, E,
-                 s->disc.nodes, why);
+                 s->hp ? "automatic accuracy" : "adaptive refinement", s->rounds, E, s->disc.nodes,
+                 why);
       goto cleanup;
     }
     cv_free(eta);
@@ -186,23 +187,26 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
                    "converged on %d elements (%d nodes) after %d round%s, %ld Newton "
                    "iterations in all (and %ld on the reference meshes); estimated max nodal "
                    "error %.2g <= %.2g",
-                   E, s->disc.nodes, s->rounds, s->rounds == 1 ? "" : "s", iters, iters_ref,
-                   est, tol);
+                   E, s->disc.nodes, s->rounds, s->rounds == 1 ? "" : "s", iters, iters_ref, est,
+                   tol);
         st = CVAR_OK;
         done = 1; /* leaves after the progress report below */
       }
-      if (est <= 0.5 * best) stalled = 0;
-      else stalled++;
+      if (est <= 0.5 * best)
+        stalled = 0;
+      else
+        stalled++;
       if (est < best) best = est;
     }
     if (s->progress) {
-      cv_progress info = {CVAR_PROGRESS_ROUND, s->iterations, s->gnorm, NAN, NAN, s->action,
-                          s->rounds, E, s->err_est};
+      cv_progress info = {CVAR_PROGRESS_ROUND, s->iterations, s->gnorm, NAN,       NAN,
+                          s->action,           s->rounds,     E,        s->err_est};
       if (s->progress(&info, s->progress_user) != 0) {
         st = CVAR_ECANCELLED;
-        cv_set_msg(s->msg, sizeof s->msg, "cancelled by the progress callback after adaptive "
-                   "round %d (%d elements, estimated max nodal error %.2g)", s->rounds, E,
-                   s->err_est);
+        cv_set_msg(s->msg, sizeof s->msg,
+                   "cancelled by the progress callback after adaptive "
+                   "round %d (%d elements, estimated max nodal error %.2g)",
+                   s->rounds, E, s->err_est);
         goto cleanup;
       }
     }
@@ -212,7 +216,8 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     /* mark: hp, the elements within a factor 4 of the largest surplus and the smooth ones
      * above tol (HP-4); --adapt, those above tol / 4 (AD-1), and always the largest */
     double thresh = s->hp ? 0.25 * emax : fmin(0.25 * tol, emax);
-    if (stop_rule(s, est, best, floor_, stalled, next_size(&s->disc, eta, sigma, thresh, tol, s->hp))) {
+    if (stop_rule(s, est, best, floor_, stalled,
+                  next_size(&s->disc, eta, sigma, thresh, tol, s->hp))) {
       st = CVAR_EMAXITER;
       goto cleanup;
     }

@@ -43,9 +43,9 @@ void cv_assembler_free(cv_assembler *as) {
 /* Fill the batch of quadrature points of elements e0 .. e0+ne-1: x, and y, y' from the
  * nodal values through the basis tables, theory (E-3). Inlined with constant P1 and N
  * where they are small (the common scalar case), so the basis loops unroll. */
-static inline __attribute__((always_inline)) void
-fill_batch(const int N, const int P1, cv_assembler *as, const double *Y, const cv_rule *r,
-           int e0, int ne) {
+static inline __attribute__((always_inline)) void fill_batch(const int N, const int P1,
+                                                             cv_assembler *as, const double *Y,
+                                                             const cv_rule *r, int e0, int ne) {
   const cv_disc *d = as->disc;
   int q = r->q, m = ne * q;
   for (int el = 0; el < ne; el++) {
@@ -88,7 +88,7 @@ static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int
 
 /* v[0 .. len-1] = NaN by block copies (a plain loop stays scalar at -O2: 12 stores per
  * element of degree 1 were a tenth of the assembly, docs/performance.md). */
-#define NAN4 NAN, NAN, NAN, NAN
+#define NAN4  NAN, NAN, NAN, NAN
 #define NAN32 NAN4, NAN4, NAN4, NAN4, NAN4, NAN4, NAN4, NAN4
 static const double nans[] = {NAN32, NAN32, NAN32, NAN32, NAN32, NAN32, NAN32, NAN32};
 _Static_assert(sizeof nans / sizeof nans[0] == CV_BATCH, "one batch of NaNs");
@@ -123,10 +123,10 @@ static cv_status call_integrand(cv_assembler *as, cv_integrand_fn Fn, void *user
  * tables to be reloaded. Same sums as the general loops in cv_assemble, (A-1)-(A-3).
  * Returns the batch's part of S; *bad collects 0 * (each entry), which is 0 unless an
  * entry is not finite. */
-static inline __attribute__((always_inline)) double
-batch_scalar(const int P1, const int Q, const cv_disc *d, const cv_rule *r, int e0, int ne,
-             const cv_partials *o, double *restrict g, const int *restrict colptr,
-             double *restrict Ax, double hscale, double *bad) {
+static inline __attribute__((always_inline)) double batch_scalar(
+    const int P1, const int Q, const cv_disc *d, const cv_rule *r, int e0, int ne,
+    const cv_partials *o, double *restrict g, const int *restrict colptr, double *restrict Ax,
+    double hscale, double *bad) {
   enum { MAXB = CV_MAX_QUAD * (CV_MAX_DEGREE + 1) };
   const int q = Q ? Q : r->q;
   double B[MAXB], D[MAXB], om[CV_MAX_QUAD];
@@ -197,15 +197,15 @@ batch_scalar(const int P1, const int Q, const cv_disc *d, const cv_rule *r, int 
 }
 
 static double batch_scalar_dispatch(const cv_disc *d, const cv_rule *r, int e0, int ne, int p,
-                                    const cv_partials *o, double *g, const int *colptr,
-                                    double *Ax, double hscale, double *bad) {
+                                    const cv_partials *o, double *g, const int *colptr, double *Ax,
+                                    double hscale, double *bad) {
   /* constant points only up to degree 4: beyond, the fully unrolled kernel spills (p = 8
    * measured 1.5x slower than with the loop over points kept) */
   int P1 = p + 1, same = r->q == P1 && P1 <= 5;
   switch (P1) {
-#define CASE(c)                                                                            \
-  case c:                                                                                  \
-    return same ? batch_scalar(c, c, d, r, e0, ne, o, g, colptr, Ax, hscale, bad)          \
+#define CASE(c)                                                                                    \
+  case c:                                                                                          \
+    return same ? batch_scalar(c, c, d, r, e0, ne, o, g, colptr, Ax, hscale, bad)                  \
                 : batch_scalar(c, 0, d, r, e0, ne, o, g, colptr, Ax, hscale, bad);
     CASE(2) CASE(3) CASE(4) CASE(5) CASE(6) CASE(7) CASE(8) CASE(9)
 #undef CASE
@@ -218,9 +218,8 @@ static double batch_scalar_dispatch(const cv_disc *d, const cv_rule *r, int e0, 
  * d2S_h/dY_{l,i}dY_{r,j} = sum (h/2) w_k (F_yiyj phi_l phi_r
  *     + F_yiy'j phi_l phi_r' (2/h) + F_yjy'i phi_l' phi_r (2/h) + F_y'iy'j phi_l' phi_r' (2/h)^2)
  *                                                                              (A-3)  */
-cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y,
-                      double *S, double *g, const int *colptr, double *Ax, double hscale,
-                      int overwrite) {
+cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y, double *S,
+                      double *g, const int *colptr, double *Ax, double hscale, int overwrite) {
   const cv_disc *d = as->disc;
   int n = d->n;
   unsigned need = CVAR_NEED_F | (g ? CVAR_NEED_GRAD : 0u) | (Ax ? CVAR_NEED_HESS : 0u);
@@ -290,8 +289,8 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
           for (int i = 0; i < n; i++)
             for (int j = 0; j < n; j++) {
               double yy = wk * Fyy[(i * n + j) * m + idx];
-              double yp = wk * rh * Fyp[(i * n + j) * m + idx];  /* F_{y_i y'_j} */
-              double py = wk * rh * Fyp[(j * n + i) * m + idx];  /* F_{y'_i y_j} */
+              double yp = wk * rh * Fyp[(i * n + j) * m + idx]; /* F_{y_i y'_j} */
+              double py = wk * rh * Fyp[(j * n + i) * m + idx]; /* F_{y'_i y_j} */
               double pp = wk * rh * rh * Fpp[(i * n + j) * m + idx];
               for (int l = 0; l < P1; l++) {
                 double bl = Bk[l], dl = Dk[l];

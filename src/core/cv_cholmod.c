@@ -15,9 +15,9 @@ struct cv_ldlt {
   cholmod_sparse *A;
   cholmod_factor *L;
   long n;
-  pthread_t th;  /* the symbolic analysis, started by cv_ldlt_new on large systems */
-  int running;   /* th has to be joined */
-  int analysed;  /* cholmod_analyze has run (L->L set, or NULL on its failure) */
+  pthread_t th; /* the symbolic analysis, started by cv_ldlt_new on large systems */
+  int running;  /* th has to be joined */
+  int analysed; /* cholmod_analyze has run (L->L set, or NULL on its failure) */
   /* Small systems: the skyline LDL^T of this file instead (theory N-7); then c, A and L
    * are unused and the matrix, its factor and the pivots live here. */
   int sky;
@@ -64,7 +64,8 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
   if (nnz > INT_MAX) nnz = cv_disc_pattern(d, NULL, NULL);
   *out = NULL;
   if (nnz > INT_MAX) {
-    cv_set_msg(msg, len, "the Hessian would have %ld entries, more than the 2^31 - 1 of the "
+    cv_set_msg(msg, len,
+               "the Hessian would have %ld entries, more than the 2^31 - 1 of the "
                "32-bit sparse matrix calcvar factors; use fewer elements or a lower degree",
                nnz);
     return CVAR_EINVAL;
@@ -112,8 +113,7 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
   L->c.error_handler = NULL;
   L->n = nfree;
   size_t nz = (size_t)(nnz ? nnz : 1);
-  L->A = cholmod_allocate_sparse((size_t)nfree, (size_t)nfree, nz, 1, 1, 1, CHOLMOD_REAL,
-                                 &L->c);
+  L->A = cholmod_allocate_sparse((size_t)nfree, (size_t)nfree, nz, 1, 1, 1, CHOLMOD_REAL, &L->c);
   if (!L->A) {
     cv_ldlt_free(L);
     return CVAR_ENOMEM;
@@ -201,8 +201,10 @@ static void skyline_factor(cv_ldlt *L) {
       uj[i] = uij;
       dj -= uij * g;
     }
-    if (j >= L->minor) dj = 0.0;
-    else if (dj == 0.0) L->minor = j;
+    if (j >= L->minor)
+      dj = 0.0;
+    else if (dj == 0.0)
+      L->minor = j;
     uj[j] = dj;
   }
 }
@@ -225,8 +227,7 @@ static cv_status factor_cholmod(cv_ldlt *L, char *msg, size_t len) {
   return CVAR_OK;
 }
 
-cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg,
-                         size_t len) {
+cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg, size_t len) {
   if (L->sky) {
     skyline_factor(L);
   } else {
@@ -258,8 +259,10 @@ cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char 
   /* The assembly checks each element's entries; only a sum of finite ones that overflows
    * arrives here (cv_assemble). */
   if (bad >= 0) {
-    cv_set_msg(msg, len, "the Hessian (or its factor) is not finite at unknown %ld: the "
-               "integrand's second derivatives overflow", bad);
+    cv_set_msg(msg, len,
+               "the Hessian (or its factor) is not finite at unknown %ld: the "
+               "integrand's second derivatives overflow",
+               bad);
     return CVAR_ENONFINITE;
   }
   /* CHOLMOD stops LDL^T at an exactly zero pivot and reports it as "not positive
@@ -291,8 +294,10 @@ static void forward_L(const cv_ldlt *L, double *x) { /* x <- L^{-1} x, L unit lo
     int has_next = 0;
     x[j] = xj;
     for (int k = Lp[j] + 1, ke = Lp[j] + Lnz[j]; k < ke; k++) {
-      if (Li[k] == j + 1) lnext = Lx[k], has_next = 1;
-      else x[Li[k]] -= Lx[k] * xj;
+      if (Li[k] == j + 1)
+        lnext = Lx[k], has_next = 1;
+      else
+        x[Li[k]] -= Lx[k] * xj;
     }
     if (j + 1 < n) carry = has_next ? x[j + 1] - lnext * xj : x[j + 1];
   }
@@ -300,7 +305,7 @@ static void forward_L(const cv_ldlt *L, double *x) { /* x <- L^{-1} x, L unit lo
 
 /* x <- L^{-T} D^{-1} x (diag 1) or L^{-T} x (diag 0): one pass for both factors */
 static inline __attribute__((always_inline)) void backward_Lt(const cv_ldlt *L, int diag,
-                                                               double *x) {
+                                                              double *x) {
   const int *Lp = L->L->p, *Li = L->L->i, *Lnz = L->L->nz;
   const double *Lx = L->L->x;
   double carry = 0.0; /* x[j + 1], final */
@@ -360,12 +365,16 @@ cv_status cv_ldlt_solve(cv_ldlt *L, double *x) {
 
 cv_status cv_ldlt_solve_L(cv_ldlt *L, int transpose, double *x) {
   if (L->sky) {
-    if (transpose) sky_backward(L, 0, x);
-    else sky_forward(L, x);
+    if (transpose)
+      sky_backward(L, 0, x);
+    else
+      sky_forward(L, x);
     return CVAR_OK;
   }
-  if (transpose) backward_Lt(L, 0, x);
-  else forward_L(L, x);
+  if (transpose)
+    backward_Lt(L, 0, x);
+  else
+    forward_L(L, x);
   return CVAR_OK;
 }
 

@@ -7,9 +7,9 @@
 
 #include "cv_internal.h"
 
-#define MIN_STEP 1e-6
+#define MIN_STEP        1e-6
 #define STEP_ITERATIONS 15
-#define MAX_STEPS 400
+#define MAX_STEPS       400
 
 /* Weight w of the homotopy term: the mean diagonal of the Hessian at Y0 per unit lumped
  * weight, so that both terms of H_t have the same size (HC-1). */
@@ -49,16 +49,18 @@ static cv_status homotopy_weight(const cv_problem *p, const cv_disc *d, const do
  * starting each step from the last solution; the step in t doubles after an easy step and
  * shrinks fourfold after a failed one. Failure to advance below MIN_STEP means the path
  * turns back or ends: the problem may have no stationary path near the start. */
-cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y,
-                              double *M, const double *Y0) {
+cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M,
+                              const double *Y0) {
   double w, t = 0.0, dt = 0.1;
   int steps = 0, total = s->iterations, maxit = s->maxit;
   size_t nd = (size_t)d->ndof * sizeof *Y;
   double *Yc = cv_malloc(nd), *Yt = cv_malloc(nd);
   cv_status st = (Yc && Yt) ? homotopy_weight(p, d, Y0, &w) : CVAR_ENOMEM;
   if (st) {
-    cv_set_msg(s->msg, sizeof s->msg, "Newton did not converge and continuation could not "
-               "start (%s)", cv_strerror(st));
+    cv_set_msg(s->msg, sizeof s->msg,
+               "Newton did not converge and continuation could not "
+               "start (%s)",
+               cv_strerror(st));
     goto cleanup;
   }
   memcpy(Yc, Y0, nd);
@@ -69,8 +71,7 @@ cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, dou
     memcpy(Yt, Yc, nd);
     st = cv_newton_run(s, p, d, Yt, M, &h);
     total += s->iterations;
-    if (st == CVAR_ECALLBACK || st == CVAR_ENOMEM || st == CVAR_EINVAL ||
-        st == CVAR_ECANCELLED)
+    if (st == CVAR_ECALLBACK || st == CVAR_ENOMEM || st == CVAR_EINVAL || st == CVAR_ECANCELLED)
       goto cleanup;
     if (st == CVAR_OK) {
       memcpy(Yc, Yt, nd);

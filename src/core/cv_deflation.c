@@ -17,20 +17,20 @@
 
 #include "cv_internal.h"
 
-#define DEFL_P 2.0      /* power of the distance (DF-1) */
-#define DEFL_SIGMA 1.0  /* shift: M -> 1 far from every known path (DF-1) */
-#define DEFL_MAXIT 25   /* deflated Newton iterations per start */
-#define WORK_FLOOR 8    /* the first solve counts as at least this many iterations */
-#define EIG_DIRS 3      /* lowest Hessian eigen-directions per path (DF-4) */
-#define MIN_TRIES 2 /* perturbations every path gets before the work limit may stop (DF-4) */
-#define EIG_STEPS 4     /* block inverse-iteration steps */
-#define MAX_BACKTRACK 12 /* deflated line search: a step cut below 2^-12 is no progress */
-#define TAU_BIG 10.0     /* |1 / (1 - r.delta0)| above this: deflation dominates (DF-3) */
-#define STALL_DROP 0.9   /* ... and |G| fell by less than 10% over two such steps: abandon */
-#define CRAWL_ALPHA 0.0625 /* a step cut to this or less is a crawl ... */
-#define CRAWL_RUN 8        /* ... and this many in a row that did not halve |G|: abandon */
-#define ARMIJO 1e-4
-#define SAME_FLOOR 1e-6 /* paths closer than this times their size are one (DF-5) */
+#define DEFL_P        2.0  /* power of the distance (DF-1) */
+#define DEFL_SIGMA    1.0  /* shift: M -> 1 far from every known path (DF-1) */
+#define DEFL_MAXIT    25   /* deflated Newton iterations per start */
+#define WORK_FLOOR    8    /* the first solve counts as at least this many iterations */
+#define EIG_DIRS      3    /* lowest Hessian eigen-directions per path (DF-4) */
+#define MIN_TRIES     2    /* perturbations every path gets before the work limit may stop (DF-4) */
+#define EIG_STEPS     4    /* block inverse-iteration steps */
+#define MAX_BACKTRACK 12   /* deflated line search: a step cut below 2^-12 is no progress */
+#define TAU_BIG       10.0 /* |1 / (1 - r.delta0)| above this: deflation dominates (DF-3) */
+#define STALL_DROP    0.9  /* ... and |G| fell by less than 10% over two such steps: abandon */
+#define CRAWL_ALPHA   0.0625 /* a step cut to this or less is a crawl ... */
+#define CRAWL_RUN     8      /* ... and this many in a row that did not halve |G|: abandon */
+#define ARMIJO        1e-4
+#define SAME_FLOOR    1e-6 /* paths closer than this times their size are one (DF-5) */
 
 /* One path: the results of its polishing solve, moved out of the solver. */
 typedef struct {
@@ -150,8 +150,7 @@ static cv_status defl_init(defl *w, const cv_problem *p, cv_disc *d, char *msg, 
   w->Yt = cv_malloc((size_t)d->ndof * sizeof *w->Yt);
   w->Mt = cv_calloc(w->nmult + 1, sizeof *w->Mt);
   w->M = cv_calloc(w->nmult + 1, sizeof *w->M);
-  if (!w->g || !w->gt || !w->delta || !w->corr || !w->dreg || !w->r || !w->Yt || !w->Mt ||
-      !w->M)
+  if (!w->g || !w->gt || !w->delta || !w->corr || !w->dreg || !w->r || !w->Yt || !w->Mt || !w->M)
     return CVAR_ENOMEM;
   for (int f = 0; f < w->nf; f++) w->ncon += w->gof[f] < 0;
   return CVAR_OK;
@@ -225,12 +224,14 @@ static cv_status solve_refined(defl *w) {
   return st;
 }
 
-static void put(defl *w, const double *Y, const double *M, double a, const double *dx,
-                double *Yt, double *Mt) {
+static void put(defl *w, const double *Y, const double *M, double a, const double *dx, double *Yt,
+                double *Mt) {
   for (int f = 0; f < w->nf; f++) {
     int gi = w->gof[f];
-    if (gi >= 0) Yt[gi] = Y[gi] + a * dx[f];
-    else Mt[-1 - gi] = M[-1 - gi] + a * dx[f];
+    if (gi >= 0)
+      Yt[gi] = Y[gi] + a * dx[f];
+    else
+      Mt[-1 - gi] = M[-1 - gi] + a * dx[f];
   }
 }
 
@@ -252,9 +253,9 @@ static cv_status defl_run(defl *w, const cv_solver *s, double *Y, int maxit, int
   st = cv_kkt_eval(&w->kkt, Y, w->M, &S, w->g, Ax, w->dreg);
   if (st) return st;
   double Mv = deflation(w, Y, w->r), phi = merit(w, w->g, Mv), phi_big = phi;
-  int big = 0;                /* consecutive iterations with |tau| > TAU_BIG */
-  int crawl = 0;              /* consecutive steps cut to CRAWL_ALPHA or less */
-  double phi_crawl = phi;     /* the merit before the first of them */
+  int big = 0;            /* consecutive iterations with |tau| > TAU_BIG */
+  int crawl = 0;          /* consecutive steps cut to CRAWL_ALPHA or less */
+  double phi_crawl = phi; /* the merit before the first of them */
   for (int it = 0; it < maxit; it++) {
     int neg;
     double dmin, dmax;
@@ -426,7 +427,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
   if (!p || max < 1 || s->method != CVAR_METHOD_NEWTON) {
     s->status = CVAR_EINVAL;
     cv_set_msg(s->msg, sizeof s->msg, "%s",
-               !p ? "problem is NULL"
+               !p        ? "problem is NULL"
                : max < 1 ? "the number of paths to find must be at least 1"
                          : "the search for every stationary path needs the Newton engine "
                            "(the minimisers find minima only)");
@@ -527,8 +528,8 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
     for (int j = 0; j < w.nknown; j++)
       if ((nmodes[j] < 0 || cursor[j] < namp * nmodes[j]) && cursor[j] < least) least = cursor[j];
     if (work - found_at >= budget && least >= MIN_TRIES) {
-      cv_set_msg(info->stop, sizeof info->stop,
-                 "the work limit was reached (%d Newton iterations)", work);
+      cv_set_msg(info->stop, sizeof info->stop, "the work limit was reached (%d Newton iterations)",
+                 work);
       break;
     }
     /* the next start into Y */
@@ -560,7 +561,8 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
       if (k < 0) {
         cv_set_msg(info->stop, sizeof info->stop,
                    "every start was tried (the guess, the straight line and %d perturbations "
-                   "of each path found)", EIG_DIRS * namp);
+                   "of each path found)",
+                   EIG_DIRS * namp);
         break;
       }
       if (nmodes[k] < 0) {
@@ -601,8 +603,10 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
     }
     int added = keep_path(s, ps, &w, xs, ev, E, ests);
     if (added < 0) goto nomem;
-    if (!added) info->duplicates++;
-    else found_at = work; /* a new path renews the allowance */
+    if (!added)
+      info->duplicates++;
+    else
+      found_at = work; /* a new path renews the allowance */
   }
   st = CVAR_OK;
   goto finish;
@@ -655,9 +659,7 @@ cv_status cv_solver_set_search_work(cv_solver *s, double factor) {
   return CVAR_OK;
 }
 
-int cv_solver_get_num_solutions(const cv_solver *s) {
-  return s && s->paths ? s->paths->n : 0;
-}
+int cv_solver_get_num_solutions(const cv_solver *s) { return s && s->paths ? s->paths->n : 0; }
 
 cv_status cv_solver_select_solution(cv_solver *s, int k) {
   if (!s) return CVAR_EINVAL;

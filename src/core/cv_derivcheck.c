@@ -20,8 +20,8 @@ static cv_status eval_at(probe *pr, unsigned need) {
   return CVAR_OK;
 }
 
-static void consider(cv_derivcheck *rep, int point, const char *name, int i, int j,
-                     double an, double fd) {
+static void consider(cv_derivcheck *rep, int point, const char *name, int i, int j, double an,
+                     double fd) {
   double err = fabs(an - fd) / fmax(1.0, fabs(an));
   if (!isfinite(an) || !isfinite(fd)) err = INFINITY;
   if (!(err <= rep->worst)) {
@@ -29,16 +29,17 @@ static void consider(cv_derivcheck *rep, int point, const char *name, int i, int
     rep->point = point;
     rep->analytic = an;
     rep->fd = fd;
-    if (j >= 0) snprintf(rep->which, sizeof rep->which, "%s[%d][%d]", name, i, j);
-    else snprintf(rep->which, sizeof rep->which, "%s[%d]", name, i);
+    if (j >= 0)
+      snprintf(rep->which, sizeof rep->which, "%s[%d][%d]", name, i, j);
+    else
+      snprintf(rep->which, sizeof rep->which, "%s[%d]", name, i);
   }
 }
 
 /* Central differences with step h = eps^(1/3) max(1, |v|), error O(h^2) ~ eps^(2/3) relative
  * for the first partials (of F) and for the second partials (of the first ones). */
-cv_status cv_problem_check_derivatives(const cv_problem *p, int m, const double *x,
-                                       const double *y, const double *dy,
-                                       cv_derivcheck *rep) {
+cv_status cv_problem_check_derivatives(const cv_problem *p, int m, const double *x, const double *y,
+                                       const double *dy, cv_derivcheck *rep) {
   if (!p || !p->F || m < 1 || m > CV_BATCH || !x || !y || !dy || !rep) return CVAR_EINVAL;
   int n = p->n;
   size_t nn = (size_t)n * n;

@@ -37,8 +37,10 @@ long cv_disc_node_elem(const cv_disc *d, long j) {
   long lo = 0, hi = d->E; /* en[lo] <= j < en[hi] */
   while (hi - lo > 1) {
     long mid = (lo + hi) / 2;
-    if (d->en[mid] <= j) lo = mid;
-    else hi = mid;
+    if (d->en[mid] <= j)
+      lo = mid;
+    else
+      hi = mid;
   }
   return lo;
 }
@@ -77,8 +79,7 @@ static cv_status disc_init_hp(cv_disc *d, const cv_meshspec *m, int nq) {
 
 /* Unknowns are node-major (theory E-2); fixed end values are removed, so free indices are
  * the global ones shifted by the fixed components of node 0, except at the two end nodes. */
-cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
-                       size_t len) {
+cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg, size_t len) {
   cv_status st;
   int n = p->n;
   memset(d, 0, sizeof *d);
@@ -97,8 +98,8 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
     }
   }
   if ((double)d->nodes * n > 2.0e9) {
-    cv_set_msg(msg, len, "%d elements of degree %d with %d unknowns exceed 2e9 unknowns",
-               d->E, d->p, n);
+    cv_set_msg(msg, len, "%d elements of degree %d with %d unknowns exceed 2e9 unknowns", d->E,
+               d->p, n);
     cv_disc_free(d);
     return CVAR_EINVAL;
   }
@@ -167,9 +168,7 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
 }
 
 /* Per-element stride of the singular-end rules: room for the largest degree. */
-static size_t srule_stride(const cv_disc *d) {
-  return (size_t)d->ref.qs * (2 + 2 * (d->p + 1));
-}
+static size_t srule_stride(const cv_disc *d) { return (size_t)d->ref.qs * (2 + 2 * (d->p + 1)); }
 
 cv_rule cv_disc_rule(const cv_disc *d, long e) {
   const cv_refelem *r = cv_disc_eref(d, e);
@@ -233,8 +232,10 @@ long cv_disc_pattern(const cv_disc *d, int *colptr, int *gof) {
   long since = 0; /* nodes since the last element boundary, without % */
   for (long J = 0, e = 0; J < d->nodes; J++) {
     /* e = first element containing node J */
-    if (d->en) e += J > 1 && J - 1 == d->en[e + 1];
-    else if (J > 1 && ++since == p) e++, since = 0;
+    if (d->en)
+      e += J > 1 && J - 1 == d->en[e + 1];
+    else if (J > 1 && ++since == p)
+      e++, since = 0;
     long r0 = cv_disc_elem_first(d, e);
     /* the node's unknowns in increasing order: y components, then multipliers */
     for (int t = 0; t < n + nc; t++) {

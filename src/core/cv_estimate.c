@@ -29,8 +29,10 @@ static void f_eval(const cv_solver *f, long fe, int split, int m, const double *
     long e = fe;
     double t = tau[k];
     if (split) {
-      if (t > 0) e++, t = 2.0 * t - 1.0;
-      else t = 2.0 * t + 1.0;
+      if (t > 0)
+        e++, t = 2.0 * t - 1.0;
+      else
+        t = 2.0 * t + 1.0;
     }
     int pe = cv_disc_edeg(fd, e);
     long j0 = cv_disc_enode(fd, e);
@@ -174,10 +176,9 @@ static cv_status indicators(const cv_disc *d, const cv_solver *f, double *eta, d
  * with a sentence in msg: the enriched solve failed, or it stopped on another stationary
  * path (other Morse index, or moved by more than the distance Newton was asked to trust),
  * which is then no error bound. */
-cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solver *f,
-                               double *est, double *est_vertex, double *floor_out,
-                               double *eta, double *sigma, double *where,
-                               char *msg, size_t len) {
+cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solver *f, double *est,
+                               double *est_vertex, double *floor_out, double *eta, double *sigma,
+                               double *where, char *msg, size_t len) {
   const cv_disc *d = &s->disc;
   int Ef = 0, *deg = NULL, n = p->n;
   double *t = NULL, *yf = NULL;

@@ -83,10 +83,10 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
       (*deg)[k++] = pe;
       continue;
     }
-    int sing_left = (e == 0 && d->sing_a) || (!(e == E - 1 && d->sing_b) && where[e] < -0.5 &&
-                                              sigma[e] < SMOOTH_RATE);
-    int sing_right = (e == E - 1 && d->sing_b) || (!(e == 0 && d->sing_a) && where[e] > 0.5 &&
-                                                   sigma[e] < SMOOTH_RATE);
+    int sing_left = (e == 0 && d->sing_a) ||
+                    (!(e == E - 1 && d->sing_b) && where[e] < -0.5 && sigma[e] < SMOOTH_RATE);
+    int sing_right = (e == E - 1 && d->sing_b) ||
+                     (!(e == 0 && d->sing_a) && where[e] > 0.5 && sigma[e] < SMOOTH_RATE);
     if (sing_left && !sing_right) { /* small element at x0 keeps p, the rest p + 1 (HP-5) */
       (*deg)[k++] = pe;
       (*t)[k] = tl;
@@ -99,7 +99,7 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
       (*deg)[k++] = pe;
       continue;
     }
-    if (sigma[e] >= SMOOTH_RATE && pe < CV_MAX_DEGREE) { /* smooth: raise p (HP-4) */
+    if (sigma[e] >= SMOOTH_RATE && pe < CV_MAX_DEGREE) {    /* smooth: raise p (HP-4) */
       if (!degree_suffices(pe, eta[e], sigma[e], target)) { /* and halve, in one round */
         (*deg)[k++] = CV_MAX_DEGREE;
         (*t)[k] = tm;

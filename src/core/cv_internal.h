@@ -9,13 +9,12 @@
 #include "cv_table_internal.h"
 
 /* Largest batch handed to an integrand callback (documented in calcvar.h). */
-#define CV_BATCH 256
+#define CV_BATCH      256
 #define CV_MAX_DEGREE 8
-#define CV_MAX_QUAD 32
-#define CV_PI 3.14159265358979323846
+#define CV_MAX_QUAD   32
+#define CV_PI         3.14159265358979323846
 /* The round-off floor of an error estimate, in units of eps times the values' size (HP-2). */
 #define CV_ROUNDOFF_ULPS 256.0
-
 
 typedef struct {
   cv_constraint_fn G;
@@ -32,20 +31,20 @@ typedef struct {
 
 struct cv_problem {
   int n;
-  int nc, ni;              /* pointwise and integral constraints */
+  int nc, ni; /* pointwise and integral constraints */
   cv_pconstraint *pc;
   cv_iconstraint *ic;
   double a, b;
   cv_integrand_fn F;
   void *user;
   cv_release_fn release;
-  int *fixed;      /* fixed[2*k + end]: 1 fixed, 0 free (natural condition) */
-  double *endval;  /* endval[2*k + end] */
+  int *fixed;     /* fixed[2*k + end]: 1 fixed, 0 free (natural condition) */
+  double *endval; /* endval[2*k + end] */
   cv_guess_fn guess;
   void *guess_user;
-  int nnotes;        /* failure notes of callbacks (cv_table_internal.h) */
+  int nnotes; /* failure notes of callbacks (cv_table_internal.h) */
   cv_note_source *notes;
-  int ntables;       /* tables added by cv_problem_add_table, each with a reference */
+  int ntables; /* tables added by cv_problem_add_table, each with a reference */
   char **table_name;
   cv_table **table;
 };
@@ -53,12 +52,12 @@ struct cv_problem {
 /* ---- reference element: GLL nodes, Gauss-Legendre rule, basis tables (cv_quadrature.c) */
 typedef struct {
   int p, q;
-  double xi[CV_MAX_DEGREE + 1];   /* GLL nodes on [-1, 1] */
-  double wl[CV_MAX_DEGREE + 1];   /* GLL weights (= integral of each basis function) */
-  double tau[CV_MAX_QUAD];        /* Gauss points */
-  double omega[CV_MAX_QUAD];      /* Gauss weights */
-  double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];  /* B[k*(p+1)+l] = phi_l(tau_k) */
-  double D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];  /* D[k*(p+1)+l] = phi_l'(tau_k) on [-1,1] */
+  double xi[CV_MAX_DEGREE + 1];                /* GLL nodes on [-1, 1] */
+  double wl[CV_MAX_DEGREE + 1];                /* GLL weights (= integral of each basis function) */
+  double tau[CV_MAX_QUAD];                     /* Gauss points */
+  double omega[CV_MAX_QUAD];                   /* Gauss weights */
+  double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)]; /* B[k*(p+1)+l] = phi_l(tau_k) */
+  double D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)]; /* D[k*(p+1)+l] = phi_l'(tau_k) on [-1,1] */
   int qs; /* points of the singular-end rules, built per element in cv_disc.c */
 } cv_refelem;
 
@@ -82,18 +81,17 @@ enum { CV_MESH_UNIFORM, CV_MESH_GRADED, CV_MESH_USER };
 typedef struct {
   int kind, elements, grade_end;
   double grading;
-  double *t;   /* user mesh on [0,1], elements+1 */
+  double *t; /* user mesh on [0,1], elements+1 */
   int nbreak;
   double *breaks;
   int *degrees; /* user mesh only: degree of each of its elements (hp), or NULL */
 } cv_meshspec;
 /* Element boundaries on [a, b] from a spec; *xe is allocated (E+1 entries). */
-cv_status cv_mesh_build(const cv_meshspec *m, double a, double b, int *E, double **xe,
-                        char *msg, size_t len);
+cv_status cv_mesh_build(const cv_meshspec *m, double a, double b, int *E, double **xe, char *msg,
+                        size_t len);
 /* Degrees of the E elements xe[0..E] built from m (m->degrees set): an element takes the
  * degree of the user element containing its midpoint (breakpoints may have split some). */
-void cv_mesh_degrees(const cv_meshspec *m, double a, double b, int E, const double *xe,
-                     int *pe);
+void cv_mesh_degrees(const cv_meshspec *m, double a, double b, int E, const double *xe, int *pe);
 
 /* ---- discretisation of one solve (cv_disc.c) ---- */
 /* Unknowns of the discrete problem, node-major (theory E-2, C-3): at each node its free
@@ -101,10 +99,10 @@ void cv_mesh_degrees(const cv_meshspec *m, double a, double b, int E, const doub
  * nc multipliers; after the last node the ni integral multipliers. */
 typedef struct {
   int n, p, E, nodes, ndof, nfree; /* p: the (largest) element degree */
-  int nc, ni, stride, off0;   /* stride = n + nc; off0 = unknowns at node 0 */
-  int nfree0, nfree1;         /* free y components at node 0 / at the last node */
+  int nc, ni, stride, off0;        /* stride = n + nc; off0 = unknowns at node 0 */
+  int nfree0, nfree1;              /* free y components at node 0 / at the last node */
   double a, b;
-  double *xe;          /* element boundaries, E+1 */
+  double *xe; /* element boundaries, E+1 */
   cv_refelem ref;
   int *fix0, *fix1;    /* index of each y component at node 0 / last, or -1 */
   int lam0, lamL, nu0; /* first multiplier at node 0 / last node (-1: none), integrals */
@@ -113,9 +111,9 @@ typedef struct {
   int sing_a, sing_b;  /* integrand singular at that end: rules Q-2 on every element */
   double *srule;       /* per-element rules (tau, omega, B, D) when singular, else NULL */
   /* Variable degree (hp, theory HP-1): NULL when every element has degree p. */
-  int *pe;             /* degree of each element */
-  long *en;            /* first node of each element, E+1 entries (en[E] = nodes - 1) */
-  cv_refelem *refs;    /* reference element of each degree, refs[k] for k = 1..p */
+  int *pe;          /* degree of each element */
+  long *en;         /* first node of each element, E+1 entries (en[E] = nodes - 1) */
+  cv_refelem *refs; /* reference element of each degree, refs[k] for k = 1..p */
 } cv_disc;
 
 /* First node, degree and reference element of element e (constant or hp). */
@@ -186,8 +184,7 @@ double *cv_ldlt_values(cv_ldlt *L);          /* Ax, length colptr[nfree] */
 /* Factor numerically (analysis happens on the first call). Returns CVAR_OK, or
  * CVAR_ESINGULAR with *minor set when a pivot is exactly zero/NaN. *neg = number of
  * negative pivots, *dmin the smallest |D(j)| / |A(j,j)|, *dmax the largest |D(j)|. */
-cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg,
-                         size_t len);
+cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg, size_t len);
 /* Solve in place: x <- A^{-1} x. */
 cv_status cv_ldlt_solve(cv_ldlt *L, double *x);
 /* x <- L^{-1} x (transpose 0) or L^{-T} x (transpose 1), L unit lower triangular. */
@@ -199,12 +196,12 @@ void cv_ldlt_diag(const cv_ldlt *L, double *D);
 typedef struct {
   const cv_problem *prob;
   const cv_disc *disc;
-  double *buf;          /* batch buffers */
-  double *K;            /* element matrix, ((p+1) n)^2 */
-  int *fl;              /* free index of each local dof, (p+1) n */
+  double *buf; /* batch buffers */
+  double *K;   /* element matrix, ((p+1) n)^2 */
+  int *fl;     /* free index of each local dof, (p+1) n */
   double *x, *y, *dy;
   cv_partials out;
-  int cb_status;        /* last callback return value (>0 cannot evaluate, <0 abort) */
+  int cb_status; /* last callback return value (>0 cannot evaluate, <0 abort) */
   long nevals;
 } cv_assembler;
 
@@ -217,9 +214,8 @@ void cv_assembler_free(cv_assembler *as);
  * cleared batch by batch before the sums, so they end up holding this assembly alone
  * (integral-multiplier rows and columns are not touched). Returns CVAR_OK,
  * CVAR_ENONFINITE (non-finite output or > 0 from the callback), CVAR_ECALLBACK. */
-cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y,
-                      double *S, double *g, const int *colptr, double *Ax, double hscale,
-                      int overwrite);
+cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y, double *S,
+                      double *g, const int *colptr, double *Ax, double hscale, int overwrite);
 
 /* ---- the Lagrangian system with constraints (cv_kkt.c) ---- */
 typedef struct {
@@ -227,22 +223,22 @@ typedef struct {
   const cv_disc *d;
   cv_assembler as;
   const int *colptr;
-  double *xn;    /* node abscissae (pointwise constraints) */
-  double *cbuf;  /* batch buffers of constraint calls */
-  double *gK;    /* gradient of one integral constraint */
+  double *xn;   /* node abscissae (pointwise constraints) */
+  double *cbuf; /* batch buffers of constraint calls */
+  double *gK;   /* gradient of one integral constraint */
 } cv_kkt;
 cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const int *colptr);
 void cv_kkt_free(cv_kkt *k);
 /* Reject pointwise constraints that fail at an end whose unknowns are all fixed. */
 cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len);
 /* Constraint values and dense Jacobian rows for the NLopt engine. */
-cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, double *jac,
-                                   int ld, const int *lrow, const int *var);
+cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, double *jac, int ld,
+                                   const int *lrow, const int *var);
 /* Least-squares starting multipliers from the stationarity condition at Y (C-5). */
 cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M);
 /* M: multipliers, lam[node*nc + k] then nu[r]. Ax and dreg may be NULL. */
-cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, double *G,
-                      double *Ax, double *dreg);
+cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, double *G, double *Ax,
+                      double *dreg);
 
 /* ---- Newton (cv_newton.c) ---- */
 typedef struct {
@@ -264,21 +260,21 @@ struct cv_solver {
   char msg[640];
   int n, have;
   cv_disc disc;
-  double *y;   /* nodes*n */
+  double *y;    /* nodes*n */
   double *mult; /* nodes*nc multiplier field, then ni integral multipliers */
   double action, gnorm, time;
   int iterations, morse, degenerate;
   double t_assemble, t_factor; /* seconds in assembly / LDL^T (bench/; from 512 unknowns) */
   double adapt_tol, err_est;   /* adaptive refinement (cv_adapt.c) */
   int adapt_max, rounds;
-  int hp;                      /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
-  int continuation, csteps;    /* automatic continuation (cv_continuation.c) */
-  char note[320];              /* what the solver decided on its own, prefixed to msg */
-  cv_progress_fn progress;     /* cv_solver_set_progress; NULL: none */
+  int hp;                   /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
+  int continuation, csteps; /* automatic continuation (cv_continuation.c) */
+  char note[320];           /* what the solver decided on its own, prefixed to msg */
+  cv_progress_fn progress;  /* cv_solver_set_progress; NULL: none */
   void *progress_user;
-  int near_sing[2];            /* ends found nearly singular after a solve */
-  double search_work;          /* cv_solve_all's work limit (cv_deflation.c) */
-  struct cv_pathset *paths;    /* the paths of the last cv_solve_all (cv_deflation.c) */
+  int near_sing[2];         /* ends found nearly singular after a solve */
+  double search_work;       /* cv_solve_all's work limit (cv_deflation.c) */
+  struct cv_pathset *paths; /* the paths of the last cv_solve_all (cv_deflation.c) */
   /* The sparse LDL^T of the Hessian pattern of `disc` (CHOLMOD common, pattern, symbolic
    * analysis) and the y dof of each unknown: made by the first Newton run on the mesh and
    * reused by the next ones on it (retries, continuation steps); dropped with the mesh. */
@@ -292,8 +288,7 @@ void cv_solver_drop_factor(cv_solver *s);
  * allocates the results and fills s->y with the starting values and flags singular ends;
  * cv_start_values fills Y with the given start / guess, or (line = 1) the straight line. */
 cv_status cv_start_setup(cv_solver *s, const cv_problem *p);
-cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y,
-                          int line);
+cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y, int line);
 /* After a solve: is the integrand at end `end` (0 = a, 1 = b) nearly singular, so that
  * the end element's rule under-integrates it (theory Q-3)? *rel: the relative change of
  * the action under the singular-end rule there. */
@@ -308,10 +303,9 @@ cv_status cv_warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from
 /* HP-2, HP-3: the estimate of s's max nodal error from a warm-started solve into f on the
  * enriched mesh (est_vertex: at the element boundaries; floor_out: its round-off part; both
  * may be NULL); with eta, sigma, where (E each, all or none) the indicators of HP-4. */
-cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solver *f,
-                               double *est, double *est_vertex, double *floor_out,
-                               double *eta, double *sigma, double *where,
-                               char *msg, size_t len);
+cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solver *f, double *est,
+                               double *est_vertex, double *floor_out, double *eta, double *sigma,
+                               double *where, char *msg, size_t len);
 /* HP-4, HP-5: the next mesh (on [0, 1], *t with *Enew + 1 entries, *deg with *Enew) from
  * d with the elements cv_hp_marked refined (hp = 0: bisected at their degree); target:
  * the tolerance, for the degree a smooth element is raised to. */
@@ -330,13 +324,11 @@ typedef struct {
 cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *y, double *M,
                         const cv_homotopy *h);
 /* After a failed Newton solve from Y0: continuation in t from Y0 (theory HC-2). */
-cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y,
-                              double *M, const double *Y0);
+cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M,
+                              const double *Y0);
 
 void cv_disc_free(cv_disc *d);
-cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
-                       size_t len);
-void cv_set_msg(char *msg, size_t len, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg, size_t len);
+void cv_set_msg(char *msg, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 
 #endif /* CV_INTERNAL_H */

@@ -41,8 +41,8 @@ static inline long pos(const int *colptr, long r, long c) {
 }
 
 /* Evaluate pointwise constraint kc at nodes j0 .. j0+m-1 into the batch buffers. */
-static cv_status eval_constraint(cv_kkt *k, int kc, const double *Y, long j0, int m,
-                                 unsigned need, double **G, double **Gy, double **Gyy) {
+static cv_status eval_constraint(cv_kkt *k, int kc, const double *Y, long j0, int m, unsigned need,
+                                 double **G, double **Gy, double **Gyy) {
   const cv_disc *d = k->d;
   int n = d->n;
   double *x = k->cbuf, *y = x + CV_BATCH, *g = y + (size_t)n * CV_BATCH;
@@ -70,8 +70,8 @@ cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len) {
     if (cv_disc_lidx(d, node, 0) >= 0) continue; /* has multipliers: imposed by Newton */
     for (int kc = 0; kc < d->nc; kc++) {
       double *G, *Gy, *Gyy;
-      cv_status st = eval_constraint(k, kc, Y, node, 1, CVAR_NEED_F | CVAR_NEED_GRAD, &G, &Gy,
-                                     &Gyy);
+      cv_status st =
+          eval_constraint(k, kc, Y, node, 1, CVAR_NEED_F | CVAR_NEED_GRAD, &G, &Gy, &Gyy);
       /* Scale of G near the end values: |grad G| |y| (or 1), so the test is relative. */
       double sc = 0.0;
       for (int i = 0; i < n && !st; i++) sc += fabs(Gy[i]) * fabs(Y[node * n + i]);
@@ -92,8 +92,8 @@ cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len) {
  * with respect to all unknowns (C-3); *S is S_h alone. The multiplier rows' diagonal gets
  * -delta (quasi-definite regularisation, C-4), also written to dreg (length nfree, zero on
  * the other rows) so that the solve can refine it away. */
-cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, double *G,
-                      double *Ax, double *dreg) {
+cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, double *G, double *Ax,
+                      double *dreg) {
   const cv_disc *d = k->d;
   const cv_problem *p = k->prob;
   const int *cp = k->colptr;
@@ -235,8 +235,8 @@ cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M) {
  * unknown index f of a multiplier row, vals[f] = G_k(x_j, Y_j) or I_r - c_r; when jac is
  * given, row lrow[f] of jac (leading dimension ld) receives the derivatives with respect
  * to the variables, variable var[f'] for the y unknown f' (var[f'] < 0: not a variable). */
-cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, double *jac,
-                                   int ld, const int *lrow, const int *var) {
+cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, double *jac, int ld,
+                                   const int *lrow, const int *var) {
   const cv_disc *d = k->d;
   const cv_problem *p = k->prob;
   int n = d->n, nc = d->nc;
@@ -245,8 +245,8 @@ cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, dou
     double I;
     int row = d->nu0 + r;
     memset(k->gK, 0, (size_t)d->nfree * sizeof *k->gK);
-    st = cv_assemble(&k->as, p->ic[r].K, p->ic[r].user, Y, &I, jac ? k->gK : NULL, k->colptr,
-                     NULL, 0.0, 0);
+    st = cv_assemble(&k->as, p->ic[r].K, p->ic[r].user, Y, &I, jac ? k->gK : NULL, k->colptr, NULL,
+                     0.0, 0);
     vals[row] = I - p->ic[r].c;
     if (jac && !st)
       for (int f = 0; f < d->nu0; f++)

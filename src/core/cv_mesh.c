@@ -91,8 +91,8 @@ cv_status cv_mesh_build(const cv_meshspec *m, double a, double b, int *Eout, dou
   }
   for (int i = 0; i < E; i++) {
     if (!(xe[i + 1] > xe[i])) {
-      cv_set_msg(msg, len, "mesh boundaries must increase strictly (element %d has length %g)",
-                 i, xe[i + 1] - xe[i]);
+      cv_set_msg(msg, len, "mesh boundaries must increase strictly (element %d has length %g)", i,
+                 xe[i + 1] - xe[i]);
       st = CVAR_EINVAL;
       goto cleanup;
     }
@@ -108,8 +108,7 @@ cleanup:
   return CVAR_OK;
 }
 
-void cv_mesh_degrees(const cv_meshspec *m, double a, double b, int E, const double *xe,
-                     int *pe) {
+void cv_mesh_degrees(const cv_meshspec *m, double a, double b, int E, const double *xe, int *pe) {
   int U = m->elements, u = 0;
   for (int e = 0; e < E; e++) {
     double mid = (0.5 * (xe[e] + xe[e + 1]) - a) / (b - a);

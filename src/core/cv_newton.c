@@ -12,17 +12,17 @@
  * 1e-11 leaves three orders of magnitude for that while still catching exact invariances,
  * whose pivots come out at the 1e-14..1e-16 level (theory N-5). */
 #define DEGENERATE_PIVOT 1e-11
-#define MAX_BACKTRACK 40
-#define ARMIJO 1e-4
-#define REFINE_STEPS 2
+#define MAX_BACKTRACK    40
+#define ARMIJO           1e-4
+#define REFINE_STEPS     2
 /* The shifted factorisations of (N-6): a pivot ratio below this is not trusted for the
  * inertia, and the refinement stops after this many sweeps. */
-#define SHIFT_PIVOT 1e-13
+#define SHIFT_PIVOT      1e-13
 #define SHIFT_REFINE_MAX 100
 
 typedef struct {
   const cv_disc *d;
-  int *gof;      /* y dof of each unknown, or -1 - (index into the multipliers) */
+  int *gof;          /* y dof of each unknown, or -1 - (index into the multipliers) */
   const int *colptr; /* the pattern, owned by L */
   cv_ldlt *L;
   double *g, *gt, *delta, *Yt, *Mt, *dreg, *corr;
@@ -116,9 +116,8 @@ static const char *where_failed(cv_status st) {
  * homotopy h (unconstrained problems only) the convex combination of theory (HC-1):
  *   G_t = t g(Y) + (1 - t) w M (Y - Y0),   H_t = t H(Y) + (1 - t) w M,
  * M the lumped weights, whose solution is Y0 at t = 0 and the problem's at t = 1. */
-static cv_status eval_system(cv_kkt *kkt, const cv_homotopy *h, const newton_ws *w,
-                             const double *Y, const double *M, double *S, double *G,
-                             double *Ax, double *dreg) {
+static cv_status eval_system(cv_kkt *kkt, const cv_homotopy *h, const newton_ws *w, const double *Y,
+                             const double *M, double *S, double *G, double *Ax, double *dreg) {
   cv_status st = cv_kkt_eval(kkt, Y, M, S, G, Ax, dreg);
   if (st || !h) return st;
   const cv_disc *d = w->d;
@@ -167,8 +166,7 @@ static void set_shift(newton_ws *w, double *Ax, double tau) {
  * its inertia is that count. L then holds the factor of H + (sigma/4) M, from which
  * solve_step refines the step of H itself. Returns CVAR_OK with *neg, or CVAR_ESINGULAR
  * (the counts differ: H is (nearly) singular, or a shifted pivot is itself tiny). */
-static cv_status factor_shifted(newton_ws *w, double *Ax, int *neg, char *detail,
-                                size_t len) {
+static cv_status factor_shifted(newton_ws *w, double *Ax, int *neg, char *detail, size_t len) {
   const cv_disc *d = w->d;
   int nf = d->nfree, cnt[2] = {-1, -2};
   double lam = 0.0;
@@ -190,8 +188,10 @@ static cv_status factor_shifted(newton_ws *w, double *Ax, int *neg, char *detail
     double dmin, dmax;
     set_shift(w, Ax, k ? -sigma : sigma);
     cv_status st = cv_ldlt_factor(w->L, &cnt[k], &dmin, &dmax, detail, len);
-    if (st == CVAR_ESINGULAR || (st == CVAR_OK && !(dmin > SHIFT_PIVOT))) cnt[k] = -1 - k;
-    else if (st) return st;
+    if (st == CVAR_ESINGULAR || (st == CVAR_OK && !(dmin > SHIFT_PIVOT)))
+      cnt[k] = -1 - k;
+    else if (st)
+      return st;
   }
   cv_status st = CVAR_ESINGULAR;
   if (cnt[0] == cnt[1]) {
@@ -257,8 +257,10 @@ static void apply_step(newton_ws *w, const double *Y, const double *M, double al
   const cv_disc *d = w->d;
   for (int f = 0; f < d->nfree; f++) {
     int gi = w->gof[f];
-    if (gi >= 0) w->Yt[gi] = Y[gi] + alpha * w->delta[f];
-    else w->Mt[-1 - gi] = M[-1 - gi] + alpha * w->delta[f];
+    if (gi >= 0)
+      w->Yt[gi] = Y[gi] + alpha * w->delta[f];
+    else
+      w->Mt[-1 - gi] = M[-1 - gi] + alpha * w->delta[f];
   }
 }
 
@@ -266,8 +268,8 @@ static void apply_step(newton_ws *w, const double *Y, const double *M, double al
  * as the full-step trial point (apply_step with alpha = 1) into w->Yt, w->Mt, the slope
  * g . delta, the merit phi and the reported residual s->gnorm of the current iterate
  * (as in residual()), and the largest |y|. */
-static double step_norm(cv_solver *s, newton_ws *w, const double *Yc, const double *Mc,
-                        double atol, double *slope, double *phi, double *ymax) {
+static double step_norm(cv_solver *s, newton_ws *w, const double *Yc, const double *Mc, double atol,
+                        double *slope, double *phi, double *ymax) {
   const cv_disc *d = w->d;
   double wn = 0.0, sl = 0.0, ym = 0.0, rs = 0.0, rmax = 0.0;
   int ny = 0;
@@ -307,21 +309,22 @@ static cv_status factor_hessian(cv_solver *s, newton_ws *w, double *Ax, int ncon
   if (st == CVAR_ESINGULAR) { /* a singular leading block, or H itself (N-6) */
     int negs = *neg;
     cv_status sst = factor_shifted(w, Ax, &negs, detail, sizeof detail);
-    if (sst == CVAR_OK) st = CVAR_OK, *neg = negs;
-    else if (sst != CVAR_ESINGULAR) st = sst;
+    if (sst == CVAR_OK)
+      st = CVAR_OK, *neg = negs;
+    else if (sst != CVAR_ESINGULAR)
+      st = sst;
   }
   if (st == CVAR_ESINGULAR) {
     s->degenerate = 1;
     s->morse = *neg - ncon;
     cv_set_msg(s->msg, sizeof s->msg,
-               ncon > 0
-                   ? "the Hessian of the Lagrangian is singular (pivot ratio %.1e at "
-                     "iteration %d): the constraints may be dependent or the action flat "
-                     "along them"
-                   : "the Hessian is singular (pivot ratio %.1e at iteration %d): the "
-                     "action is flat along some direction, as for an integrand invariant "
-                     "under reparametrisation such as arc length sqrt(x'^2 + y'^2); use "
-                     "the energy form x'^2 + y'^2 instead",
+               ncon > 0 ? "the Hessian of the Lagrangian is singular (pivot ratio %.1e at "
+                          "iteration %d): the constraints may be dependent or the action flat "
+                          "along them"
+                        : "the Hessian is singular (pivot ratio %.1e at iteration %d): the "
+                          "action is flat along some direction, as for an integrand invariant "
+                          "under reparametrisation such as arc length sqrt(x'^2 + y'^2); use "
+                          "the energy form x'^2 + y'^2 instead",
                dmin, s->iterations);
   } else if (st) {
     cv_set_msg(s->msg, sizeof s->msg, "%s", detail);
@@ -342,9 +345,8 @@ typedef struct {
  * point in w->Yt, w->Mt, w->gt and *t; CVAR_ESTALL when no step was accepted (no message);
  * an error of the integrand with its message. */
 static cv_status line_search(cv_solver *s, cv_kkt *kkt, const cv_homotopy *h, newton_ws *w,
-                             const double *Yc, const double *Mc, double *Ax, double S,
-                             double slope, double phi, double wn, int use_S, int timed,
-                             trial *t) {
+                             const double *Yc, const double *Mc, double *Ax, double S, double slope,
+                             double phi, double wn, int use_S, int timed, trial *t) {
   t->alpha = 1.0, t->St = t->phit = t->rnt = 0.0, t->stale = 0;
   for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
     if (ls > 0) apply_step(w, Yc, Mc, t->alpha);
@@ -377,8 +379,8 @@ static cv_status line_search(cv_solver *s, cv_kkt *kkt, const cv_homotopy *h, ne
 /* Workspace and constraint system of one Newton run from (Y, M): the trial buffers start
  * as copies (their fixed values are then set once), pointwise constraints are checked at
  * the fixed ends and the multipliers initialised (C-5). *ncon: constraint rows. */
-static cv_status run_init(cv_solver *s, const cv_problem *p, cv_disc *d, newton_ws *w,
-                          cv_kkt *kkt, const double *Y, double *M, size_t nmult, int *ncon) {
+static cv_status run_init(cv_solver *s, const cv_problem *p, cv_disc *d, newton_ws *w, cv_kkt *kkt,
+                          const double *Y, double *M, size_t nmult, int *ncon) {
   int nf = d->nfree;
   memset(kkt, 0, sizeof *kkt);
   cv_status st = ws_init(w, s, d, nmult, s->msg, sizeof s->msg);
@@ -412,7 +414,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   int nf = d->nfree, ncon = 0;
   size_t nmult = (size_t)d->nodes * d->nc + d->ni;
   double S = 0.0, scale = 0.0;
-  int stale = 0; /* see the first residual below */
+  int stale = 0;           /* see the first residual below */
   double *Yc = Y, *Mc = M; /* the current iterate (see the swap below) */
 
   s->iterations = 0;
@@ -437,8 +439,10 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   if (timed) s->t_assemble += cv_now() - ta;
   if (st) {
     s->action = NAN;
-    cv_set_msg(s->msg, sizeof s->msg, "%s at the initial guess; give a [guess] inside the "
-               "integrand's domain", where_failed(st));
+    cv_set_msg(s->msg, sizeof s->msg,
+               "%s at the initial guess; give a [guess] inside the "
+               "integrand's domain",
+               where_failed(st));
     goto cleanup;
   }
   s->action = S;
@@ -498,12 +502,21 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     stale = t.stale;
     if (s->progress) {
       /* after the step: the residual is the one of the iterate it started from */
-      cv_progress info = {CVAR_PROGRESS_NEWTON, s->iterations, s->gnorm, wn, alpha, t.St,
-                          s->adapt_tol > 0 ? s->rounds : 0, d->E, NAN};
+      cv_progress info = {CVAR_PROGRESS_NEWTON,
+                          s->iterations,
+                          s->gnorm,
+                          wn,
+                          alpha,
+                          t.St,
+                          s->adapt_tol > 0 ? s->rounds : 0,
+                          d->E,
+                          NAN};
       if (s->progress(&info, s->progress_user) != 0) {
         st = CVAR_ECANCELLED;
-        cv_set_msg(s->msg, sizeof s->msg, "cancelled by the progress callback after iteration "
-                   "%d", s->iterations);
+        cv_set_msg(s->msg, sizeof s->msg,
+                   "cancelled by the progress callback after iteration "
+                   "%d",
+                   s->iterations);
         goto cleanup; /* the iterate the step started from stays the result */
       }
     }

@@ -20,16 +20,16 @@ typedef struct {
   cv_solver *s;
   const cv_disc *d;
   cv_kkt *kkt;
-  double *Y, *g;      /* nodal values (full), gradient over all unknowns */
-  int nv;             /* NLopt variables: the free y unknowns */
-  int *yof, *fof;     /* variable -> y dof, variable -> unknown index */
-  int *rows;          /* constraint row -> unknown index of its multiplier, or nu row */
-  int *lrow, *var;    /* unknown index -> constraint row / NLopt variable, or -1 */
-  int m;              /* number of constraint rows */
+  double *Y, *g;   /* nodal values (full), gradient over all unknowns */
+  int nv;          /* NLopt variables: the free y unknowns */
+  int *yof, *fof;  /* variable -> y dof, variable -> unknown index */
+  int *rows;       /* constraint row -> unknown index of its multiplier, or nu row */
+  int *lrow, *var; /* unknown index -> constraint row / NLopt variable, or -1 */
+  int m;           /* number of constraint rows */
   double scale, action;
-  double smin, ymax;  /* smallest action and largest |y| seen (runaway diagnosis) */
+  double smin, ymax; /* smallest action and largest |y| seen (runaway diagnosis) */
   long evals;
-  cv_status stop;     /* status stored before a forced stop */
+  cv_status stop; /* status stored before a forced stop */
   nlopt_opt opt;
   /* Preconditioned variables (theory NL-1): y = y0 + L^{-T} |D|^{-1/2} z with L D L^T the
    * factor of a model Hessian (stiffness + mass), so the minimisers see an O(1)-conditioned
@@ -65,7 +65,8 @@ static int model_F(int m, const double *x, const double *y, const double *dy, un
   (void)need;
   for (int k = 0; k < m; k++) {
     double s = 0.0;
-    for (int i = 0; i < n; i++) s += dy[i * m + k] * dy[i * m + k] + iL2 * y[i * m + k] * y[i * m + k];
+    for (int i = 0; i < n; i++)
+      s += dy[i * m + k] * dy[i * m + k] + iL2 * y[i * m + k] * y[i * m + k];
     o->F[k] = 0.5 * s;
     for (int i = 0; i < n && o->Fy; i++) {
       o->Fy[i * m + k] = iL2 * y[i * m + k];
@@ -114,8 +115,8 @@ static double objective(unsigned n, const double *x, double *grad, void *data) {
 }
 
 /* Constraint rows: G_k(x_j, Y_j) at the nodes with multipliers, then I_r - c_r. */
-static void eq_constraints(unsigned m, double *result, unsigned n, const double *x,
-                           double *grad, void *data) {
+static void eq_constraints(unsigned m, double *result, unsigned n, const double *x, double *grad,
+                           void *data) {
   nl_ctx *c = data;
   (void)n;
   load(c, x);
@@ -135,7 +136,6 @@ static void eq_constraints(unsigned m, double *result, unsigned n, const double 
     to_z(c, c->w, row);
   }
 }
-
 
 static nlopt_algorithm algorithm(cv_method m) {
   switch (m) {
@@ -260,8 +260,7 @@ static cv_status result_status(const nl_ctx *c, cv_solver *s, nlopt_result r, do
                cv_method_name(s->method));
   } else if (r == NLOPT_FORCED_STOP) {
     st = c->stop ? c->stop : CVAR_EDEPENDENCY;
-    cv_set_msg(s->msg, sizeof s->msg, "%s stopped: %s", cv_method_name(s->method),
-               cv_strerror(st));
+    cv_set_msg(s->msg, sizeof s->msg, "%s stopped: %s", cv_method_name(s->method), cv_strerror(st));
   } else if (r == NLOPT_ROUNDOFF_LIMITED || r == NLOPT_FAILURE) {
     /* L-BFGS reports a failed line search as a generic failure; near the minimum that is
      * round-off. Accepted by the caller only if the residual fell by 1e4 (NL-2). */
@@ -394,8 +393,7 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
   if (!isfinite(s->gnorm) && st == CVAR_OK) {
     st = CVAR_ENONFINITE;
     cv_set_msg(s->msg, sizeof s->msg, "the integrand is not finite at the point reached");
-  } else if (st == CVAR_OK && !(s->gnorm <= (roundoff ? 1e-4 : 1e-2) * g0) &&
-             s->gnorm > 1e-12) {
+  } else if (st == CVAR_OK && !(s->gnorm <= (roundoff ? 1e-4 : 1e-2) * g0) && s->gnorm > 1e-12) {
     st = CVAR_ESTALL;
     cv_set_msg(s->msg, sizeof s->msg,
                "%s stopped short of a stationary point (scaled residual %.3g, %.3g at the "

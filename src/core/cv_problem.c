@@ -86,8 +86,7 @@ cv_status cv_problem_set_integrand(cv_problem *p, cv_integrand_fn F, void *user)
 }
 
 cv_status cv_problem_set_end_value(cv_problem *p, int k, int end, double value) {
-  if (!p || k < 0 || k >= p->n || (end != 0 && end != 1) || !isfinite(value))
-    return CVAR_EINVAL;
+  if (!p || k < 0 || k >= p->n || (end != 0 && end != 1) || !isfinite(value)) return CVAR_EINVAL;
   p->fixed[2 * k + end] = 1;
   p->endval[2 * k + end] = value;
   return CVAR_OK;
@@ -185,8 +184,7 @@ cv_status cv_problem_add_note(cv_problem *p, cv_note_fn fn, void *user) {
 }
 
 cv_status cv_problem_add_table(cv_problem *p, const char *name, cv_table *t) {
-  if (!p || !name || !t || !(isalpha((unsigned char)name[0]) || name[0] == '_'))
-    return CVAR_EINVAL;
+  if (!p || !name || !t || !(isalpha((unsigned char)name[0]) || name[0] == '_')) return CVAR_EINVAL;
   for (const char *q = name; *q; q++)
     if (!(isalnum((unsigned char)*q) || *q == '_')) return CVAR_EINVAL;
   for (int k = 0; k < p->ntables; k++)

@@ -7,8 +7,8 @@
 
 #include "cv_internal.h"
 
-cv_status cv_problem_eval_energy(const cv_problem *p, int m, const double *x,
-                                 const double *y, const double *dy, double *H, double *P) {
+cv_status cv_problem_eval_energy(const cv_problem *p, int m, const double *x, const double *y,
+                                 const double *dy, double *H, double *P) {
   if (!p || !p->F || m < 0 || (m > 0 && (!x || !y || !dy))) return CVAR_EINVAL;
   if (m == 0) return CVAR_OK;
   int n = p->n, mb = m < CV_BATCH ? m : CV_BATCH;

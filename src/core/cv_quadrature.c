@@ -68,8 +68,10 @@ static void gauss_lobatto_compute(int p, double *xi, double *w) {
   }
   for (int j = 0; j <= p; j++) {
     double P, dP;
-    if (j == 0 || j == p) P = (j == 0 && (p % 2)) ? -1.0 : 1.0;
-    else legendre(p, xi[j], &P, &dP);
+    if (j == 0 || j == p)
+      P = (j == 0 && (p % 2)) ? -1.0 : 1.0;
+    else
+      legendre(p, xi[j], &P, &dP);
     w[j] = 2.0 / (p * (p + 1.0) * P * P);
   }
 }
@@ -196,6 +198,6 @@ cv_rule cv_end_rule(int p, int qs, int end) {
     }
     pthread_mutex_unlock(&rule_lock);
   }
-  return (cv_rule){qs, end_cache[end][p][qs].tau, end_cache[end][p][qs].om,
-                   end_cache[end][p][qs].B, end_cache[end][p][qs].D};
+  return (cv_rule){qs, end_cache[end][p][qs].tau, end_cache[end][p][qs].om, end_cache[end][p][qs].B,
+                   end_cache[end][p][qs].D};
 }

@@ -47,11 +47,17 @@ static cv_status grade_singular_ends(cv_solver *s, const cv_problem *p) {
   if (st) return st;
   if (s->near_sing[0] || s->near_sing[1]) /* set by cv_solve_mesh, which says why */
     cv_set_msg(s->note, sizeof s->note, "the mesh was graded towards %s (k = %g); ",
-               both ? "both ends" : at_a ? "the start" : "the end", k);
+               both   ? "both ends"
+               : at_a ? "the start"
+                      : "the end",
+               k);
   else
     cv_set_msg(s->note, sizeof s->note,
                "the integrand is singular at %s, so the mesh was graded towards %s (k = %g); ",
-               both ? "both ends" : at_a ? "the start" : "the end", both ? "them" : "it", k);
+               both   ? "both ends"
+               : at_a ? "the start"
+                      : "the end",
+               both ? "them" : "it", k);
   return CVAR_OK;
 }
 
@@ -73,7 +79,8 @@ static cv_status retry_straight_line(cv_solver *s, const cv_problem *p, cv_statu
       size_t ln = strlen(s->note);
       cv_set_msg(s->note + ln, sizeof s->note - ln,
                  "from the given start Newton failed after %d iterations (%s), from the "
-                 "straight line it converged; ", it, cv_strerror(first));
+                 "straight line it converged; ",
+                 it, cv_strerror(first));
       cv_free(Yfail);
       st = CVAR_OK;
     } else {
@@ -96,8 +103,10 @@ static cv_status continue_from_start(cv_solver *s, const cv_problem *p, cv_statu
   char keep[sizeof s->msg];
   memcpy(keep, s->msg, sizeof keep);
   cv_status st0 = Y0 ? cv_start_values(s, p, &s->disc, Y0, 0) : CVAR_ENOMEM;
-  if (!st0) st = cv_continuation_run(s, p, &s->disc, s->y, s->mult, Y0);
-  else memcpy(s->msg, keep, sizeof keep); /* report Newton's failure */
+  if (!st0)
+    st = cv_continuation_run(s, p, &s->disc, s->y, s->mult, Y0);
+  else
+    memcpy(s->msg, keep, sizeof keep); /* report Newton's failure */
   cv_free(Y0);
   return st;
 }
@@ -165,8 +174,8 @@ static int twice_agrees(const cv_solver *s, const cv_problem *p, double *dev) {
   t->degree = s->degree, t->nq = s->nq, t->maxit = s->maxit;
   t->rtol = s->rtol, t->atol = s->atol, t->continuation = s->continuation;
   t->mesh.elements = 2 * s->mesh.elements;
-  if (t->mesh.elements > 0 && cv_solver_set_breakpoints(t, s->mesh.nbreak, s->mesh.breaks) ==
-                                  CVAR_OK) {
+  if (t->mesh.elements > 0 &&
+      cv_solver_set_breakpoints(t, s->mesh.nbreak, s->mesh.breaks) == CVAR_OK) {
     t->near_sing[0] = t->near_sing[1] = 1;
     if (solve_once(t, p) == CVAR_OK) {
       *dev = fabs(t->action - s->action) / fmax(fabs(s->action), DBL_MIN);
@@ -190,8 +199,8 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
    * (HC-3; the Poincare half-plane geodesic between (+-1, 0.01) rises from its ends at
    * slope 100, which the uniform mesh does not resolve). */
   if ((st == CVAR_ESTALL || st == CVAR_EDIVERGED || st == CVAR_EMAXITER) &&
-      s->method == CVAR_METHOD_NEWTON && s->mesh.kind == CV_MESH_UNIFORM && !s->start &&
-      s->have && !s->disc.sing_a && !s->disc.sing_b && s->maxit >= 20) {
+      s->method == CVAR_METHOD_NEWTON && s->mesh.kind == CV_MESH_UNIFORM && !s->start && s->have &&
+      !s->disc.sing_a && !s->disc.sing_b && s->maxit >= 20) {
     char first[sizeof s->msg];
     memcpy(first, s->msg, sizeof first);
     s->near_sing[0] = s->near_sing[1] = 1;
@@ -215,7 +224,8 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
       memcpy(keep, s->note, sizeof keep);
       cv_set_msg(s->note, sizeof s->note,
                  "on the uniform mesh Newton and continuation failed (%s), so both ends were "
-                 "integrated as singular; %s", cv_strerror(st), keep);
+                 "integrated as singular; %s",
+                 cv_strerror(st), keep);
       st = CVAR_OK;
     } else {
       /* both attempts failed: say what was tried, with the first attempt's detail */
@@ -224,7 +234,8 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
       s->note[0] = '\0';
       cv_set_msg(s->msg, sizeof s->msg,
                  "%s; with the mesh graded towards both ends and both integrated as singular: "
-                 "%s", first, second);
+                 "%s",
+                 first, second);
       st = st2;
     }
   }
@@ -238,7 +249,9 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
     cv_set_msg(s->note, sizeof s->note,
                "the integrand is nearly singular at %s (the singular-end rule changed the "
                "action by %.1e of itself there), so it is integrated as singular; %s",
-               un[0] && un[1] ? "both ends" : un[0] ? "the start" : "the end",
+               un[0] && un[1] ? "both ends"
+               : un[0]        ? "the start"
+                              : "the end",
                fmax(rel[0], rel[1]), first);
     s->near_sing[0] = s->near_sing[1] = 0;
   }

@@ -99,8 +99,7 @@ cv_status cv_solver_set_mesh(cv_solver *s, int elements, const double *t) {
   return CVAR_OK;
 }
 
-cv_status cv_solver_set_mesh_hp(cv_solver *s, int elements, const double *t,
-                                const int *degrees) {
+cv_status cv_solver_set_mesh_hp(cv_solver *s, int elements, const double *t, const int *degrees) {
   if (!s || elements < 1 || !degrees) return CVAR_EINVAL;
   int pmax = 1;
   for (int e = 0; e < elements; e++) {
@@ -147,7 +146,7 @@ cv_status cv_solver_set_tolerances(cv_solver *s, double rtol, double atol) {
 }
 
 static const char *const method_names[] = {"newton", "lbfgs", "tnewton", "mma",
-                                            "ccsaq",  "slsqp", "auglag"};
+                                           "ccsaq",  "slsqp", "auglag"};
 #define NUM_METHODS (int)(sizeof method_names / sizeof method_names[0])
 
 const char *cv_method_name(cv_method m) {
@@ -199,9 +198,7 @@ cv_status cv_solver_set_start(cv_solver *s, int len, const double *y) {
 }
 
 cv_status cv_solver_get_status(const cv_solver *s) { return s ? s->status : CVAR_EINVAL; }
-const char *cv_solver_last_error(const cv_solver *s) {
-  return s ? s->msg : "solver is NULL";
-}
+const char *cv_solver_last_error(const cv_solver *s) { return s ? s->msg : "solver is NULL"; }
 int cv_solver_get_num_nodes(const cv_solver *s) { return s && s->have ? s->disc.nodes : 0; }
 int cv_solver_get_num_elements(const cv_solver *s) { return s && s->have ? s->disc.E : 0; }
 int cv_solver_get_degree(const cv_solver *s) { return s && s->have ? s->disc.p : 0; }
@@ -244,8 +241,8 @@ int cv_solver_get_num_qpoints(const cv_solver *s) {
 }
 
 /* The solution and its derivative on element e at reference coordinate t (E-3). */
-static void eval_local(const cv_solver *s, long e, const double *phi,
-                       const double *dphi, double *yv, double *dv) {
+static void eval_local(const cv_solver *s, long e, const double *phi, const double *dphi,
+                       double *yv, double *dv) {
   const cv_disc *d = &s->disc;
   int n = d->n, P1 = cv_disc_edeg(d, e) + 1;
   double rh = 2.0 / (d->xe[e + 1] - d->xe[e]);
@@ -261,8 +258,7 @@ static void eval_local(const cv_solver *s, long e, const double *phi,
   }
 }
 
-cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double *y,
-                                double *dy) {
+cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double *y, double *dy) {
   if (!s) return CVAR_EINVAL;
   if (!s->have) return CVAR_ESTATE;
   const cv_disc *d = &s->disc;
@@ -312,8 +308,10 @@ cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y, 
     long lo = 0, hi = d->E; /* find e with xe[e] <= x < xe[e+1] */
     while (hi - lo > 1) {
       long mid = (lo + hi) / 2;
-      if (d->xe[mid] <= x[k]) lo = mid;
-      else hi = mid;
+      if (d->xe[mid] <= x[k])
+        lo = mid;
+      else
+        hi = mid;
     }
     double h = d->xe[lo + 1] - d->xe[lo], t = 2.0 * (x[k] - d->xe[lo]) / h - 1.0;
     cv_lagrange(cv_disc_edeg(d, lo), cv_disc_eref(d, lo)->xi, t, phi, dphi);

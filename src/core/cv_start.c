@@ -27,8 +27,8 @@ cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, d
   if (s->start && !line) {
     if (s->start_len != d->ndof) {
       cv_set_msg(s->msg, sizeof s->msg,
-                 "start vector has %d values but the mesh has %d nodes x %d unknowns",
-                 s->start_len, d->nodes, n);
+                 "start vector has %d values but the mesh has %d nodes x %d unknowns", s->start_len,
+                 d->nodes, n);
       return CVAR_EINVAL;
     }
     memcpy(Y, s->start, (size_t)d->ndof * sizeof *Y);
@@ -47,8 +47,7 @@ cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, d
       if (rc) {
         cv_free(yb);
         cv_set_msg(s->msg, sizeof s->msg,
-                   "the initial guess is not finite (or its callback failed) near x = %g",
-                   xb[0]);
+                   "the initial guess is not finite (or its callback failed) near x = %g", xb[0]);
         return CVAR_ECALLBACK;
       }
     }
@@ -114,8 +113,10 @@ static void detect_singular_ends(const cv_problem *p, cv_disc *d, const double *
     int rc = p->F(1, &x, buf, buf + n, CVAR_NEED_F, &o, p->user);
     /* infinite (or "cannot evaluate here"), not NaN: a NaN end is undefined, not singular */
     int singular = rc > 0 || (rc == 0 && isinf(o.F[0]));
-    if (end) d->sing_b = singular;
-    else d->sing_a = singular;
+    if (end)
+      d->sing_b = singular;
+    else
+      d->sing_a = singular;
   }
   cv_free(buf);
 }
@@ -204,8 +205,8 @@ static double rule_gap(const cv_problem *p, const cv_disc *d, const double *Y, l
     }
     r1 = (cv_rule){qs, tau, om, B, D};
   }
-  int ok = element_integral(p, d, Y, e, &r0, buf, &S0) &&
-           element_integral(p, d, Y, e, &r1, buf, &S1);
+  int ok =
+      element_integral(p, d, Y, e, &r0, buf, &S0) && element_integral(p, d, Y, e, &r1, buf, &S1);
   *own = ok ? fabs(S0) : 0.0;
   return ok ? fabs(S1 - S0) : INFINITY;
 }

@@ -5,7 +5,7 @@
 
 #include "cv_internal.h"
 
-#define MSG_ITEM(name, msg) msg,
+#define MSG_ITEM(name, msg)  msg,
 #define NAME_ITEM(name, msg) #name,
 static const char *const messages[] = {CVAR_STATUS_LIST(MSG_ITEM)};
 static const char *const names[] = {CVAR_STATUS_LIST(NAME_ITEM)};

@@ -18,10 +18,10 @@ typedef struct {
   const char *var;
   int n;
   char **unk;
-  int np;          /* parameters usable now */
+  int np; /* parameters usable now */
   char **pname;
   double *pval;
-  int const_only;  /* parsing a parameter: only numbers, pi and earlier parameters */
+  int const_only; /* parsing a parameter: only numbers, pi and earlier parameters */
 } names;
 
 static void msg(char *err, size_t errlen, const char *fmt, ...) {
@@ -58,8 +58,10 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
     return -1;
   }
   if (c->const_only) {
-    msg(err, errlen, "'%s' is not a constant (a parameter may use numbers, pi and earlier "
-        "parameters)", name);
+    msg(err, errlen,
+        "'%s' is not a constant (a parameter may use numbers, pi and earlier "
+        "parameters)",
+        name);
     return -1;
   }
   ex_id e = ex_slot(d, slot);
@@ -84,9 +86,9 @@ static const char *const formula_what[] = {"integrand", "constraint", "integral"
 /* Parse F (with its variable, unknowns and parameters) and hand the compiled formula to
  * the problem as the integrand, a pointwise constraint (no y' allowed) or an integral
  * constraint int K = c. */
-static cv_status compile(cv_problem *p, const char *variable, const char *unknowns,
-                         const char *F, const char *parameters, formula_kind kind, double c_rhs,
-                         int *index, char *err, size_t errlen) {
+static cv_status compile(cv_problem *p, const char *variable, const char *unknowns, const char *F,
+                         const char *parameters, formula_kind kind, double c_rhs, int *index,
+                         char *err, size_t errlen) {
   const char *what = formula_what[kind];
   if (err && errlen) err[0] = 0;
   if (!p || !unknowns || !F) {
@@ -193,16 +195,16 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
   if (kind == FORMULA_CONSTRAINT)
     for (int i = 0; i < c.n; i++)
       if (ex_depends_on(d, f, 1 + c.n + i)) {
-        msg(err, errlen, "constraint: a pointwise constraint G(%s, y) may not involve %s'",
-            c.var, c.unk[i]);
+        msg(err, errlen, "constraint: a pointwise constraint G(%s, y) may not involve %s'", c.var,
+            c.unk[i]);
         goto cleanup;
       }
   if (kind == FORMULA_INTEGRAL && !isfinite(c_rhs)) {
     msg(err, errlen, "integral: the constant is not a finite number");
     goto cleanup;
   }
-  ex_integrand *g = ex_integrand_new(d, c.n, f, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS,
-                                     perr, sizeof perr);
+  ex_integrand *g =
+      ex_integrand_new(d, c.n, f, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, perr, sizeof perr);
   if (!g) {
     msg(err, errlen, "%s: %s", what, perr);
     st = CVAR_ENOMEM;
@@ -212,11 +214,10 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
   if (kind == FORMULA_INTEGRAND)
     st = cv_problem_set_integrand_owned(p, ex_integrand_eval, g, ex_integrand_release);
   else if (kind == FORMULA_CONSTRAINT)
-    st = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g,
-                                         ex_integrand_release, index);
+    st = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g, ex_integrand_release,
+                                         index);
   else
-    st = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release, c_rhs,
-                                       index);
+    st = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release, c_rhs, index);
   /* names the table whose grid a failing solve left (g lives as long as the problem) */
   if (st == CVAR_OK && ex_integrand_has_tables(g))
     st = cv_problem_add_note(p, ex_integrand_note, g);
@@ -234,25 +235,20 @@ cleanup:
   return st;
 }
 
-cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
-                                        const char *unknowns, const char *F,
-                                        const char *parameters, char *err, size_t errlen) {
-  return compile(p, variable, unknowns, F, parameters, FORMULA_INTEGRAND, 0.0, NULL, err,
-                 errlen);
+cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable, const char *unknowns,
+                                        const char *F, const char *parameters, char *err,
+                                        size_t errlen) {
+  return compile(p, variable, unknowns, F, parameters, FORMULA_INTEGRAND, 0.0, NULL, err, errlen);
 }
 
-cv_status cv_problem_add_constraint_expr(cv_problem *p, const char *variable,
-                                         const char *unknowns, const char *G,
-                                         const char *parameters, int *index, char *err,
-                                         size_t errlen) {
-  return compile(p, variable, unknowns, G, parameters, FORMULA_CONSTRAINT, 0.0, index, err,
-                 errlen);
+cv_status cv_problem_add_constraint_expr(cv_problem *p, const char *variable, const char *unknowns,
+                                         const char *G, const char *parameters, int *index,
+                                         char *err, size_t errlen) {
+  return compile(p, variable, unknowns, G, parameters, FORMULA_CONSTRAINT, 0.0, index, err, errlen);
 }
 
-cv_status cv_problem_add_integral_expr(cv_problem *p, const char *variable,
-                                       const char *unknowns, const char *K, double c,
-                                       const char *parameters, int *index, char *err,
-                                       size_t errlen) {
-  return compile(p, variable, unknowns, K, parameters, FORMULA_INTEGRAL, c, index, err,
-                 errlen);
+cv_status cv_problem_add_integral_expr(cv_problem *p, const char *variable, const char *unknowns,
+                                       const char *K, double c, const char *parameters, int *index,
+                                       char *err, size_t errlen) {
+  return compile(p, variable, unknowns, K, parameters, FORMULA_INTEGRAL, c, index, err, errlen);
 }

@@ -70,7 +70,7 @@ ex_id ex_unary(ex_dag *d, ex_op op, ex_id a) {
   if (bad_const(d, a)) return ex_intern(d, op, a, -1, -1, 0.0); /* IEEE: no rule */
   switch (op) {
   case EX_NEG:
-    if (is_op(d, a, EX_NEG)) return arg(d, a);                          /* -(-x) = x */
+    if (is_op(d, a, EX_NEG)) return arg(d, a);                                      /* -(-x) = x */
     if (is_op(d, a, EX_SUB)) return ex_binary(d, EX_SUB, d->nodes[a].b, arg(d, a)); /* -(p-q) */
     /* -((p-q)/r) = (q-p)/r and -(c*(p-q)) = c*(q-p): the sign goes into a difference
      * rather than staying outside, the same form "-(p - q)/r" parses to. */
@@ -82,7 +82,8 @@ ex_id ex_unary(ex_dag *d, ex_op op, ex_id a) {
   case EX_ABS:
     if (is_op(d, a, EX_NEG) || is_op(d, a, EX_ABS)) return ex_unary(d, EX_ABS, arg(d, a));
     break;
-  case EX_COS: case EX_COSH: /* even functions */
+  case EX_COS:
+  case EX_COSH: /* even functions */
     if (is_op(d, a, EX_NEG)) return ex_unary(d, op, arg(d, a));
     break;
   default: break;
@@ -181,14 +182,17 @@ ex_id ex_binary(ex_dag *d, ex_op op, ex_id a, ex_id b) {
     if (is_val(d, b, 1)) return a;
     if (is_val(d, b, 0) || is_val(d, a, 1)) return ex_num(d, 1.0);
     break;
-  case EX_MIN: case EX_MAX:
+  case EX_MIN:
+  case EX_MAX:
     /* Operands keep their written order: on a tie the first is the branch taken. */
     if (a == b) return a;
     break;
-  case EX_LT: case EX_GT:
+  case EX_LT:
+  case EX_GT:
     if (a == b) return ex_num(d, 0.0);
     break;
-  case EX_LE: case EX_GE:
+  case EX_LE:
+  case EX_GE:
     if (a == b) return ex_num(d, 1.0);
     break;
   default: break;

@@ -108,8 +108,10 @@ static int mul_mono(poly *P, const mono *a, const mono *b) {
   int i = 0, j = 0, n = 0;
   if (!f) return -1;
   while (i < a->nf || j < b->nf) {
-    if (j >= b->nf || (i < a->nf && a->f[i].base < b->f[j].base)) f[n++] = a->f[i++];
-    else if (i >= a->nf || b->f[j].base < a->f[i].base) f[n++] = b->f[j++];
+    if (j >= b->nf || (i < a->nf && a->f[i].base < b->f[j].base))
+      f[n++] = a->f[i++];
+    else if (i >= a->nf || b->f[j].base < a->f[i].base)
+      f[n++] = b->f[j++];
     else {
       double p = a->f[i].p + b->f[j].p;
       if (p != 0) f[n++] = (factor){a->f[i].base, p};

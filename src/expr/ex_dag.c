@@ -168,10 +168,22 @@ ex_id ex_nonfinite_const(const ex_dag *d, ex_id e) {
 
 int ex_op_arity(ex_op op) {
   switch (op) {
-  case EX_NUM: case EX_SLOT: return 0;
-  case EX_ADD: case EX_SUB: case EX_MUL: case EX_DIV: case EX_POW: case EX_ATAN2:
-  case EX_MIN: case EX_MAX: case EX_LT: case EX_LE: case EX_GT: case EX_GE: return 2;
-  case EX_IF: case EX_TABLE: return 3; /* a table call: 1 to 3 (absent ones are -1) */
+  case EX_NUM:
+  case EX_SLOT: return 0;
+  case EX_ADD:
+  case EX_SUB:
+  case EX_MUL:
+  case EX_DIV:
+  case EX_POW:
+  case EX_ATAN2:
+  case EX_MIN:
+  case EX_MAX:
+  case EX_LT:
+  case EX_LE:
+  case EX_GT:
+  case EX_GE: return 2;
+  case EX_IF:
+  case EX_TABLE: return 3; /* a table call: 1 to 3 (absent ones are -1) */
   default: return 1;
   }
 }

@@ -4,15 +4,15 @@
 
 #include "expr/ex_internal.h"
 
-#define NUM(v) ex_num(d, (v))
+#define NUM(v)    ex_num(d, (v))
 #define ADD(p, q) ex_binary(d, EX_ADD, (p), (q))
 #define SUB(p, q) ex_binary(d, EX_SUB, (p), (q))
 #define MUL(p, q) ex_binary(d, EX_MUL, (p), (q))
 #define DIV(p, q) ex_binary(d, EX_DIV, (p), (q))
 #define POW(p, q) ex_binary(d, EX_POW, (p), (q))
-#define NEG(p) ex_unary(d, EX_NEG, (p))
+#define NEG(p)    ex_unary(d, EX_NEG, (p))
 #define FN(op, p) ex_unary(d, (op), (p))
-#define SQ(p) POW((p), NUM(2.0))
+#define SQ(p)     POW((p), NUM(2.0))
 
 /* d(node id)/d slot given the derivatives da, db, dc of its operands (X-2). The derivative of
  * a node reuses the node itself where the rule allows (exp, sqrt, tan, tanh, a^b, a/b), so
@@ -47,13 +47,15 @@ static ex_id rule(ex_dag *d, ex_id id, ex_node nd, int slot, ex_id da, ex_id db,
   case EX_EXP: return MUL(id, da);
   case EX_LOG: return DIV(da, a);
   case EX_SQRT: return DIV(da, MUL(NUM(2.0), id));
-  case EX_ABS:
-    return MUL(ex_if(d, ex_binary(d, EX_LT, a, NUM(0.0)), NUM(-1.0), NUM(1.0)), da);
+  case EX_ABS: return MUL(ex_if(d, ex_binary(d, EX_LT, a, NUM(0.0)), NUM(-1.0), NUM(1.0)), da);
   case EX_ATAN2: /* atan2(a, b) = angle of (b, a): (b a' - a b') / (a^2 + b^2) */
     return DIV(SUB(MUL(b, da), MUL(a, db)), ADD(SQ(a), SQ(b)));
   case EX_MIN: return ex_if(d, ex_binary(d, EX_LE, a, b), da, db);
   case EX_MAX: return ex_if(d, ex_binary(d, EX_GE, a, b), da, db);
-  case EX_LT: case EX_LE: case EX_GT: case EX_GE: return NUM(0.0);
+  case EX_LT:
+  case EX_LE:
+  case EX_GT:
+  case EX_GE: return NUM(0.0);
   case EX_IF: return ex_if(d, a, db, dc);
   case EX_TABLE: {
     ex_id dargs[3] = {da, db, dc};

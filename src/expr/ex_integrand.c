@@ -8,19 +8,19 @@
 
 struct ex_integrand {
   int n;
-  int np;           /* parameters: tape slots 2n+1 .. 2n+np */
-  int owns_tapes;   /* 0 for a clone (ex_integrand_clone) */
-  double *pbuf;     /* np batches, each filled with one parameter's value */
+  int np;              /* parameters: tape slots 2n+1 .. 2n+np */
+  int owns_tapes;      /* 0 for a clone (ex_integrand_clone) */
+  double *pbuf;        /* np batches, each filled with one parameter's value */
   unsigned char *used; /* used[j]: the expression reads parameter j (shared by clones) */
   unsigned max_need;
   ex_tape *tape[3]; /* level 0: F; 1: F, Fy, Fp; 2: also Fyy (upper), Fyp, Fpp (upper) */
   int nout[3];
   int depends_on_dy; /* F reads some y'_i: not usable as a constraint G(x, y) */
-  double *work;     /* registers of the largest tape, one batch */
-  double *scratch;  /* one batch per output, for groups the caller did not ask for */
+  double *work;      /* registers of the largest tape, one batch */
+  double *scratch;   /* one batch per output, for groups the caller did not ask for */
   const double **in;
   double **outp;
-  char note[320];   /* why the last failing evaluation failed (a table's grid left) */
+  char note[320]; /* why the last failing evaluation failed (a table's grid left) */
 };
 
 static void set_err(char *err, size_t errlen, const char *msg) {
@@ -173,9 +173,9 @@ static double *dest(ex_integrand *g, double *buf, size_t offset, int o) {
 }
 
 /* Evaluate the smallest tape covering `need` into the given buffers (NULL: not wanted). */
-static int eval_into(ex_integrand *g, int m, const double *x, const double *y,
-                     const double *dy, unsigned need, double *F, double *Fy, double *Fp,
-                     double *Fyy, double *Fyp, double *Fpp) {
+static int eval_into(ex_integrand *g, int m, const double *x, const double *y, const double *dy,
+                     unsigned need, double *F, double *Fy, double *Fp, double *Fyy, double *Fyp,
+                     double *Fpp) {
   int level = need & CVAR_NEED_HESS ? 2 : need & CVAR_NEED_GRAD ? 1 : 0;
   if (!g->tape[level]) return -1;
   int n = g->n;
@@ -187,8 +187,7 @@ static int eval_into(ex_integrand *g, int m, const double *x, const double *y,
       g->in[1 + i] = y + i * M + k0;
       g->in[1 + n + i] = dy ? dy + i * M + k0 : NULL; /* NULL: a constraint G(x, y) */
     }
-    for (int j = 0; j < g->np; j++)
-      g->in[1 + 2 * n + j] = g->pbuf + (size_t)j * EX_INTEGRAND_BATCH;
+    for (int j = 0; j < g->np; j++) g->in[1 + 2 * n + j] = g->pbuf + (size_t)j * EX_INTEGRAND_BATCH;
     g->outp[0] = dest(g, F, (size_t)k0, 0);
     if (level >= 1) {
       for (int i = 0; i < n; i++) {
@@ -219,18 +218,18 @@ static int eval_into(ex_integrand *g, int m, const double *x, const double *y,
   return 0;
 }
 
-int ex_integrand_eval(int m, const double *x, const double *y, const double *dy,
-                      unsigned need, cv_partials *out, void *user) {
+int ex_integrand_eval(int m, const double *x, const double *y, const double *dy, unsigned need,
+                      cv_partials *out, void *user) {
   ex_integrand *g = user;
   if (!g || !out || m < 1) return -1;
   int grad = (need & CVAR_NEED_GRAD) != 0, hess = (need & CVAR_NEED_HESS) != 0;
-  return eval_into(g, m, x, y, dy, need, need & CVAR_NEED_F ? out->F : NULL,
-                   grad ? out->Fy : NULL, grad ? out->Fp : NULL, hess ? out->Fyy : NULL,
-                   hess ? out->Fyp : NULL, hess ? out->Fpp : NULL);
+  return eval_into(g, m, x, y, dy, need, need & CVAR_NEED_F ? out->F : NULL, grad ? out->Fy : NULL,
+                   grad ? out->Fp : NULL, hess ? out->Fyy : NULL, hess ? out->Fyp : NULL,
+                   hess ? out->Fpp : NULL);
 }
 
-int ex_integrand_eval_constraint(int m, const double *x, const double *y, unsigned need,
-                                 double *G, double *Gy, double *Gyy, void *user) {
+int ex_integrand_eval_constraint(int m, const double *x, const double *y, unsigned need, double *G,
+                                 double *Gy, double *Gyy, void *user) {
   ex_integrand *g = user;
   if (!g || m < 1 || g->depends_on_dy) return -1;
   return eval_into(g, m, x, y, NULL, need, need & CVAR_NEED_F ? G : NULL,

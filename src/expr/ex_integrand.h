@@ -47,14 +47,14 @@ void ex_integrand_set_params(ex_integrand *g, const double *p);
  * written as computed; the core checks finiteness. Returns 0, or -1 when `need` asks for
  * a group beyond max_need (a programming error) or m < 1. Not re-entrant on one object
  * (it owns its work buffer), as calcvar.h promises for callbacks. */
-int ex_integrand_eval(int m, const double *x, const double *y, const double *dy,
-                      unsigned need, cv_partials *out, void *user);
+int ex_integrand_eval(int m, const double *x, const double *y, const double *dy, unsigned need,
+                      cv_partials *out, void *user);
 
 /* A cv_constraint_fn (calcvar.h) for a pointwise constraint G(x, y): the same object,
  * with G = F, Gy = F_y, Gyy = F_yy. Returns -1 when the expression depends on some y'
  * (the caller should have refused it), when `need` exceeds max_need, or when m < 1. */
-int ex_integrand_eval_constraint(int m, const double *x, const double *y, unsigned need,
-                                 double *G, double *Gy, double *Gyy, void *user);
+int ex_integrand_eval_constraint(int m, const double *x, const double *y, unsigned need, double *G,
+                                 double *Gy, double *Gyy, void *user);
 
 /* Number of unknowns n, and the max_need it was built with. */
 int ex_integrand_num_unknowns(const ex_integrand *g);

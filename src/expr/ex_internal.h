@@ -65,7 +65,7 @@ int ex_table_apply(const ex_dag *d, const ex_node *nd, const double *u, double *
 /* d(call)/d slot = sum_k call_{+e_k} * dargs[k] (TB-5). */
 ex_id ex_table_diff(ex_dag *d, const ex_node *nd, const ex_id *dargs);
 /* Encoding of a call in the node's v: index*64 + 16*o0 + 4*o1 + o2. */
-#define EX_TABLE_CODE(index, o0, o1, o2) ((double)((index) * 64 + (o0) * 16 + (o1) * 4 + (o2)))
+#define EX_TABLE_CODE(index, o0, o1, o2) ((double)((index)*64 + (o0)*16 + (o1)*4 + (o2)))
 void ex_table_decode(double v, int *index, int ord[3]);
 /* Free the registry (ex_dag_free). */
 void ex_dag_free_tables(ex_dag *d);

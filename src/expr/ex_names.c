@@ -10,13 +10,12 @@
  * error messages name operations from it, and a name in it cannot be a parameter or an
  * unknown. */
 static const ex_function functions[] = {
-    {"sin", EX_SIN, 1},     {"cos", EX_COS, 1},     {"tan", EX_TAN, 1},
-    {"asin", EX_ASIN, 1},   {"acos", EX_ACOS, 1},   {"atan", EX_ATAN, 1},
-    {"sinh", EX_SINH, 1},   {"cosh", EX_COSH, 1},   {"tanh", EX_TANH, 1},
-    {"asinh", EX_ASINH, 1}, {"acosh", EX_ACOSH, 1}, {"atanh", EX_ATANH, 1},
-    {"exp", EX_EXP, 1},     {"log", EX_LOG, 1},     {"sqrt", EX_SQRT, 1},
-    {"abs", EX_ABS, 1},     {"atan2", EX_ATAN2, 2}, {"pow", EX_POW, 2},
-    {"min", EX_MIN, 2},     {"max", EX_MAX, 2},     {"if", EX_IF, 3}};
+    {"sin", EX_SIN, 1},     {"cos", EX_COS, 1},     {"tan", EX_TAN, 1},     {"asin", EX_ASIN, 1},
+    {"acos", EX_ACOS, 1},   {"atan", EX_ATAN, 1},   {"sinh", EX_SINH, 1},   {"cosh", EX_COSH, 1},
+    {"tanh", EX_TANH, 1},   {"asinh", EX_ASINH, 1}, {"acosh", EX_ACOSH, 1}, {"atanh", EX_ATANH, 1},
+    {"exp", EX_EXP, 1},     {"log", EX_LOG, 1},     {"sqrt", EX_SQRT, 1},   {"abs", EX_ABS, 1},
+    {"atan2", EX_ATAN2, 2}, {"pow", EX_POW, 2},     {"min", EX_MIN, 2},     {"max", EX_MAX, 2},
+    {"if", EX_IF, 3}};
 #define NUM_FUNCTIONS (sizeof functions / sizeof functions[0])
 
 const ex_function *ex_function_find(const char *name) {
@@ -54,8 +53,10 @@ int ex_list_split(const char *value, ex_list *list) {
   const char *start = value;
   memset(list, 0, sizeof *list);
   for (const char *p = value;; p++) {
-    if (*p == '(') depth++;
-    else if (*p == ')' && depth > 0) depth--;
+    if (*p == '(')
+      depth++;
+    else if (*p == ')' && depth > 0)
+      depth--;
     if (*p == '\0' || (*p == ',' && depth == 0)) {
       const char *a = start, *b = p;
       while (a < b && isspace((unsigned char)*a)) a++;

@@ -21,7 +21,7 @@
 /* Nesting bound: each level costs a handful of small stack frames, so 200 levels is far
  * below any stack limit, and far above what a readable formula uses. */
 #define MAX_DEPTH 200
-#define MAX_NAME 128
+#define MAX_NAME  128
 
 typedef struct {
   ex_dag *d;
@@ -52,9 +52,7 @@ static ex_id fail(parser *p, size_t at, const char *fmt, ...) {
 }
 
 /* A node from a constructor: -1 there means memory ran out. */
-static ex_id built(parser *p, ex_id e) {
-  return e >= 0 ? e : fail(p, p->pos, "out of memory");
-}
+static ex_id built(parser *p, ex_id e) { return e >= 0 ? e : fail(p, p->pos, "out of memory"); }
 
 static void skip_ws(parser *p) {
   while (p->s[p->pos] && isspace((unsigned char)p->s[p->pos])) p->pos++;
@@ -67,8 +65,10 @@ static int is_name_char(int c) { return isalnum(c) || c == '_'; }
 static const char *found(parser *p, char *buf, size_t len) {
   unsigned char c = (unsigned char)p->s[p->pos];
   if (!c) return "the end of the expression";
-  if (isprint(c)) snprintf(buf, len, "'%c'", c);
-  else snprintf(buf, len, "byte 0x%02x", c);
+  if (isprint(c))
+    snprintf(buf, len, "'%c'", c);
+  else
+    snprintf(buf, len, "byte 0x%02x", c);
   return buf;
 }
 
@@ -112,9 +112,12 @@ static ex_id parse_cond(parser *p) {
   const char *s = p->s + p->pos;
   ex_op op;
   size_t len = 1;
-  if (s[0] == '<') op = s[1] == '=' ? (len = 2, EX_LE) : EX_LT;
-  else if (s[0] == '>') op = s[1] == '=' ? (len = 2, EX_GE) : EX_GT;
-  else return a;
+  if (s[0] == '<')
+    op = s[1] == '=' ? (len = 2, EX_LE) : EX_LT;
+  else if (s[0] == '>')
+    op = s[1] == '=' ? (len = 2, EX_GE) : EX_GT;
+  else
+    return a;
   p->pos += len;
   ex_id b = parse_sum(p);
   if (b < 0) return -1;
@@ -153,8 +156,7 @@ static ex_id parse_call(parser *p, const ex_function *f, size_t at) {
   ex_id args[3];
   int n = parse_args(p, f->name, f->op == EX_IF, args);
   if (n == -2)
-    return fail(p, at, "'%s' takes %d argument%s", f->name, f->nargs,
-                f->nargs == 1 ? "" : "s");
+    return fail(p, at, "'%s' takes %d argument%s", f->name, f->nargs, f->nargs == 1 ? "" : "s");
   if (n < 0) return -1;
   if (n != f->nargs)
     return fail(p, at, "'%s' takes %d argument%s, not %d", f->name, f->nargs,
@@ -176,25 +178,27 @@ static ex_id parse_table_call(parser *p, int index, const char *name, size_t at)
     while (isdigit((unsigned char)p->s[p->pos])) {
       int k = p->s[p->pos] - '1';
       if (k < 0 || k >= dim)
-        return fail(p, p->pos, "'%s' has %d coordinate%s: a derivative index is 1%s", name,
-                    dim, dim == 1 ? "" : "s", dim == 1 ? "" : dim == 2 ? " or 2" : ", 2 or 3");
+        return fail(p, p->pos, "'%s' has %d coordinate%s: a derivative index is 1%s", name, dim,
+                    dim == 1 ? "" : "s",
+                    dim == 1   ? ""
+                    : dim == 2 ? " or 2"
+                               : ", 2 or 3");
       ord[k]++;
       p->pos++;
     }
     if (p->pos == k0 || p->pos - k0 > 6)
-      return fail(p, k0, "after '%s.' write the coordinates to differentiate by (e.g. %s.1)",
-                  name, name);
+      return fail(p, k0, "after '%s.' write the coordinates to differentiate by (e.g. %s.1)", name,
+                  name);
     skip_ws(p);
-    if (p->s[p->pos] != '(')
-      return fail(p, at, "'%s' is a table: write %s(...)", name, name);
+    if (p->s[p->pos] != '(') return fail(p, at, "'%s' is a table: write %s(...)", name, name);
   }
   ex_id args[3];
   int n = parse_args(p, name, 0, args);
   if (n == -2) n = 3; /* a fourth argument begins: refused below */
   if (n < 0) return -1;
   if (n != dim || (n == 3 && p->s[p->pos - 1] != ')'))
-    return fail(p, at, "table '%s' has %d coordinate%s, so it takes %d argument%s%s", name,
-                dim, dim == 1 ? "" : "s", dim, dim == 1 ? "" : "s",
+    return fail(p, at, "table '%s' has %d coordinate%s, so it takes %d argument%s%s", name, dim,
+                dim == 1 ? "" : "s", dim, dim == 1 ? "" : "s",
                 n == 3 && p->s[p->pos - 1] != ')' ? ", not more" : "");
   ex_id e = built(p, ex_table_call(p->d, index, ord, args));
   /* a call at numbers folds inside the grid (ex_table_call), so one that stays a call at
@@ -204,9 +208,10 @@ static ex_id parse_table_call(parser *p, int index, const char *name, size_t at)
       double lo, hi, v = ex_node_value(p->d, args[k]);
       cv_table_get_range(t, k, &lo, &hi);
       if (ex_node_op(p->d, args[k]) == EX_NUM && !(v >= lo && v <= hi))
-        return fail(p, at, "table '%s' is called outside its grid: argument %d is %.15g, "
-                    "the grid spans [%.15g, %.15g] (tables are not extrapolated)", name,
-                    k + 1, v, lo, hi);
+        return fail(p, at,
+                    "table '%s' is called outside its grid: argument %d is %.15g, "
+                    "the grid spans [%.15g, %.15g] (tables are not extrapolated)",
+                    name, k + 1, v, lo, hi);
     }
   }
   return e;
@@ -227,15 +232,14 @@ static ex_id parse_name(parser *p) {
   int table = f ? -1 : ex_dag_find_table(p->d, name);
   if (table >= 0 && !primes && (p->s[p->pos] == '(' || (p->s[p->pos] == '.' && p->pos == i)))
     return parse_table_call(p, table, name, at);
-  if (table >= 0)
-    return fail(p, at, "'%s' is a table: write %s(...)", name, name);
+  if (table >= 0) return fail(p, at, "'%s' is a table: write %s(...)", name, name);
   if (p->s[p->pos] == '(' && !primes) {
     if (!f) return fail(p, at, "unknown function '%s'", name);
     return parse_call(p, f, at);
   }
   if (primes > 2 || (primes == 2 && !p->allow_second))
-    return fail(p, at, "%s%.*s: only the first derivative %s' may be written here", name,
-                primes, "''''''''''''''''", name);
+    return fail(p, at, "%s%.*s: only the first derivative %s' may be written here", name, primes,
+                "''''''''''''''''", name);
   if (strcmp(name, "pi") == 0) {
     if (primes) return fail(p, at + 2, "a prime is only allowed on an unknown, not on 'pi'");
     return built(p, ex_num(p->d, EX_PI));
@@ -333,8 +337,8 @@ static ex_id parse_term(parser *p) { return parse_level(p, parse_unary, '*', EX_
 
 static ex_id parse_sum(parser *p) { return parse_level(p, parse_term, '+', EX_ADD, '-', EX_SUB); }
 
-ex_id ex_parse(ex_dag *d, const char *src, ex_resolve_fn resolve, void *user,
-               int allow_second, char *err, size_t errlen) {
+ex_id ex_parse(ex_dag *d, const char *src, ex_resolve_fn resolve, void *user, int allow_second,
+               char *err, size_t errlen) {
   parser p = {d, src ? src : "", 0, resolve, user, allow_second, err, errlen, 0, 0};
   if (err && errlen) err[0] = 0;
   if (!d) return fail(&p, 0, "no expression DAG");

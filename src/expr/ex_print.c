@@ -41,8 +41,10 @@ static int prec(const ex_dag *d, ex_id e) {
   const ex_node *nd = &d->nodes[e];
   switch (nd->op) {
   case EX_NUM: return nd->v < 0 ? P_NEG : P_ATOM;
-  case EX_ADD: case EX_SUB: return P_SUM;
-  case EX_MUL: case EX_DIV: return P_PROD;
+  case EX_ADD:
+  case EX_SUB: return P_SUM;
+  case EX_MUL:
+  case EX_DIV: return P_PROD;
   case EX_NEG: return P_NEG;
   case EX_POW: return P_POW;
   default: return P_ATOM;
@@ -61,9 +63,8 @@ static int is_negative(const ex_dag *d, ex_id e) {
 static int plain_factor(const ex_dag *d, ex_id e) {
   const ex_node *nd = &d->nodes[e];
   if (nd->op == EX_POW) nd = &d->nodes[nd->a];
-  return nd->op == EX_SLOT || (nd->op >= EX_SIN && nd->op <= EX_ABS) ||
-         nd->op == EX_ATAN2 || nd->op == EX_MIN || nd->op == EX_MAX || nd->op == EX_IF ||
-         nd->op == EX_TABLE;
+  return nd->op == EX_SLOT || (nd->op >= EX_SIN && nd->op <= EX_ABS) || nd->op == EX_ATAN2 ||
+         nd->op == EX_MIN || nd->op == EX_MAX || nd->op == EX_IF || nd->op == EX_TABLE;
 }
 
 static void put(printer *o, const char *s, size_t n) {
@@ -119,14 +120,16 @@ static void emit(printer *o, ex_id e) {
       puts_(o, tmp);
     }
     break;
-  case EX_ADD: case EX_SUB:
+  case EX_ADD:
+  case EX_SUB:
     child(o, nd->a, 0);
     puts_(o, nd->op == EX_ADD ? " + " : " - ");
     /* a + (b - c) keeps its parentheses: the text then parses back to this very node
      * (floating-point addition is not associative). */
     child(o, nd->b, is_negative(d, nd->b) || prec(d, nd->b) <= P_SUM);
     break;
-  case EX_MUL: case EX_DIV: {
+  case EX_MUL:
+  case EX_DIV: {
     int pb = prec(d, nd->b) <= P_PROD || is_negative(d, nd->b);
     /* c*(x*y) prints as c*x*y: the constructor re-associates (c*x)*y to c*(x*y), so the
      * text still parses back to this node. */
@@ -147,7 +150,10 @@ static void emit(printer *o, ex_id e) {
     put(o, "^", 1);
     child(o, nd->b, prec(d, nd->b) < P_POW || is_negative(d, nd->b));
     break;
-  case EX_LT: case EX_LE: case EX_GT: case EX_GE: /* a comparison used as a number */
+  case EX_LT:
+  case EX_LE:
+  case EX_GT:
+  case EX_GE: /* a comparison used as a number */
     puts_(o, "if(");
     comparison(o, nd);
     puts_(o, ", 1, 0)");
@@ -155,8 +161,10 @@ static void emit(printer *o, ex_id e) {
   case EX_IF: {
     puts_(o, "if(");
     const ex_node *c = &d->nodes[nd->a];
-    if (c->op >= EX_LT && c->op <= EX_GE) comparison(o, c);
-    else child(o, nd->a, 0);
+    if (c->op >= EX_LT && c->op <= EX_GE)
+      comparison(o, c);
+    else
+      child(o, nd->a, 0);
     puts_(o, ", ");
     child(o, nd->b, 0);
     puts_(o, ", ");

@@ -21,8 +21,8 @@ ex_id ex_subst(ex_dag *d, ex_id e, int slot, ex_id by) {
     } else if (nd.op == EX_SLOT) {
       map[id] = nd.a == slot ? by : id;
     } else {
-      map[id] = ex_remake(d, &nd, map[nd.a], nd.b >= 0 ? map[nd.b] : -1,
-                          nd.c >= 0 ? map[nd.c] : -1);
+      map[id] =
+          ex_remake(d, &nd, map[nd.a], nd.b >= 0 ? map[nd.b] : -1, nd.c >= 0 ? map[nd.c] : -1);
       if (map[id] < 0) goto cleanup;
     }
   }

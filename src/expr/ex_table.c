@@ -10,8 +10,7 @@
 #include "expr/ex_internal.h"
 
 int ex_dag_add_table(ex_dag *d, const char *name, struct cv_table *t) {
-  if (!d || !name || !t || ex_dag_find_table(d, name) >= 0 || strcmp(name, "pi") == 0)
-    return -1;
+  if (!d || !name || !t || ex_dag_find_table(d, name) >= 0 || strcmp(name, "pi") == 0) return -1;
   if (!(name[0] == '_' || (name[0] >= 'a' && name[0] <= 'z') || (name[0] >= 'A' && name[0] <= 'Z')))
     return -1;
   for (int op = 0; op < EX_NUM_OPS; op++) {

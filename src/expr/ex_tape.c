@@ -20,11 +20,39 @@
 
 /* Tape operations. Suffix V = vector operand, K = the instruction's scalar constant. */
 typedef enum {
-  T_FILL, T_COPY,
-  T_ADD_VV, T_ADD_KV, T_SUB_VV, T_SUB_KV, T_SUB_VK, T_MUL_VV, T_MUL_KV,
-  T_DIV_VV, T_DIV_KV, T_DIV_VK, T_NEG,
-  T_POW_VV, T_POW_KV, T_POW_VK, T_SQR, T_CUBE, T_POW4, T_RECIP, T_RECIP2, T_SQRT, T_RSQRT,
-  T_ABS, T_FN1, T_ATAN2, T_MIN, T_MAX, T_LT, T_LE, T_GT, T_GE, T_IF,
+  T_FILL,
+  T_COPY,
+  T_ADD_VV,
+  T_ADD_KV,
+  T_SUB_VV,
+  T_SUB_KV,
+  T_SUB_VK,
+  T_MUL_VV,
+  T_MUL_KV,
+  T_DIV_VV,
+  T_DIV_KV,
+  T_DIV_VK,
+  T_NEG,
+  T_POW_VV,
+  T_POW_KV,
+  T_POW_VK,
+  T_SQR,
+  T_CUBE,
+  T_POW4,
+  T_RECIP,
+  T_RECIP2,
+  T_SQRT,
+  T_RSQRT,
+  T_ABS,
+  T_FN1,
+  T_ATAN2,
+  T_MIN,
+  T_MAX,
+  T_LT,
+  T_LE,
+  T_GT,
+  T_GE,
+  T_IF,
   T_TABLE /* a table's spline or partial at 1..3 operands (ex_table.c, theory TB-2) */
 } tape_op;
 
@@ -39,7 +67,7 @@ typedef struct {
   double (*fn)(double); /* T_FN1: the libm function */
   double k;             /* scalar operand (K variants, T_FILL) */
   loc dst, a, b, c;
-  int tab, multi;       /* T_TABLE: index in the tape's tables and in its call groups */
+  int tab, multi; /* T_TABLE: index in the tape's tables and in its call groups */
 } instr;
 
 /* One T_TABLE instruction computes every partial the tape needs of one table at the same
@@ -55,7 +83,7 @@ typedef struct {
 struct ex_tape {
   int nslots, nout, nins, nregs;
   instr *ins;
-  int ntab;             /* tables the tape calls, each with a reference, and their names */
+  int ntab; /* tables the tape calls, each with a reference, and their names */
   cv_table **tab;
   char **tabname;
   int ngroup;
@@ -89,12 +117,12 @@ static double (*unary_fn(ex_op op))(double) {
 
 /* Per-node compile state. */
 typedef struct {
-  unsigned char live;   /* reachable from an output through non-constant nodes */
-  unsigned char konst;  /* constant: its value is cval */
-  unsigned char needv;  /* needs a vector location (computed or filled) */
-  unsigned char fused;  /* a table call computed by an earlier call's instruction */
+  unsigned char live;  /* reachable from an output through non-constant nodes */
+  unsigned char konst; /* constant: its value is cval */
+  unsigned char needv; /* needs a vector location (computed or filled) */
+  unsigned char fused; /* a table call computed by an earlier call's instruction */
   double cval;
-  int last;             /* id of the last node reading it as a vector operand */
+  int last; /* id of the last node reading it as a vector operand */
   loc home;
 } cnode;
 
@@ -105,8 +133,7 @@ static int k_capable(ex_op op) {
 
 /* Reachability from the outputs; constant subtrees are not entered (they become scalars,
  * their values computed here). Returns -1 if a slot is out of range or a constant fails. */
-static int mark_live(const ex_dag *d, cnode *cn, int nn, int nslots, int nout,
-                     const ex_id *outs) {
+static int mark_live(const ex_dag *d, cnode *cn, int nn, int nslots, int nout, const ex_id *outs) {
   for (int o = 0; o < nout; o++) cn[outs[o]].live = 1;
   for (int id = nn - 1; id >= 0; id--) {
     if (!cn[id].live) continue;
@@ -172,8 +199,8 @@ static void release_operands(regpool *rp, const cnode *cn, const ex_node *nd, in
 
 /* T_TABLE for table call id: the tape's reference to the table, and one call group with
  * the later calls of the same table at the same arguments. Returns -1 on failure. */
-static int select_table(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id,
-                        regpool *rp, instr *in) {
+static int select_table(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id, regpool *rp,
+                        instr *in) {
   const ex_node *nd = &d->nodes[id];
   int index, ord[3];
   ex_table_decode(nd->v, &index, ord);
@@ -208,8 +235,8 @@ static int select_table(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id,
    * destinations are allocated now (after the operands', so never aliasing them) */
   for (int j = id + 1; j < nn && gr->n < EX_TABLE_FUSE; j++) {
     const ex_node *nj = &d->nodes[j];
-    if (!cn[j].live || cn[j].konst || nj->op != EX_TABLE || nj->a != nd->a ||
-        nj->b != nd->b || nj->c != nd->c)
+    if (!cn[j].live || cn[j].konst || nj->op != EX_TABLE || nj->a != nd->a || nj->b != nd->b ||
+        nj->c != nd->c)
       continue;
     int jindex, jord[3];
     ex_table_decode(nj->v, &jindex, jord);
@@ -226,8 +253,8 @@ static int select_table(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id,
 /* The instruction computing non-constant node id from its operands' homes: the variant
  * taking a constant operand as the scalar k where there is one. Returns -1 for an
  * operation the tape cannot run (or a table call that fails). */
-static int select_instr(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id,
-                        regpool *rp, instr *in) {
+static int select_instr(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id, regpool *rp,
+                        instr *in) {
   const ex_node *nd = &d->nodes[id];
   ex_id a = nd->a, b = nd->b;
   int kc = k_capable(nd->op);
@@ -236,11 +263,13 @@ static int select_instr(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id,
   if (b >= 0) in->b = cn[b].home;
   if (nd->c >= 0) in->c = cn[nd->c].home;
   switch (nd->op) {
-  case EX_ADD: case EX_MUL: /* commutative: the constant goes to k */
-    in->op = nd->op == EX_ADD ? (ka || kb ? T_ADD_KV : T_ADD_VV)
-                              : (ka || kb ? T_MUL_KV : T_MUL_VV);
-    if (ka) in->k = cn[a].cval, in->a = in->b;
-    else if (kb) in->k = cn[b].cval;
+  case EX_ADD:
+  case EX_MUL: /* commutative: the constant goes to k */
+    in->op = nd->op == EX_ADD ? (ka || kb ? T_ADD_KV : T_ADD_VV) : (ka || kb ? T_MUL_KV : T_MUL_VV);
+    if (ka)
+      in->k = cn[a].cval, in->a = in->b;
+    else if (kb)
+      in->k = cn[b].cval;
     if (ka || kb) in->b = in->a;
     break;
   case EX_SUB:
@@ -262,8 +291,14 @@ static int select_instr(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id,
       /* Small integer and half-integer exponents by multiplication and sqrt: exact
        * or within an ulp of pow(), and several times faster. */
       double e = cn[b].cval;
-      in->op = e == 2 ? T_SQR : e == 3 ? T_CUBE : e == 4 ? T_POW4 : e == -1 ? T_RECIP
-             : e == -2 ? T_RECIP2 : e == 0.5 ? T_SQRT : e == -0.5 ? T_RSQRT : T_POW_VK;
+      in->op = e == 2      ? T_SQR
+               : e == 3    ? T_CUBE
+               : e == 4    ? T_POW4
+               : e == -1   ? T_RECIP
+               : e == -2   ? T_RECIP2
+               : e == 0.5  ? T_SQRT
+               : e == -0.5 ? T_RSQRT
+                           : T_POW_VK;
       in->k = e;
     } else {
       in->op = T_POW_VV;
@@ -399,7 +434,8 @@ int ex_tape_num_instructions(const ex_tape *t) { return t ? t->nins : 0; }
 
 /* The kernels. restrict is sound: a destination is never an operand (see the register
  * allocation) and callers' inputs, outputs and work do not overlap (expr.h). */
-#define LOOP(body) for (int k = 0; k < m; k++) D[k] = (body)
+#define LOOP(body)                                                                                 \
+  for (int k = 0; k < m; k++) D[k] = (body)
 typedef double *restrict dptr;
 typedef const double *restrict cptr;
 
@@ -424,13 +460,20 @@ static void run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
   case T_POW_VK: LOOP(pow(A[k], K)); break;
   case T_SQR: LOOP(A[k] * A[k]); break;
   case T_CUBE: LOOP(A[k] * A[k] * A[k]); break;
-  case T_POW4: for (int k = 0; k < m; k++) { double s = A[k] * A[k]; D[k] = s * s; } break;
+  case T_POW4:
+    for (int k = 0; k < m; k++) {
+      double s = A[k] * A[k];
+      D[k] = s * s;
+    }
+    break;
   case T_RECIP: LOOP(1.0 / A[k]); break;
   case T_RECIP2: LOOP(1.0 / (A[k] * A[k])); break;
   case T_SQRT: LOOP(sqrt(A[k])); break;
   case T_RSQRT: LOOP(1.0 / sqrt(A[k])); break;
   case T_ABS: LOOP(fabs(A[k])); break;
-  case T_FN1: for (int k = 0; k < m; k++) D[k] = in->fn(A[k]); break;
+  case T_FN1:
+    for (int k = 0; k < m; k++) D[k] = in->fn(A[k]);
+    break;
   case T_ATAN2: LOOP(atan2(A[k], B[k])); break;
   case T_MIN: LOOP((A[k] <= B[k] || A[k] != A[k]) ? A[k] : B[k]); break; /* = ex_apply */
   case T_MAX: LOOP((A[k] >= B[k] || A[k] != A[k]) ? A[k] : B[k]); break;
@@ -443,8 +486,7 @@ static void run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
   }
 }
 
-static double *where(loc l, int m, const double *const *in, double *const *out,
-                     double *work);
+static double *where(loc l, int m, const double *const *in, double *const *out, double *work);
 
 /* T_TABLE over the m points: every partial of its group at once; a point outside the grid
  * gives NaN and, the first time in this evaluation, a fault record (EX_TAPE_FAULT). */
@@ -467,8 +509,7 @@ static void run_table(const ex_tape *t, const instr *in, int m, const double *co
   }
 }
 
-static double *where(loc l, int m, const double *const *in, double *const *out,
-                     double *work) {
+static double *where(loc l, int m, const double *const *in, double *const *out, double *work) {
   switch (l.space) {
   case L_NONE: return NULL; /* operand absent */
   case L_REG: return work + (size_t)l.idx * (size_t)m;
@@ -488,8 +529,10 @@ void ex_tape_eval(const ex_tape *t, int m, const double *const *in, double *cons
     const double *A = where(p->a, m, in, out, work);
     const double *B = where(p->b, m, in, out, work);
     const double *C = where(p->c, m, in, out, work);
-    if (p->op == T_TABLE) run_table(t, p, m, in, out, work, A, B, C, fault);
-    else run(p, m, D, A, B, C);
+    if (p->op == T_TABLE)
+      run_table(t, p, m, in, out, work, A, B, C, fault);
+    else
+      run(p, m, D, A, B, C);
   }
 }
 
@@ -504,8 +547,16 @@ int ex_tape_fault(const ex_tape *t, int m, const double *work, char *msg, size_t
   double lo = 0, hi = 0;
   cv_table_get_range(t->tab[j], k, &lo, &hi);
   if (msg && len)
-    snprintf(msg, len, "the path left the grid of table '%s': its %s argument was %.15g, "
-             "outside [%.10g, %.10g] (tables are not extrapolated)", t->tabname[j],
-             axis[k < 0 ? 0 : k > 2 ? 2 : k], fault[2 + (k < 0 ? 0 : k > 2 ? 2 : k)], lo, hi);
+    snprintf(msg, len,
+             "the path left the grid of table '%s': its %s argument was %.15g, "
+             "outside [%.10g, %.10g] (tables are not extrapolated)",
+             t->tabname[j],
+             axis[k < 0   ? 0
+                  : k > 2 ? 2
+                          : k],
+             fault[2 + (k < 0   ? 0
+                        : k > 2 ? 2
+                                : k)],
+             lo, hi);
   return 1;
 }

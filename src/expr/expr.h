@@ -19,14 +19,39 @@ typedef struct ex_dag ex_dag;
 typedef int ex_id; /* node index; negative means failure */
 
 typedef enum {
-  EX_NUM, EX_SLOT,
-  EX_ADD, EX_SUB, EX_MUL, EX_DIV, EX_NEG, EX_POW,
-  EX_SIN, EX_COS, EX_TAN, EX_ASIN, EX_ACOS, EX_ATAN, EX_SINH, EX_COSH, EX_TANH,
-  EX_ASINH, EX_ACOSH, EX_ATANH, EX_EXP, EX_LOG, EX_SQRT, EX_ABS,
-  EX_ATAN2, EX_MIN, EX_MAX,
-  EX_LT, EX_LE, EX_GT, EX_GE, /* comparisons: value 1.0 or 0.0 */
-  EX_IF,                      /* if(c, a, b): a where c != 0, else b */
-  EX_TABLE,                   /* a table's spline (or a partial of it) at 1..3 arguments */
+  EX_NUM,
+  EX_SLOT,
+  EX_ADD,
+  EX_SUB,
+  EX_MUL,
+  EX_DIV,
+  EX_NEG,
+  EX_POW,
+  EX_SIN,
+  EX_COS,
+  EX_TAN,
+  EX_ASIN,
+  EX_ACOS,
+  EX_ATAN,
+  EX_SINH,
+  EX_COSH,
+  EX_TANH,
+  EX_ASINH,
+  EX_ACOSH,
+  EX_ATANH,
+  EX_EXP,
+  EX_LOG,
+  EX_SQRT,
+  EX_ABS,
+  EX_ATAN2,
+  EX_MIN,
+  EX_MAX,
+  EX_LT,
+  EX_LE,
+  EX_GT,
+  EX_GE,    /* comparisons: value 1.0 or 0.0 */
+  EX_IF,    /* if(c, a, b): a where c != 0, else b */
+  EX_TABLE, /* a table's spline (or a partial of it) at 1..3 arguments */
   EX_NUM_OPS
 } ex_op;
 
@@ -36,15 +61,15 @@ void ex_dag_free(ex_dag *d);
 /* Constructors (simplifying, hash-consing). Return a node id, or -1 on allocation failure. */
 ex_id ex_num(ex_dag *d, double v);
 ex_id ex_slot(ex_dag *d, int slot);
-ex_id ex_unary(ex_dag *d, ex_op op, ex_id a);            /* EX_NEG, EX_SIN..EX_ABS */
-ex_id ex_binary(ex_dag *d, ex_op op, ex_id a, ex_id b);  /* ADD..POW, ATAN2, MIN, MAX, LT..GE */
+ex_id ex_unary(ex_dag *d, ex_op op, ex_id a);           /* EX_NEG, EX_SIN..EX_ABS */
+ex_id ex_binary(ex_dag *d, ex_op op, ex_id a, ex_id b); /* ADD..POW, ATAN2, MIN, MAX, LT..GE */
 ex_id ex_if(ex_dag *d, ex_id c, ex_id a, ex_id b);
 
 /* Inspection. */
 ex_op ex_node_op(const ex_dag *d, ex_id e);
-double ex_node_value(const ex_dag *d, ex_id e);      /* EX_NUM only */
-int ex_node_slot(const ex_dag *d, ex_id e);          /* EX_SLOT only */
-int ex_is_const(const ex_dag *d, ex_id e);           /* depends on no slot */
+double ex_node_value(const ex_dag *d, ex_id e); /* EX_NUM only */
+int ex_node_slot(const ex_dag *d, ex_id e);     /* EX_SLOT only */
+int ex_is_const(const ex_dag *d, ex_id e);      /* depends on no slot */
 int ex_depends_on(const ex_dag *d, ex_id e, int slot);
 /* Value of a constant expression; returns 0 on success, -1 if it depends on a slot. */
 int ex_eval_const(const ex_dag *d, ex_id e, double *value);
@@ -73,16 +98,16 @@ void ex_list_free(ex_list *list);
 /* Name resolution during parsing. `primes` is 0 for `name`, 1 for `name'` (2 for `name''`
  * only when the parse was started with allow_second = 1). Return a node id, or -1 with a
  * message in err (e.g. "unknown name 'q'", "a prime is only allowed on an unknown"). */
-typedef ex_id (*ex_resolve_fn)(ex_dag *d, const char *name, int primes, void *user,
-                               char *err, size_t errlen);
+typedef ex_id (*ex_resolve_fn)(ex_dag *d, const char *name, int primes, void *user, char *err,
+                               size_t errlen);
 
 /* Parse src (grammar of SCENES.md "Expressions"): numbers, pi, names (via resolve),
  * + - * / unary -, ^ (right-assoc., tighter than unary minus), parentheses, the functions
  * of SCENES.md, if(cond, a, b) with < <= > >= in cond. Returns a node id, or -1 with
  * err = "column C: what is wrong" (1-based column). Nesting depth is bounded (no stack
  * overflow on hostile input): too deep gives an error, not a crash. */
-ex_id ex_parse(ex_dag *d, const char *src, ex_resolve_fn resolve, void *user,
-               int allow_second, char *err, size_t errlen);
+ex_id ex_parse(ex_dag *d, const char *src, ex_resolve_fn resolve, void *user, int allow_second,
+               char *err, size_t errlen);
 
 /* Symbolic derivative d e / d slot. At kinks (abs, min, max, if) the derivative of the
  * branch taken. Comparisons have derivative 0. Returns -1 on allocation failure. */

@@ -21,8 +21,8 @@
 /** A Lagrangian problem: F(x, y, y') and its constraints as nodes of one DAG, with slots
  * 0 = the variable x, 1..n = y_i, n+1..2n = y'_i. */
 typedef struct {
-  ex_dag *dag;                   /* derivatives are added to it */
-  int n;                         /* unknowns */
+  ex_dag *dag; /* derivatives are added to it */
+  int n;       /* unknowns */
   ex_id F;
   int ncons;                     /* pointwise constraints G_c(x, y) = 0 */
   const ex_id *cons;             /* [ncons] */
@@ -71,8 +71,7 @@ typedef struct {
  * d/dx G = G_x + sum_j G_{y_j} y'_j + sum_j G_{y'_j} y''_j, and negated if the
  * coefficient of y_i'' comes out a negative number, so a mechanical equation reads
  * "m l^2 th'' + ... = 0". Returns CVAR_OK, or CVAR_ENOMEM with err set. */
-cv_status mech_equations_new(const mech_problem *mp, mech_equations *eq, char *err,
-                             size_t errlen);
+cv_status mech_equations_new(const mech_problem *mp, mech_equations *eq, char *err, size_t errlen);
 void mech_equations_free(mech_equations *eq);
 
 /* ---- Small oscillations (mech_modes.c) ------------------------------------------------ */
@@ -86,18 +85,18 @@ typedef enum {
 /** Equilibrium and normal modes. Arrays are owned (mech_modes_free). */
 typedef struct {
   int n;
-  int nc;              /* pointwise constraints G_c(y) = 0 (P-13) */
-  int nmodes;          /* n - nc: modes on the constraints' tangent space */
-  double *equilibrium; /* [n] */
-  double *multipliers; /* [nc]: lambda_c of L + lambda.G at the equilibrium */
-  double residual;     /* max |dL/dy_i| at the equilibrium */
-  int iterations;      /* Newton iterations for the equilibrium */
-  double *omega2;      /* [nmodes], increasing */
+  int nc;               /* pointwise constraints G_c(y) = 0 (P-13) */
+  int nmodes;           /* n - nc: modes on the constraints' tangent space */
+  double *equilibrium;  /* [n] */
+  double *multipliers;  /* [nc]: lambda_c of L + lambda.G at the equilibrium */
+  double residual;      /* max |dL/dy_i| at the equilibrium */
+  int iterations;       /* Newton iterations for the equilibrium */
+  double *omega2;       /* [nmodes], increasing */
   mech_mode_kind *kind; /* [nmodes] */
-  double *shape;       /* [nmodes*n]: mode k is shape[k*n .. k*n + n-1], v^T M v = 1 */
-  double *mass;        /* [n*n] M, row-major (symmetric) */
-  double *stiffness;   /* [n*n] K = -d2(L + lambda.G)/dy dy, row-major (symmetric) */
-  double gyroscopic;   /* max |G_ij| of G = C - C^T, C_ij = d2L/dy'_i dy_j; the modes of
+  double *shape;        /* [nmodes*n]: mode k is shape[k*n .. k*n + n-1], v^T M v = 1 */
+  double *mass;         /* [n*n] M, row-major (symmetric) */
+  double *stiffness;    /* [n*n] K = -d2(L + lambda.G)/dy dy, row-major (symmetric) */
+  double gyroscopic;    /* max |G_ij| of G = C - C^T, C_ij = d2L/dy'_i dy_j; the modes of
                           K v = w2 M v ignore G (docs/theory.md (P-10)) */
   /* With G != 0, the motions of M y'' + G y' + K y = 0 (P-12): one entry per frequency,
    * ngyro <= n of them, stable (omega > 0, growth 0), unstable (growth > 0, omega >= 0)
@@ -122,8 +121,7 @@ typedef struct {
  * CVAR_ESINGULAR M = d2L/dy'dy' is not positive definite, or the constraints' gradients
  *                are dependent at the equilibrium;
  * CVAR_EDEPENDENCY a LAPACK routine failed; CVAR_ENOMEM. */
-cv_status mech_modes_new(const mech_problem *mp, mech_modes *md, int *at, char *err,
-                         size_t errlen);
+cv_status mech_modes_new(const mech_problem *mp, mech_modes *md, int *at, char *err, size_t errlen);
 void mech_modes_free(mech_modes *md);
 
 #endif /* CV_MECH_H */

@@ -8,24 +8,24 @@
 #include "mech/mech.h"
 
 /* Slots of mech.h: 0 = x, 1..n = y, n+1..2n = y', 2n+1..3n = y''. */
-static int slot_y(int n, int i) { (void)n; return 1 + i; }
+static int slot_y(int n, int i) {
+  (void)n;
+  return 1 + i;
+}
 static int slot_dy(int n, int i) { return 1 + n + i; }
 static int slot_ddy(int n, int i) { return 1 + 2 * n + i; }
 
-static ex_id add(ex_dag *d, ex_id a, ex_id b)
-{
+static ex_id add(ex_dag *d, ex_id a, ex_id b) {
   return a >= 0 && b >= 0 ? ex_binary(d, EX_ADD, a, b) : -1;
 }
 
-static ex_id mul(ex_dag *d, ex_id a, ex_id b)
-{
+static ex_id mul(ex_dag *d, ex_id a, ex_id b) {
   return a >= 0 && b >= 0 ? ex_binary(d, EX_MUL, a, b) : -1;
 }
 
 /* d/dx G(x, y, y') along a path, by the chain rule (P-4):
  * G_x + sum_j G_{y_j} y'_j + sum_j G_{y'_j} y''_j. */
-static ex_id total_derivative(ex_dag *d, ex_id G, int n)
-{
+static ex_id total_derivative(ex_dag *d, ex_id G, int n) {
   ex_id r = ex_diff(d, G, 0);
   for (int j = 0; j < n && r >= 0; j++) {
     r = add(d, r, mul(d, ex_diff(d, G, slot_y(n, j)), ex_slot(d, slot_dy(n, j))));
@@ -34,8 +34,7 @@ static ex_id total_derivative(ex_dag *d, ex_id G, int n)
   return r;
 }
 
-static char *cat(const char *a, const char *b)
-{
+static char *cat(const char *a, const char *b) {
   size_t la = strlen(a), lb = strlen(b);
   char *s = cv_malloc(la + lb + 1);
   if (s) {
@@ -45,41 +44,34 @@ static char *cat(const char *a, const char *b)
   return s;
 }
 
-static int make_names(const mech_problem *s, mech_equations *eq)
-{
+static int make_names(const mech_problem *s, mech_equations *eq) {
   int n = s->n;
   eq->nslots = 1 + 3 * n + s->ncons + s->nints;
-  if (!(eq->names = cv_calloc((size_t)eq->nslots, sizeof *eq->names)))
-    return -1;
+  if (!(eq->names = cv_calloc((size_t)eq->nslots, sizeof *eq->names))) return -1;
   eq->names[0] = cat(s->variable, "");
   for (int i = 0; i < n; i++) {
     eq->names[slot_y(n, i)] = cat(s->unknowns[i], "");
     eq->names[slot_dy(n, i)] = cat(s->unknowns[i], "'");
     eq->names[slot_ddy(n, i)] = cat(s->unknowns[i], "''");
   }
-  for (int c = 0; c < s->ncons; c++)
-    eq->names[1 + 3 * n + c] = cat("lambda_", s->cons_names[c]);
+  for (int c = 0; c < s->ncons; c++) eq->names[1 + 3 * n + c] = cat("lambda_", s->cons_names[c]);
   for (int r = 0; r < s->nints; r++)
     eq->names[1 + 3 * n + s->ncons + r] = cat("mu_", s->int_names[r]);
   for (int k = 0; k < eq->nslots; k++)
-    if (!eq->names[k])
-      return -1;
+    if (!eq->names[k]) return -1;
   return 0;
 }
 
 /* Euler–Lagrange expression of unknown i for integrand G, in the sign of (P-4):
  * d/dx G_{y'_i} - G_{y_i}. */
-static ex_id el_of(ex_dag *d, ex_id G, int n, int i)
-{
+static ex_id el_of(ex_dag *d, ex_id G, int n, int i) {
   ex_id p = ex_diff(d, G, slot_dy(n, i));
   ex_id dp = p >= 0 ? total_derivative(d, p, n) : -1;
   ex_id gy = ex_diff(d, G, slot_y(n, i));
   return dp >= 0 && gy >= 0 ? ex_binary(d, EX_SUB, dp, gy) : -1;
 }
 
-cv_status mech_equations_new(const mech_problem *s, mech_equations *eq, char *err,
-                             size_t errlen)
-{
+cv_status mech_equations_new(const mech_problem *s, mech_equations *eq, char *err, size_t errlen) {
   int n = s->n;
   ex_dag *d = s->dag;
   memset(eq, 0, sizeof *eq);
@@ -105,35 +97,27 @@ cv_status mech_equations_new(const mech_problem *s, mech_equations *eq, char *er
       ex_id ek = el_of(d, s->ints[r], n, i);
       E = add(d, E, mul(d, ex_slot(d, 1 + 3 * n + s->ncons + r), ek));
     }
-    if (p < 0 || E < 0 || (p = ex_collect(d, p)) < 0 || (E = ex_collect(d, E)) < 0)
-      goto nomem;
+    if (p < 0 || E < 0 || (p = ex_collect(d, p)) < 0 || (E = ex_collect(d, E)) < 0) goto nomem;
     /* Sign: a positive constant coefficient of y_i'' when it is a negative constant. */
     ex_id c = ex_diff(d, E, slot_ddy(n, i));
     double cv;
-    if (c < 0)
-      goto nomem;
-    if (ex_eval_const(d, c, &cv) == 0 && cv < 0 && (E = ex_unary(d, EX_NEG, E)) < 0)
-      goto nomem;
+    if (c < 0) goto nomem;
+    if (ex_eval_const(d, c, &cv) == 0 && cv < 0 && (E = ex_unary(d, EX_NEG, E)) < 0) goto nomem;
     eq->momentum[i] = p;
     eq->el[i] = E;
   }
-  if (H < 0 || (eq->hamiltonian = ex_collect(d, H)) < 0)
-    goto nomem;
+  if (H < 0 || (eq->hamiltonian = ex_collect(d, H)) < 0) goto nomem;
   return CVAR_OK;
 nomem:
-  if (err && errlen)
-    snprintf(err, errlen, "out of memory while building the equations");
+  if (err && errlen) snprintf(err, errlen, "out of memory while building the equations");
   mech_equations_free(eq);
   return CVAR_ENOMEM;
 }
 
-void mech_equations_free(mech_equations *eq)
-{
-  if (!eq)
-    return;
+void mech_equations_free(mech_equations *eq) {
+  if (!eq) return;
   if (eq->names)
-    for (int k = 0; k < eq->nslots; k++)
-      cv_free(eq->names[k]);
+    for (int k = 0; k < eq->nslots; k++) cv_free(eq->names[k]);
   cv_free(eq->names);
   cv_free(eq->momentum);
   cv_free(eq->el);

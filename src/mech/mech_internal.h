@@ -17,12 +17,12 @@ typedef struct {
   ex_id *outs;      /* [nout] */
   ex_tape *tape;
   double *tape_work;
-  double *val;      /* [nout] at the current point */
-  double *zero;     /* [n] y' = 0 */
-  double *J;        /* [N*N] symmetric Jacobian of the stationarity system, then its r [N] */
+  double *val;  /* [nout] at the current point */
+  double *zero; /* [n] y' = 0 */
+  double *J;    /* [N*N] symmetric Jacobian of the stationarity system, then its r [N] */
   double *r;
-  double *step;     /* [N] */
-  int lw;           /* LAPACK workspace: work holds N*N + N + lw doubles */
+  double *step; /* [N] */
+  int lw;       /* LAPACK workspace: work holds N*N + N + lw doubles */
   double *work;
 } mech_ctx;
 
@@ -42,8 +42,7 @@ int mech_workspace(int N, int n);
 /* The Newton step -J^+ g by the eigen-decomposition of the symmetric J (N x N; minimum norm
  * where J is singular: neutral directions do not move). work holds N*N + N + lw doubles.
  * Returns 0, or -1 if LAPACK dsyev fails. */
-int mech_pinv_step(int N, const double *J, const double *g, double *step, double *work,
-                   int lw);
+int mech_pinv_step(int N, const double *J, const double *g, double *step, double *work, int lw);
 /* Orthonormal basis T (n x (n - nc), column-major) of {v : A^T v = 0}, A (n x nc,
  * column-major). Returns 0, 1 if the columns of A are dependent, -1 on a LAPACK failure,
  * -2 out of memory. */
@@ -55,7 +54,7 @@ void mech_project(int n, int m, const double *T, const double *X, double *P);
 int mech_sygv(int m, double *K, double *M, double *omega2, double *work, int lw);
 /* The 2n eigenvalues lambda = re + i im of lambda^2 M v + lambda G v + K v = 0 with
  * G = C - C^T (P-12). Returns 0, -1 if LAPACK dggev fails, -2 out of memory. */
-int mech_gyro_eigenvalues(int n, const double *M, const double *K, const double *C,
-                          double *re, double *im);
+int mech_gyro_eigenvalues(int n, const double *M, const double *K, const double *C, double *re,
+                          double *im);
 
 #endif /* CV_MECH_INTERNAL_H */

@@ -11,19 +11,21 @@
 
 /* Modes apply to L(y, y') with holonomic constraints G(y) that hold still, fewer than the
  * unknowns, and no integral constraints. */
-static cv_status applicable(const mech_problem *mp, int *at, char *err, size_t errlen)
-{
+static cv_status applicable(const mech_problem *mp, int *at, char *err, size_t errlen) {
   if (ex_depends_on(mp->dag, mp->F, 0)) {
     *at = MECH_AT_F;
     if (err && errlen)
-      snprintf(err, errlen, "the integrand depends explicitly on %s; modes needs a "
-               "Lagrangian L(y, y') without it", mp->variable);
+      snprintf(err, errlen,
+               "the integrand depends explicitly on %s; modes needs a "
+               "Lagrangian L(y, y') without it",
+               mp->variable);
     return CVAR_EINVAL;
   }
   if (mp->nints > 0) {
     *at = MECH_AT_CONS + mp->ncons;
     if (err && errlen)
-      snprintf(err, errlen, "modes does not handle integral constraints: they constrain the "
+      snprintf(err, errlen,
+               "modes does not handle integral constraints: they constrain the "
                "whole path, not the positions near an equilibrium");
     return CVAR_EINVAL;
   }
@@ -31,31 +33,31 @@ static cv_status applicable(const mech_problem *mp, int *at, char *err, size_t e
     if (ex_depends_on(mp->dag, mp->cons[c], 0)) {
       *at = MECH_AT_CONS + c;
       if (err && errlen)
-        snprintf(err, errlen, "the constraint '%s' depends on %s (it moves): modes needs "
-                 "constraints G(y) that hold still", mp->cons_names[c], mp->variable);
+        snprintf(err, errlen,
+                 "the constraint '%s' depends on %s (it moves): modes needs "
+                 "constraints G(y) that hold still",
+                 mp->cons_names[c], mp->variable);
       return CVAR_EINVAL;
     }
   if (mp->ncons >= mp->n) {
     *at = MECH_AT_CONS;
     if (err && errlen)
-      snprintf(err, errlen, "%d constraints on %d unknowns leave nothing to oscillate",
-               mp->ncons, mp->n);
+      snprintf(err, errlen, "%d constraints on %d unknowns leave nothing to oscillate", mp->ncons,
+               mp->n);
     return CVAR_EINVAL;
   }
   return CVAR_OK;
 }
 
 /* The expressions of c->val (exact symbolic derivatives) and their tape. */
-static int build_partials(mech_ctx *c)
-{
+static int build_partials(mech_ctx *c) {
   const mech_problem *mp = c->mp;
   ex_dag *d = mp->dag;
   int n = c->n, nn = c->nn;
   ex_id *outs = c->outs;
   for (int i = 0; i < n; i++) {
     ex_id gi = ex_diff(d, mp->F, 1 + i), pi = ex_diff(d, mp->F, 1 + n + i);
-    if (gi < 0 || pi < 0)
-      return -1;
+    if (gi < 0 || pi < 0) return -1;
     outs[i] = gi;
     for (int j = 0; j < n; j++) {
       if ((outs[n + i * n + j] = ex_diff(d, gi, 1 + j)) < 0 ||
@@ -68,11 +70,9 @@ static int build_partials(mech_ctx *c)
     ex_id *o = outs + n + 3 * nn + k * c->per, G = mp->cons[k];
     o[0] = G;
     for (int i = 0; i < n; i++) {
-      if ((o[1 + i] = ex_diff(d, G, 1 + i)) < 0)
-        return -1;
+      if ((o[1 + i] = ex_diff(d, G, 1 + i)) < 0) return -1;
       for (int j = 0; j < n; j++)
-        if ((o[1 + n + i * n + j] = ex_diff(d, o[1 + i], 1 + j)) < 0)
-          return -1;
+        if ((o[1 + n + i * n + j] = ex_diff(d, o[1 + i], 1 + j)) < 0) return -1;
     }
   }
   if (!(c->tape = ex_tape_new(d, 1 + 2 * n, c->nout, outs)) ||
@@ -81,8 +81,7 @@ static int build_partials(mech_ctx *c)
   return 0;
 }
 
-int mech_eval_partials(mech_ctx *c, const double *y)
-{
+int mech_eval_partials(mech_ctx *c, const double *y) {
   int n = c->n;
   const double **in = cv_malloc((size_t)(1 + 2 * n) * sizeof *in);
   double **o = cv_malloc((size_t)c->nout * sizeof *o);
@@ -96,8 +95,7 @@ int mech_eval_partials(mech_ctx *c, const double *y)
     in[1 + i] = y + i;
     in[1 + n + i] = c->zero + i;
   }
-  for (int q = 0; q < c->nout; q++)
-    o[q] = c->val + q;
+  for (int q = 0; q < c->nout; q++) o[q] = c->val + q;
   ex_tape_eval(c->tape, 1, (const double *const *)in, (double *const *)o, c->tape_work);
   cv_free(in);
   cv_free(o);
@@ -108,9 +106,8 @@ int mech_eval_partials(mech_ctx *c, const double *y)
  * on the constraints' tangent space T (n x m, orthonormal): M_r = T'MT, K_r = T'KT,
  * C_r = T'CT; without constraints T = I and these are M, K, C. T, Mr, Kr, Cr are n*n
  * each. */
-static cv_status reduced_matrices(mech_ctx *c, mech_modes *md, double *T, double *Mr,
-                                  double *Kr, double *Cr, char *err, size_t errlen)
-{
+static cv_status reduced_matrices(mech_ctx *c, mech_modes *md, double *T, double *Mr, double *Kr,
+                                  double *Cr, char *err, size_t errlen) {
   int n = c->n, nn = c->nn, N = c->N, nc = c->nc, m = n - nc;
   const double *Mv = c->val + n + nn, *C = c->val + n + 2 * nn;
   md->gyroscopic = 0;
@@ -123,11 +120,9 @@ static cv_status reduced_matrices(mech_ctx *c, mech_modes *md, double *T, double
   if (nc > 0) {
     double *Ag = c->step + N; /* constraint gradients, n x nc column-major */
     for (int k = 0; k < nc; k++)
-      for (int i = 0; i < n; i++)
-        Ag[i + (size_t)k * n] = c->val[n + 3 * nn + k * c->per + 1 + i];
+      for (int i = 0; i < n; i++) Ag[i + (size_t)k * n] = c->val[n + 3 * nn + k * c->per + 1 + i];
     int t = mech_tangent_basis(n, nc, Ag, T);
-    if (t == -2)
-      return CVAR_ENOMEM;
+    if (t == -2) return CVAR_ENOMEM;
     if (t != 0) {
       if (err && errlen)
         snprintf(err, errlen, "%s",
@@ -142,8 +137,7 @@ static cv_status reduced_matrices(mech_ctx *c, mech_modes *md, double *T, double
     mech_project(n, m, T, C, Cr);
   } else {
     memset(T, 0, (size_t)nn * sizeof *T);
-    for (int i = 0; i < n; i++)
-      T[i + (size_t)i * n] = 1.0;
+    for (int i = 0; i < n; i++) T[i + (size_t)i * n] = 1.0;
     memcpy(Mr, md->mass, (size_t)nn * sizeof *Mr);
     memcpy(Kr, md->stiffness, (size_t)nn * sizeof *Kr);
     memcpy(Cr, C, (size_t)nn * sizeof *Cr);
@@ -153,8 +147,7 @@ static cv_status reduced_matrices(mech_ctx *c, mech_modes *md, double *T, double
     for (int j = 0; j < m; j++)
       md->gyroscopic = fmax(md->gyroscopic, fabs(Cr[i * m + j] - Cr[j * m + i]));
   /* G below round-off of C itself (the two mixed partials differ in their last bits) */
-  if (md->gyroscopic <= 1e-13 * cmax)
-    md->gyroscopic = 0;
+  if (md->gyroscopic <= 1e-13 * cmax) md->gyroscopic = 0;
   return CVAR_OK;
 }
 
@@ -163,8 +156,7 @@ static cv_status reduced_matrices(mech_ctx *c, mech_modes *md, double *T, double
  * Ka and Mb hold m*m doubles each. */
 static cv_status normal_modes(mech_ctx *c, mech_modes *md, const double *T, const double *Mr,
                               const double *Kr, double *Ka, double *Mb, int *at, char *err,
-                              size_t errlen)
-{
+                              size_t errlen) {
   int n = c->n, m = md->nmodes;
   memcpy(Ka, Kr, (size_t)m * m * sizeof *Ka);
   memcpy(Mb, Mr, (size_t)m * m * sizeof *Mb);
@@ -172,7 +164,8 @@ static cv_status normal_modes(mech_ctx *c, mech_modes *md, const double *T, cons
   if (info > m) {
     *at = MECH_AT_F;
     if (err && errlen)
-      snprintf(err, errlen, "the mass matrix M = d2L/dy'dy' is not positive definite at the "
+      snprintf(err, errlen,
+               "the mass matrix M = d2L/dy'dy' is not positive definite at the "
                "equilibrium%s (its leading minor of order %d is not positive): some "
                "coordinate has no kinetic energy, so there are no oscillations to compute",
                c->nc ? " along the constraints" : "", info - m);
@@ -180,7 +173,8 @@ static cv_status normal_modes(mech_ctx *c, mech_modes *md, const double *T, cons
   }
   if (info != 0) {
     if (err && errlen)
-      snprintf(err, errlen, "the generalised eigenproblem K v = w2 M v did not converge "
+      snprintf(err, errlen,
+               "the generalised eigenproblem K v = w2 M v did not converge "
                "(LAPACK dsygv)");
     return CVAR_EDEPENDENCY;
   }
@@ -194,16 +188,13 @@ static cv_status normal_modes(mech_ctx *c, mech_modes *md, const double *T, cons
     double *v = md->shape + (size_t)k * n;
     for (int i = 0; i < n; i++) {
       v[i] = 0;
-      for (int a = 0; a < m; a++)
-        v[i] += T[i + (size_t)a * n] * w[a];
+      for (int a = 0; a < m; a++) v[i] += T[i + (size_t)a * n] * w[a];
     }
     int imax = 0;
     for (int i = 1; i < n; i++)
-      if (fabs(v[i]) > fabs(v[imax]))
-        imax = i;
+      if (fabs(v[i]) > fabs(v[imax])) imax = i;
     double sg = v[imax] < 0 ? -1.0 : 1.0;
-    for (int i = 0; i < n; i++)
-      v[i] = sg * v[i] + 0.0;
+    for (int i = 0; i < n; i++) v[i] = sg * v[i] + 0.0;
   }
   return CVAR_OK;
 }
@@ -212,12 +203,10 @@ static cv_status normal_modes(mech_ctx *c, mech_modes *md, const double *T, cons
  * pair lambda, -conj(lambda) of a conservative system one is kept: the eigenvalues with
  * Im > 0 and Re >= 0 (up to round-off), the real ones with Re > 0, and half of the zero
  * ones; then ordered: neutral and stable by omega, then unstable by growth. */
-static void gyro_motions(mech_modes *md, int m, const double *re, const double *im)
-{
+static void gyro_motions(mech_modes *md, int m, const double *re, const double *im) {
   int N = 2 * m;
   double big = 0;
-  for (int k = 0; k < N; k++)
-    big = fmax(big, hypot(re[k], im[k]));
+  for (int k = 0; k < N; k++) big = fmax(big, hypot(re[k], im[k]));
   /* A free direction is a double zero with a Jordan block, computed as two eigenvalues of
    * size sqrt(eps) |lambda|: "zero" is 1e-6 of the largest. Re lambda of a stable pair is
    * round-off of a non-normal eigenproblem: "zero" is 1e-7 of the largest. */
@@ -245,8 +234,7 @@ static void gyro_motions(mech_modes *md, int m, const double *re, const double *
       int ua = md->gyro_kind[b - 1] == MECH_MODE_UNSTABLE;
       double kb = ub ? md->gyro_growth[b] : md->gyro_omega[b];
       double ka = ua ? md->gyro_growth[b - 1] : md->gyro_omega[b - 1];
-      if (ua < ub || (ua == ub && ka <= kb))
-        break;
+      if (ua < ub || (ua == ub && ka <= kb)) break;
       double t = md->gyro_omega[b];
       md->gyro_omega[b] = md->gyro_omega[b - 1], md->gyro_omega[b - 1] = t;
       t = md->gyro_growth[b];
@@ -257,8 +245,7 @@ static void gyro_motions(mech_modes *md, int m, const double *re, const double *
   md->ngyro = g;
 }
 
-static int alloc_modes(mech_modes *md, int n, int nc)
-{
+static int alloc_modes(mech_modes *md, int n, int nc) {
   size_t nn = (size_t)n * n;
   md->equilibrium = cv_malloc((size_t)n * sizeof *md->equilibrium);
   md->multipliers = cv_malloc((size_t)(nc ? nc : 1) * sizeof *md->multipliers);
@@ -270,29 +257,24 @@ static int alloc_modes(mech_modes *md, int n, int nc)
   md->gyro_omega = cv_malloc((size_t)n * sizeof *md->gyro_omega);
   md->gyro_growth = cv_malloc((size_t)n * sizeof *md->gyro_growth);
   md->gyro_kind = cv_malloc((size_t)n * sizeof *md->gyro_kind);
-  return md->equilibrium && md->multipliers && md->omega2 && md->kind && md->shape &&
-                 md->mass && md->stiffness && md->gyro_omega && md->gyro_growth &&
-                 md->gyro_kind
+  return md->equilibrium && md->multipliers && md->omega2 && md->kind && md->shape && md->mass &&
+                 md->stiffness && md->gyro_omega && md->gyro_growth && md->gyro_kind
              ? 0
              : -1;
 }
 
 cv_status mech_modes_new(const mech_problem *mp, mech_modes *md, int *at, char *err,
-                         size_t errlen)
-{
+                         size_t errlen) {
   int n = mp->n, nn = n * n, nc = mp->ncons, N = n + nc, where = MECH_AT_NONE;
   mech_ctx c = {.mp = mp, .n = n, .nc = nc, .nn = nn, .N = N, .per = 1 + n + nn};
   double *mats = NULL, *eig = NULL;
   cv_status st = CVAR_ENOMEM;
   memset(md, 0, sizeof *md);
   md->n = n;
-  if (err && errlen)
-    err[0] = '\0';
-  if (!at)
-    at = &where;
+  if (err && errlen) err[0] = '\0';
+  if (!at) at = &where;
   *at = MECH_AT_NONE;
-  if ((st = applicable(mp, at, err, errlen)) != CVAR_OK)
-    return st;
+  if ((st = applicable(mp, at, err, errlen)) != CVAR_OK) return st;
   st = CVAR_ENOMEM;
   c.nout = n + 3 * nn + nc * c.per;
   c.lw = mech_workspace(N, n);
@@ -309,10 +291,8 @@ cv_status mech_modes_new(const mech_problem *mp, mech_modes *md, int *at, char *
     goto cleanup;
   md->nc = nc;
   c.r = c.J + (size_t)N * N;
-  if (build_partials(&c) < 0)
-    goto cleanup;
-  if ((st = mech_equilibrium(&c, md, at, err, errlen)) != CVAR_OK)
-    goto cleanup;
+  if (build_partials(&c) < 0) goto cleanup;
+  if ((st = mech_equilibrium(&c, md, at, err, errlen)) != CVAR_OK) goto cleanup;
   double *T = mats, *Mr = T + nn, *Kr = Mr + nn, *Cr = Kr + nn, *Ka = Cr + nn, *Mb = Ka + nn;
   if ((st = reduced_matrices(&c, md, T, Mr, Kr, Cr, err, errlen)) != CVAR_OK ||
       (st = normal_modes(&c, md, T, Mr, Kr, Ka, Mb, at, err, errlen)) != CVAR_OK)
@@ -345,15 +325,12 @@ cleanup:
   ex_tape_free(c.tape);
   cv_free(mats);
   cv_free(eig);
-  if (st != CVAR_OK)
-    mech_modes_free(md);
+  if (st != CVAR_OK) mech_modes_free(md);
   return st;
 }
 
-void mech_modes_free(mech_modes *md)
-{
-  if (!md)
-    return;
+void mech_modes_free(mech_modes *md) {
+  if (!md) return;
   cv_free(md->equilibrium);
   cv_free(md->omega2);
   cv_free(md->kind);

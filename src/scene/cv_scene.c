@@ -16,16 +16,12 @@ struct cv_report {
   char *json;
 };
 
-static void say(char *err, size_t errlen, const char *fmt, const char *what)
-{
-  if (err && errlen)
-    snprintf(err, errlen, fmt, what);
+static void say(char *err, size_t errlen, const char *fmt, const char *what) {
+  if (err && errlen) snprintf(err, errlen, fmt, what);
 }
 
 /* "name=value" strings into sc_set pairs pointing into one copy (*buf). */
-static sc_set *split_sets(int nset, const char *const *set, char **buf, char *err,
-                          size_t errlen)
-{
+static sc_set *split_sets(int nset, const char *const *set, char **buf, char *err, size_t errlen) {
   size_t total = 0;
   for (int i = 0; i < nset; i++) {
     if (!set[i]) {
@@ -62,25 +58,22 @@ static sc_set *split_sets(int nset, const char *const *set, char **buf, char *er
 }
 
 static cv_scene *load(const char *path, const char *text, const char *name, int nset,
-                      const char *const *set, char *err, size_t errlen)
-{
-  if (err && errlen)
-    err[0] = '\0';
+                      const char *const *set, char *err, size_t errlen) {
+  if (err && errlen) err[0] = '\0';
   if ((!path && !text) || nset < 0 || (nset > 0 && !set)) {
     say(err, errlen, "%s", "cv_scene_load: invalid argument");
     return NULL;
   }
   char *buf = NULL;
   sc_set *pairs = NULL;
-  if (nset > 0 && !(pairs = split_sets(nset, set, &buf, err, errlen)))
-    return NULL;
+  if (nset > 0 && !(pairs = split_sets(nset, set, &buf, err, errlen))) return NULL;
   cv_scene *sc = cv_calloc(1, sizeof *sc);
   if (!sc) {
     say(err, errlen, "%s", "out of memory");
   } else {
     sc->s = path ? scene_load_file(path, nset, pairs, err, errlen)
-                 : scene_load_buffer(text, strlen(text), name ? name : "<text>", nset, pairs,
-                                     err, errlen);
+                 : scene_load_buffer(text, strlen(text), name ? name : "<text>", nset, pairs, err,
+                                     errlen);
     if (!sc->s) {
       cv_free(sc);
       sc = NULL;
@@ -92,56 +85,43 @@ static cv_scene *load(const char *path, const char *text, const char *name, int 
 }
 
 cv_scene *cv_scene_load_file(const char *path, int nset, const char *const *set, char *err,
-                             size_t errlen)
-{
+                             size_t errlen) {
   return load(path, NULL, NULL, nset, set, err, errlen);
 }
 
-cv_scene *cv_scene_load_text(const char *text, const char *name, int nset,
-                             const char *const *set, char *err, size_t errlen)
-{
+cv_scene *cv_scene_load_text(const char *text, const char *name, int nset, const char *const *set,
+                             char *err, size_t errlen) {
   return load(NULL, text, name, nset, set, err, errlen);
 }
 
-void cv_scene_free(cv_scene *sc)
-{
-  if (!sc)
-    return;
+void cv_scene_free(cv_scene *sc) {
+  if (!sc) return;
   scene_free(sc->s);
   cv_free(sc);
 }
 
-int cv_scene_get_num_unknowns(const cv_scene *sc)
-{
-  return sc ? sc->s->n : 0;
-}
+int cv_scene_get_num_unknowns(const cv_scene *sc) { return sc ? sc->s->n : 0; }
 
-const char *cv_scene_get_unknown(const cv_scene *sc, int i)
-{
+const char *cv_scene_get_unknown(const cv_scene *sc, int i) {
   return sc && i >= 0 && i < sc->s->n ? sc->s->unknowns[i] : NULL;
 }
 
-const char *cv_scene_get_title(const cv_scene *sc)
-{
+const char *cv_scene_get_title(const cv_scene *sc) {
   return sc && sc->s->title ? sc->s->title : "";
 }
 
-const char *cv_scene_get_variable(const cv_scene *sc)
-{
+const char *cv_scene_get_variable(const cv_scene *sc) {
   return sc && sc->s->variable ? sc->s->variable : "x";
 }
 
 /* Integer options must be whole numbers in range; reals finite and positive. */
-static int whole(double v, double lo, double hi)
-{
+static int whole(double v, double lo, double hi) {
   return isfinite(v) && v == floor(v) && v >= lo && v <= hi;
 }
 
 cv_status cv_scene_set_option(cv_scene *sc, const char *name, double value, char *err,
-                              size_t errlen)
-{
-  if (err && errlen)
-    err[0] = '\0';
+                              size_t errlen) {
+  if (err && errlen) err[0] = '\0';
   if (!sc || !name) {
     say(err, errlen, "%s", "cv_scene_set_option: invalid argument");
     return CVAR_EINVAL;
@@ -163,30 +143,33 @@ cv_status cv_scene_set_option(cv_scene *sc, const char *name, double value, char
   else if (strcmp(name, "tol") == 0 && (ok = isfinite(value) && value >= 0))
     s->tol = value;
   else if (ok && strcmp(name, "elements") && strcmp(name, "degree") &&
-           strcmp(name, "max_iterations") && strcmp(name, "method") &&
-           strcmp(name, "tolerance") && strcmp(name, "adapt") && strcmp(name, "tol")) {
-    say(err, errlen, "unknown option '%s' (known: elements, degree, tolerance, "
-        "max_iterations, adapt, tol, method)", name);
+           strcmp(name, "max_iterations") && strcmp(name, "method") && strcmp(name, "tolerance") &&
+           strcmp(name, "adapt") && strcmp(name, "tol")) {
+    say(err, errlen,
+        "unknown option '%s' (known: elements, degree, tolerance, "
+        "max_iterations, adapt, tol, method)",
+        name);
     return CVAR_EINVAL;
   }
   if (ok && s->tol > 0 && s->adapt > 0) {
     /* as `solve --tol` with `--adapt`: two accuracy rules at once */
-    say(err, errlen, "%s", "tol and adapt may not be given together (tol chooses the degrees "
+    say(err, errlen, "%s",
+        "tol and adapt may not be given together (tol chooses the degrees "
         "too; adapt refines at a fixed degree)");
-    if (strcmp(name, "tol") == 0) s->tol = 0;
-    else s->adapt = 0;
+    if (strcmp(name, "tol") == 0)
+      s->tol = 0;
+    else
+      s->adapt = 0;
     return CVAR_EINVAL;
   }
   if (!ok) {
-    if (err && errlen)
-      snprintf(err, errlen, "%s: invalid value %g", name, value);
+    if (err && errlen) snprintf(err, errlen, "%s: invalid value %g", name, value);
     return CVAR_EINVAL;
   }
   return CVAR_OK;
 }
 
-cv_problem *cv_scene_problem_new(const cv_scene *sc, char *err, size_t errlen)
-{
+cv_problem *cv_scene_problem_new(const cv_scene *sc, char *err, size_t errlen) {
   if (!sc) {
     say(err, errlen, "%s", "cv_scene_problem_new: no scene");
     return NULL;
@@ -194,9 +177,7 @@ cv_problem *cv_scene_problem_new(const cv_scene *sc, char *err, size_t errlen)
   return scene_problem_new(sc->s, scene_method_need(sc->s->method), err, errlen);
 }
 
-cv_status cv_scene_configure_solver(const cv_scene *sc, cv_solver *s, char *err,
-                                    size_t errlen)
-{
+cv_status cv_scene_configure_solver(const cv_scene *sc, cv_solver *s, char *err, size_t errlen) {
   if (!sc || !s) {
     say(err, errlen, "%s", "cv_scene_configure_solver: invalid argument");
     return CVAR_EINVAL;
@@ -204,8 +185,7 @@ cv_status cv_scene_configure_solver(const cv_scene *sc, cv_solver *s, char *err,
   return scene_solver_configure(sc->s, s, err, errlen);
 }
 
-cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *s, cv_status *why)
-{
+cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *s, cv_status *why) {
   cv_report *r = NULL;
   cli_report cr;
   memset(&cr, 0, sizeof cr);
@@ -220,8 +200,9 @@ cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *s, cv_sta
   }
   r = cv_calloc(1, sizeof *r);
   int rounds = isfinite(cv_solver_get_error_estimate(s)); /* --adapt or --tol: 1, 2 */
-  if (!r || cli_report_build(&cr, sc->s, p, s, cv_solver_get_status(s),
-                             rounds && sc->s->tol > 0 ? 2 : rounds) < 0 ||
+  if (!r ||
+      cli_report_build(&cr, sc->s, p, s, cv_solver_get_status(s),
+                       rounds && sc->s->tol > 0 ? 2 : rounds) < 0 ||
       !(r->json = cli_report_json_text(&cr))) {
     cv_report_free(r);
     r = NULL;
@@ -230,20 +211,14 @@ cv_report *cv_report_new(cv_scene *sc, const cv_problem *p, cv_solver *s, cv_sta
   st = CVAR_OK;
 done:
   cli_report_free(&cr);
-  if (why)
-    *why = st;
+  if (why) *why = st;
   return r;
 }
 
-const char *cv_report_json(const cv_report *r)
-{
-  return r && r->json ? r->json : "";
-}
+const char *cv_report_json(const cv_report *r) { return r && r->json ? r->json : ""; }
 
-void cv_report_free(cv_report *r)
-{
-  if (!r)
-    return;
+void cv_report_free(cv_report *r) {
+  if (!r) return;
   free(r->json); /* from json_dumps: jansson's allocator */
   cv_free(r);
 }

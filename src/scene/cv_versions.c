@@ -11,17 +11,17 @@
 /* LAPACK's own version query (reference LAPACK and OpenBLAS both export it). */
 void ilaver_(int *major, int *minor, int *patch);
 
-cv_status cv_dependency_versions(char *buf, size_t len)
-{
-  if (!buf || len == 0)
-    return CVAR_EINVAL;
+cv_status cv_dependency_versions(char *buf, size_t len) {
+  if (!buf || len == 0) return CVAR_EINVAL;
   int cv[3] = {0, 0, 0}, nv[3] = {0, 0, 0}, lv[3] = {0, 0, 0};
   cholmod_version(cv);
   nlopt_version(&nv[0], &nv[1], &nv[2]);
   ilaver_(&lv[0], &lv[1], &lv[2]);
   /* inih has no version call: the one of the headers built against is not recorded */
-  int k = snprintf(buf, len, "CHOLMOD %d.%d.%d, NLopt %d.%d.%d, LAPACK %d.%d.%d, jansson %s, "
-                   "inih", cv[0], cv[1], cv[2], nv[0], nv[1], nv[2], lv[0], lv[1], lv[2],
+  int k = snprintf(buf, len,
+                   "CHOLMOD %d.%d.%d, NLopt %d.%d.%d, LAPACK %d.%d.%d, jansson %s, "
+                   "inih",
+                   cv[0], cv[1], cv[2], nv[0], nv[1], nv[2], lv[0], lv[1], lv[2],
                    jansson_version_str());
   return k >= 0 && (size_t)k < len ? CVAR_OK : CVAR_EINVAL;
 }

@@ -45,19 +45,19 @@ typedef struct {
   double value[2]; /* at a and at b; meaningful where not free */
   int free_end[2]; /* nonzero: natural boundary condition dF/dy' = 0 there */
   int line;
-  ex_id expr[2];   /* parameters as inputs: the value as an expression of them, else -1 */
+  ex_id expr[2]; /* parameters as inputs: the value as an expression of them, else -1 */
 } sc_boundary;
 
 typedef struct scene {
-  char *file;     /* the name used in messages */
+  char *file; /* the name used in messages */
   char *title;
   char *variable; /* default "x" */
   double a, b;
-  int n;          /* number of unknowns */
+  int n; /* number of unknowns */
   char **unknowns;
 
-  ex_dag *dag;    /* owns every expression below */
-  ex_id F;        /* the integrand */
+  ex_dag *dag; /* owns every expression below */
+  ex_id F;     /* the integrand */
   int F_line;
 
   sc_boundary *bc; /* [n] */
@@ -70,26 +70,26 @@ typedef struct scene {
   sc_item *params, *defs, *cons, *ints, *reports;
 
   /* [mesh] */
-  int elements;        /* default 100 */
-  int degree;          /* default 1 */
+  int elements; /* default 100 */
+  int degree;   /* default 1 */
   int nbreak;
   double *breakpoints; /* sorted, inside (a, b) */
   double adapt;        /* 0: off */
   int adapt_line;
-  double tol;          /* [mesh] tol: automatic accuracy (hp), 0: off */
+  double tol; /* [mesh] tol: automatic accuracy (hp), 0: off */
   int tol_line;
-  int elements_line, degree_line; /* 0 when not given (--tol then picks its start) */
-#define SCENE_TOL_MAX_NODES 1000000 /* cap of --tol / [mesh] tol on the nodes */
-#define SCENE_TOL_START_ELEMENTS 4  /* --tol's starting mesh when the scene gives none */
-#define SCENE_TOL_START_DEGREE 4
-  double grading;      /* 0: uniform; else the exponent k >= 1 (an addition, docs/scenes.md) */
-  int graded_end;      /* CVAR_GRADE_A, CVAR_GRADE_B or CVAR_GRADE_BOTH */
+  int elements_line, degree_line;        /* 0 when not given (--tol then picks its start) */
+#define SCENE_TOL_MAX_NODES      1000000 /* cap of --tol / [mesh] tol on the nodes */
+#define SCENE_TOL_START_ELEMENTS 4       /* --tol's starting mesh when the scene gives none */
+#define SCENE_TOL_START_DEGREE   4
+  double grading; /* 0: uniform; else the exponent k >= 1 (an addition, docs/scenes.md) */
+  int graded_end; /* CVAR_GRADE_A, CVAR_GRADE_B or CVAR_GRADE_BOTH */
 
   /* [solver] */
-  cv_method method;    /* the names are the core's: cv_method_name, cv_method_from_name */
-  int method_line;     /* 0 when not given */
-  double tolerance;    /* default 1e-10 */
-  int max_iterations;  /* default 50 */
+  cv_method method;   /* the names are the core's: cv_method_name, cv_method_from_name */
+  int method_line;    /* 0 when not given */
+  double tolerance;   /* default 1e-10 */
+  int max_iterations; /* default 50 */
 
   /* Parameters as inputs (scene_load_*_inputs, docs/scale-out.md): parameter i is slot
    * 2n+1+i of every expression instead of a folded number, params[i].expr is that slot,
@@ -99,19 +99,18 @@ typedef struct scene {
    * exact_action_expr) so that scene_set_parameters re-evaluates them. */
   int params_as_inputs;
   ex_id a_expr, b_expr, exact_action_expr;
-  int settings_line;   /* a [mesh]/[solver] value that uses a parameter: its line, else 0 */
-  int is_instance;     /* made by scene_instance_new: shares the rest with its scene */
+  int settings_line; /* a [mesh]/[solver] value that uses a parameter: its line, else 0 */
+  int is_instance;   /* made by scene_instance_new: shares the rest with its scene */
   /* [plot] (an addition, docs/scenes.md): slots 0 = the variable, 1..n = the unknowns */
-  int plot_path[2];    /* path = U, V: V drawn against U; -1, -1 when not given */
-  int *plot_down;      /* [n + 1]: nonzero for a name drawn increasing downward */
+  int plot_path[2]; /* path = U, V: V drawn against U; -1, -1 when not given */
+  int *plot_down;   /* [n + 1]: nonzero for a name drawn increasing downward */
 } scene;
 
 /** Load a scene file. `name` for messages is the path itself; the path "-" reads standard
  * input, named "<stdin>" in messages (read once; later loads of "-" in the process reuse
  * its text). Only regular files (and "-") of at most SC_MAX_BYTES are read. nset overrides
  * (may be 0). */
-scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
-                       size_t errlen);
+scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err, size_t errlen);
 /** Load a scene from memory: len bytes (NUL bytes inside are rejected), `name` is used in
  * messages (e.g. "gallery:catenary"). */
 scene *scene_load_buffer(const char *text, size_t len, const char *name, int nset,
@@ -133,8 +132,8 @@ scene *scene_load_buffer_inputs(const char *text, size_t len, const char *name, 
  * evaluated with the values before it. Then the interval, the end values, the [integrals]
  * constants and the exact action. Returns 0, or -1 with "FILE: what is wrong" in err (a
  * non-finite value, a >= b); the scene is then unusable until a successful call. */
-int scene_set_parameters(scene *s, const unsigned char *given, const double *vals,
-                         char *err, size_t errlen);
+int scene_set_parameters(scene *s, const unsigned char *given, const double *vals, char *err,
+                         size_t errlen);
 
 /** A copy of s that shares its expressions, names and settings but owns its parameter
  * values, interval, end values and [integrals] constants: one per thread, each set with

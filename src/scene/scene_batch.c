@@ -21,20 +21,16 @@
 
 #include "scene/scene_batch_internal.h"
 
-double sc_batch_now(void)
-{
+double sc_batch_now(void) {
   struct timespec ts;
   clock_gettime(CLOCK_MONOTONIC, &ts);
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void worker_free(cv_batch *b, worker *w)
-{
+static void worker_free(cv_batch *b, worker *w) {
   ex_integrand_free(w->F);
-  for (int k = 0; w->cons && k < b->s->ncons; k++)
-    ex_integrand_free(w->cons[k]);
-  for (int k = 0; w->ints && k < b->s->nints; k++)
-    ex_integrand_free(w->ints[k]);
+  for (int k = 0; w->cons && k < b->s->ncons; k++) ex_integrand_free(w->cons[k]);
+  for (int k = 0; w->ints && k < b->s->nints; k++) ex_integrand_free(w->ints[k]);
   cv_free(w->cons);
   cv_free(w->ints);
   cv_solver_free(w->sv);
@@ -56,8 +52,7 @@ static void worker_free(cv_batch *b, worker *w)
   memset(w, 0, sizeof *w);
 }
 
-static int worker_init(cv_batch *b, worker *w)
-{
+static int worker_init(cv_batch *b, worker *w) {
   const scene *s = b->s;
   memset(w, 0, sizeof *w);
   w->owner = b;
@@ -74,42 +69,33 @@ static int worker_init(cv_batch *b, worker *w)
   w->rv = cv_malloc(((size_t)b->nrowt + 1) * sizeof *w->rv);
   w->rw = b->rowt ? cv_malloc((ex_tape_work_size(b->rowt, 1) + 1) * sizeof *w->rw) : NULL;
   w->gv = cv_malloc(((size_t)b->nguess * QBATCH + 1) * sizeof *w->gv);
-  w->gw = b->guesst ? cv_malloc((ex_tape_work_size(b->guesst, QBATCH) + 1) * sizeof *w->gw)
-                    : NULL;
+  w->gw = b->guesst ? cv_malloc((ex_tape_work_size(b->guesst, QBATCH) + 1) * sizeof *w->gw) : NULL;
   if (!w->inst || !w->F || !w->cons || !w->ints || !w->sv || !w->pv || !w->pb ||
       (b->rep && !w->tw) || !w->prev_end || !w->rv || (b->rowt && !w->rw) || !w->gv ||
       (b->guesst && !w->gw))
     return -1;
   for (int k = 0; k < s->ncons; k++)
-    if (!(w->cons[k] = ex_integrand_clone(b->cons[k])))
-      return -1;
+    if (!(w->cons[k] = ex_integrand_clone(b->cons[k]))) return -1;
   for (int k = 0; k < s->nints; k++)
-    if (!(w->ints[k] = ex_integrand_clone(b->ints[k])))
-      return -1;
+    if (!(w->ints[k] = ex_integrand_clone(b->ints[k]))) return -1;
   return 0;
 }
 
-void cv_batch_free(cv_batch *b)
-{
-  if (!b)
-    return;
-  for (int t = 0; t < b->nworkers; t++)
-    worker_free(b, &b->w[t]);
+void cv_batch_free(cv_batch *b) {
+  if (!b) return;
+  for (int t = 0; t < b->nworkers; t++) worker_free(b, &b->w[t]);
   cv_free(b->w);
   scene_free(b->check);
   ex_integrand_free(b->F);
-  for (int k = 0; b->cons && k < b->s->ncons; k++)
-    ex_integrand_free(b->cons[k]);
-  for (int k = 0; b->ints && k < b->s->nints; k++)
-    ex_integrand_free(b->ints[k]);
+  for (int k = 0; b->cons && k < b->s->ncons; k++) ex_integrand_free(b->cons[k]);
+  for (int k = 0; b->ints && k < b->s->nints; k++) ex_integrand_free(b->ints[k]);
   cv_free(b->cons);
   cv_free(b->ints);
   ex_tape_free(b->rep);
   ex_tape_free(b->rowt);
   ex_tape_free(b->guesst);
   cv_free(b->guess_of);
-  for (int k = 0; b->outname && k < b->nout; k++)
-    cv_free(b->outname[k]);
+  for (int k = 0; b->outname && k < b->nout; k++) cv_free(b->outname[k]);
   cv_free(b->outname);
   cv_free(b->col);
   cv_free(b->given);
@@ -117,16 +103,12 @@ void cv_batch_free(cv_batch *b)
   cv_free(b);
 }
 
-cv_batch *scene_batch_new(scene *s, char *err, size_t errlen)
-{
+cv_batch *scene_batch_new(scene *s, char *err, size_t errlen) {
   char msg[400] = "";
-  if (err && errlen)
-    err[0] = '\0';
-  if (!s)
-    return NULL;
+  if (err && errlen) err[0] = '\0';
+  if (!s) return NULL;
   if (!s->params_as_inputs) {
-    snprintf(err, errlen, "%s: a batch needs the scene loaded with parameters as inputs",
-             s->file);
+    snprintf(err, errlen, "%s: a batch needs the scene loaded with parameters as inputs", s->file);
     scene_free(s);
     return NULL;
   }
@@ -147,10 +129,8 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen)
   b->outname = cv_calloc((size_t)b->nout + 1, sizeof *b->outname);
   b->given = cv_calloc((size_t)b->np + 1, 1);
   b->check = scene_instance_new(s);
-  if (!b->cons || !b->ints || !b->outname || !b->given || !b->check)
-    goto nomem;
-  for (int i = 0; i < s->n; i++)
-    b->any_exact |= s->exact[i] >= 0;
+  if (!b->cons || !b->ints || !b->outname || !b->given || !b->check) goto nomem;
+  for (int i = 0; i < s->n; i++) b->any_exact |= s->exact[i] >= 0;
   /* Compile once: every expression of the problem with the parameters as inputs. */
   if (!(b->F = ex_integrand_new_params(s->dag, s->n, b->np, s->F, b->need, msg, sizeof msg))) {
     snprintf(err, errlen, "%s:%d: integrand: %s", s->file, s->F_line,
@@ -158,57 +138,46 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen)
     goto fail;
   }
   for (int k = 0; k < s->ncons; k++)
-    if (!(b->cons[k] = ex_integrand_new_params(s->dag, s->n, b->np, s->cons[k].expr, b->need,
-                                               msg, sizeof msg))) {
+    if (!(b->cons[k] = ex_integrand_new_params(s->dag, s->n, b->np, s->cons[k].expr, b->need, msg,
+                                               sizeof msg))) {
       snprintf(err, errlen, "%s:%d: [constraints] %s: %s", s->file, s->cons[k].line,
                s->cons[k].name, msg[0] ? msg : "out of memory");
       goto fail;
     }
   for (int k = 0; k < s->nints; k++)
-    if (!(b->ints[k] = ex_integrand_new_params(s->dag, s->n, b->np, s->ints[k].expr, b->need,
-                                               msg, sizeof msg))) {
-      snprintf(err, errlen, "%s:%d: [integrals] %s: %s", s->file, s->ints[k].line,
-               s->ints[k].name, msg[0] ? msg : "out of memory");
+    if (!(b->ints[k] = ex_integrand_new_params(s->dag, s->n, b->np, s->ints[k].expr, b->need, msg,
+                                               sizeof msg))) {
+      snprintf(err, errlen, "%s:%d: [integrals] %s: %s", s->file, s->ints[k].line, s->ints[k].name,
+               msg[0] ? msg : "out of memory");
       goto fail;
     }
   if (s->nreports > 0) {
     ex_id *outs = cv_malloc((size_t)s->nreports * sizeof *outs);
-    if (!outs)
-      goto nomem;
-    for (int r = 0; r < s->nreports; r++)
-      outs[r] = s->reports[r].expr;
+    if (!outs) goto nomem;
+    for (int r = 0; r < s->nreports; r++) outs[r] = s->reports[r].expr;
     b->rep = ex_tape_new(s->dag, 1 + 2 * s->n + b->np, s->nreports, outs);
     cv_free(outs);
-    if (!b->rep)
-      goto nomem;
+    if (!b->rep) goto nomem;
   }
   b->guess_of = cv_malloc(((size_t)s->n + 1) * sizeof *b->guess_of);
-  if (!b->guess_of)
-    goto nomem;
+  if (!b->guess_of) goto nomem;
   {
     ex_id *outs = cv_malloc(((size_t)s->n + 1) * sizeof *outs);
-    if (!outs)
-      goto nomem;
+    if (!outs) goto nomem;
     for (int i = 0; i < s->n; i++) {
       b->guess_of[i] = s->guess[i] >= 0 ? b->nguess : -1;
-      if (s->guess[i] >= 0)
-        outs[b->nguess++] = s->guess[i];
+      if (s->guess[i] >= 0) outs[b->nguess++] = s->guess[i];
     }
-    if (b->nguess > 0)
-      b->guesst = ex_tape_new(s->dag, 1 + 2 * s->n + b->np, b->nguess, outs);
+    if (b->nguess > 0) b->guesst = ex_tape_new(s->dag, 1 + 2 * s->n + b->np, b->nguess, outs);
     cv_free(outs);
-    if (b->nguess > 0 && !b->guesst)
-      goto nomem;
+    if (b->nguess > 0 && !b->guesst) goto nomem;
   }
-  if (cv_batch_set_columns(b, 0, NULL, err, errlen) != CVAR_OK)
-    goto nomem;
+  if (cv_batch_set_columns(b, 0, NULL, err, errlen) != CVAR_OK) goto nomem;
   for (int r = 0; r < s->nreports; r++)
-    if (!(b->outname[r] = sc_strdup(s->reports[r].name)))
-      goto nomem;
+    if (!(b->outname[r] = sc_strdup(s->reports[r].name))) goto nomem;
   for (int k = 0; k < s->nints; k++) {
     size_t len = strlen(s->ints[k].name) + 4;
-    if (!(b->outname[s->nreports + k] = cv_malloc(len)))
-      goto nomem;
+    if (!(b->outname[s->nreports + k] = cv_malloc(len))) goto nomem;
     snprintf(b->outname[s->nreports + k], len, "mu_%s", s->ints[k].name);
   }
   return b;
@@ -219,8 +188,7 @@ fail:
   return NULL;
 }
 
-cv_batch *cv_batch_new(const char *scene_path, char *err, size_t errlen)
-{
+cv_batch *cv_batch_new(const char *scene_path, char *err, size_t errlen) {
   if (!scene_path) {
     snprintf(err, errlen, "no scene file given");
     return NULL;
@@ -231,36 +199,31 @@ cv_batch *cv_batch_new(const char *scene_path, char *err, size_t errlen)
 
 const scene *scene_batch_scene(const cv_batch *b) { return b ? b->s : NULL; }
 int cv_batch_num_parameters(const cv_batch *b) { return b ? b->np : 0; }
-const char *cv_batch_parameter_name(const cv_batch *b, int i)
-{
+const char *cv_batch_parameter_name(const cv_batch *b, int i) {
   return b && i >= 0 && i < b->np ? b->s->params[i].name : NULL;
 }
 int cv_batch_num_outputs(const cv_batch *b) { return b ? b->nout : 0; }
-const char *cv_batch_output_name(const cv_batch *b, int k)
-{
+const char *cv_batch_output_name(const cv_batch *b, int k) {
   return b && k >= 0 && k < b->nout ? b->outname[k] : NULL;
 }
 
 /* The row tape (theory (B-1)) for the current given[]: a parameter that no column
  * gives is replaced by its definition, recursively, so the outputs depend only on the
  * given parameters' slots. Adds nodes to the DAG: single-threaded, before any worker. */
-static int build_row_tape(cv_batch *b)
-{
+static int build_row_tape(cv_batch *b) {
   scene *s = b->s;
   int n = s->n, np = b->np, rc = -1;
   int cap = np + 2 + 2 * n + s->nints + 1;
   ex_id *def = cv_malloc(((size_t)np + 1) * sizeof *def);
   ex_id *outs = cv_malloc((size_t)cap * sizeof *outs);
-  if (!def || !outs)
-    goto done;
+  if (!def || !outs) goto done;
   int k = 0;
   for (int j = 0; j < np; j++) {
     ex_id e = b->given[j] ? s->params[j].expr : s->params[j].expr2;
     for (int i = 0; i < j && e >= 0 && !b->given[j]; i++)
       if (!b->given[i] && ex_depends_on(s->dag, e, 1 + 2 * n + i))
         e = ex_subst(s->dag, e, 1 + 2 * n + i, def[i]);
-    if ((def[j] = e) < 0)
-      goto done;
+    if ((def[j] = e) < 0) goto done;
     outs[k++] = e;
   }
   ex_id targets[2] = {s->a_expr, s->b_expr};
@@ -270,19 +233,15 @@ static int build_row_tape(cv_batch *b)
   t[nt++] = targets[1];
   for (int i = 0; i < n; i++)
     for (int end = 0; end < 2; end++)
-      if (!s->bc[i].free_end[end])
-        t[nt++] = s->bc[i].expr[end];
-  for (int q = 0; q < s->nints; q++)
-    t[nt++] = s->ints[q].expr2;
-  if (s->has_exact_action)
-    t[nt++] = s->exact_action_expr;
+      if (!s->bc[i].free_end[end]) t[nt++] = s->bc[i].expr[end];
+  for (int q = 0; q < s->nints; q++) t[nt++] = s->ints[q].expr2;
+  if (s->has_exact_action) t[nt++] = s->exact_action_expr;
   for (int q = 0; q < nt; q++)
     for (int i = 0; i < np && t[q] >= 0; i++)
       if (!b->given[i] && ex_depends_on(s->dag, t[q], 1 + 2 * n + i))
         t[q] = ex_subst(s->dag, t[q], 1 + 2 * n + i, def[i]);
   for (int q = 0; q < nt; q++)
-    if (t[q] < 0)
-      goto done;
+    if (t[q] < 0) goto done;
   k += nt;
   ex_tape_free(b->rowt);
   b->rowt = ex_tape_new(s->dag, 1 + 2 * n + np, k, outs);
@@ -295,29 +254,23 @@ done:
 }
 
 cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names, char *err,
-                               size_t errlen)
-{
-  if (err && errlen)
-    err[0] = '\0';
-  if (!b || ncols < 0 || (ncols > 0 && !names))
-    return CVAR_EINVAL;
+                               size_t errlen) {
+  if (err && errlen) err[0] = '\0';
+  if (!b || ncols < 0 || (ncols > 0 && !names)) return CVAR_EINVAL;
   if (b->nworkers > 0) { /* workers hold buffers sized for the current row tape */
     snprintf(err, errlen, "the columns are set before the first solve");
     return CVAR_EINVAL;
   }
   int *col = cv_malloc(((size_t)ncols + 1) * sizeof *col);
-  if (!col)
-    return CVAR_ENOMEM;
+  if (!col) return CVAR_ENOMEM;
   memset(b->given, 0, (size_t)b->np + 1);
   for (int c = 0; c < ncols; c++) {
     col[c] = -1;
     for (int i = 0; i < b->np; i++)
-      if (names[c] && strcmp(names[c], b->s->params[i].name) == 0)
-        col[c] = i;
+      if (names[c] && strcmp(names[c], b->s->params[i].name) == 0) col[c] = i;
     if (col[c] < 0 || b->given[col[c]]) {
-      snprintf(err, errlen, col[c] < 0 ? "'%s' is not a parameter of %s"
-                                       : "'%s' is given twice", names[c] ? names[c] : "",
-               b->s->file);
+      snprintf(err, errlen, col[c] < 0 ? "'%s' is not a parameter of %s" : "'%s' is given twice",
+               names[c] ? names[c] : "", b->s->file);
       cv_free(col);
       memset(b->given, 0, (size_t)b->np + 1);
       return CVAR_EINVAL;
@@ -334,10 +287,8 @@ cv_status cv_batch_set_columns(cv_batch *b, int ncols, const char *const *names,
   return CVAR_OK;
 }
 
-cv_status cv_batch_set_threads(cv_batch *b, int nthreads)
-{
-  if (!b || nthreads < 0 || nthreads > 4096)
-    return CVAR_EINVAL;
+cv_status cv_batch_set_threads(cv_batch *b, int nthreads) {
+  if (!b || nthreads < 0 || nthreads > 4096) return CVAR_EINVAL;
   if (nthreads == 0) {
     long c = sysconf(_SC_NPROCESSORS_ONLN);
     nthreads = c > 0 ? (int)(c < 4096 ? c : 4096) : 1;
@@ -346,33 +297,24 @@ cv_status cv_batch_set_threads(cv_batch *b, int nthreads)
   return CVAR_OK;
 }
 
-cv_status cv_batch_set_warm_start(cv_batch *b, int on)
-{
-  if (!b)
-    return CVAR_EINVAL;
+cv_status cv_batch_set_warm_start(cv_batch *b, int on) {
+  if (!b) return CVAR_EINVAL;
   b->warm = on != 0;
   return CVAR_OK;
 }
 
-cv_status cv_batch_set_mesh(cv_batch *b, int elements, int degree)
-{
-  if (!b || elements < 0 || degree < 0 || degree > 8)
-    return CVAR_EINVAL;
-  if (elements)
-    b->s->elements = elements;
-  if (degree)
-    b->s->degree = degree;
+cv_status cv_batch_set_mesh(cv_batch *b, int elements, int degree) {
+  if (!b || elements < 0 || degree < 0 || degree > 8) return CVAR_EINVAL;
+  if (elements) b->s->elements = elements;
+  if (degree) b->s->degree = degree;
   return CVAR_OK;
 }
 
 /* Make sure workers 0..T-1 exist. */
-cv_status sc_batch_workers(cv_batch *b, int T)
-{
-  if (T <= b->nworkers)
-    return CVAR_OK;
+cv_status sc_batch_workers(cv_batch *b, int T) {
+  if (T <= b->nworkers) return CVAR_OK;
   worker *nw = cv_realloc(b->w, (size_t)T * sizeof *nw);
-  if (!nw)
-    return CVAR_ENOMEM;
+  if (!nw) return CVAR_ENOMEM;
   b->w = nw;
   while (b->nworkers < T) {
     if (worker_init(b, &b->w[b->nworkers]) < 0) {
@@ -397,14 +339,12 @@ typedef struct {
   worker *w;
 } task;
 
-static void *run(void *arg)
-{
+static void *run(void *arg) {
   task *t = arg;
   job *j = t->j;
   for (;;) {
     int r0 = atomic_fetch_add(&j->next, j->block);
-    if (r0 >= j->nrows)
-      break;
+    if (r0 >= j->nrows) break;
     int r1 = r0 + j->block < j->nrows ? r0 + j->block : j->nrows;
     for (int r = r0; r < r1; r++)
       sc_batch_solve_row(j->b, t->w, r, j->rows + (size_t)r * j->b->ncols, &j->res[r]);
@@ -412,15 +352,11 @@ static void *run(void *arg)
   return NULL;
 }
 
-cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_result *res)
-{
-  if (!b || nrows < 0 || (nrows > 0 && (!res || (b->ncols > 0 && !rows))))
-    return CVAR_EINVAL;
-  if (nrows == 0)
-    return CVAR_OK;
+cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_result *res) {
+  if (!b || nrows < 0 || (nrows > 0 && (!res || (b->ncols > 0 && !rows)))) return CVAR_EINVAL;
+  if (nrows == 0) return CVAR_OK;
   int T = b->nthreads < nrows ? b->nthreads : nrows;
-  if (sc_batch_workers(b, T) != CVAR_OK)
-    return CVAR_ENOMEM;
+  if (sc_batch_workers(b, T) != CVAR_OK) return CVAR_ENOMEM;
   /* Blocks of consecutive rows, claimed in turn: about 8 per thread keeps the threads
    * busy to the end; inside a block each row may warm-start from the one before. */
   job j = {b, nrows, nrows / (8 * T) > 0 ? nrows / (8 * T) : 1, rows, res, 0};
@@ -442,8 +378,7 @@ cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_re
     started = t;
   }
   run(&tk[0]);
-  for (int t = 1; t <= started; t++)
-    pthread_join(th[t], NULL);
+  for (int t = 1; t <= started; t++) pthread_join(th[t], NULL);
   cv_free(tk);
   cv_free(th);
   return CVAR_OK;

@@ -23,7 +23,7 @@ const scene *scene_batch_scene(const cv_batch *b);
  * scene again. *inst receives the worker's scene instance (its values are this row's
  * until the next call). Free the problem (cv_problem_free) before the next call and
  * before the batch. NULL with a sentence in err when the values are invalid. */
-cv_problem *scene_batch_problem(cv_batch *b, const double *row, const scene **inst,
-                                char *err, size_t errlen);
+cv_problem *scene_batch_problem(cv_batch *b, const double *row, const scene **inst, char *err,
+                                size_t errlen);
 
 #endif /* CV_SCENE_BATCH_H */

@@ -15,15 +15,15 @@ typedef struct {
   scene *inst;
   ex_integrand *F, **cons, **ints; /* clones of the batch's compiled objects */
   cv_solver *sv;
-  double *pv;                      /* parameter values of the row */
-  double *tw, *pb;                 /* report tape work; parameter batches */
-  size_t cap;                      /* quadrature points the buffers below hold */
+  double *pv;      /* parameter values of the row */
+  double *tw, *pb; /* report tape work; parameter batches */
+  size_t cap;      /* quadrature points the buffers below hold */
   double *qx, *qw, *qy, *qdy, *qv;
-  double *prev;                    /* warm start: last converged nodal values */
+  double *prev; /* warm start: last converged nodal values */
   int prev_len, prev_row;
-  double *prev_end;                /* its end values [2n] */
-  double *rv, *rw;                 /* row tape outputs and work */
-  double *gv, *gw;                 /* guess tape outputs (one batch each) and work */
+  double *prev_end; /* its end values [2n] */
+  double *rv, *rw;  /* row tape outputs and work */
+  double *gv, *gw;  /* guess tape outputs (one batch each) and work */
 } worker;
 
 struct cv_batch {
@@ -31,12 +31,12 @@ struct cv_batch {
   int n, np;
   unsigned need;
   ex_integrand *F, **cons, **ints;
-  ex_tape *rep;                    /* [report] integrands, nslots 1 + 2n + np */
+  ex_tape *rep; /* [report] integrands, nslots 1 + 2n + np */
   int nout;
   char **outname;
   int ncols;
-  int *col;                        /* parameter index of each column */
-  unsigned char *given;            /* given[i]: some column sets parameter i */
+  int *col;             /* parameter index of each column */
+  unsigned char *given; /* given[i]: some column sets parameter i */
   int nthreads, warm, any_exact, nworkers;
   /* The row tape: every value that follows the parameters (their values, then a, b, the
    * fixed end values, the [integrals] constants, the exact action) as expressions of the
@@ -46,9 +46,9 @@ struct cv_batch {
   /* The [guess] expressions compiled once (unknowns without one: the default line). */
   ex_tape *guesst;
   int nguess;
-  int *guess_of;                   /* tape output of unknown i's guess, or -1 */
+  int *guess_of; /* tape output of unknown i's guess, or -1 */
   worker *w;
-  scene *check;                    /* instance for cv_batch_check_row */
+  scene *check; /* instance for cv_batch_check_row */
 };
 
 /* scene_batch.c */
@@ -64,7 +64,6 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w);
 /* cv_guess_fn over the compiled [guess]; user is the worker. */
 int sc_batch_guess(int m, const double *x, double *y, void *user);
 /* Solve row number `row` (values vals) on worker w into r. */
-void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals,
-                        cv_batch_result *r);
+void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_batch_result *r);
 
 #endif /* CV_SCENE_BATCH_INTERNAL_H */

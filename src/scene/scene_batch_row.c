@@ -14,19 +14,16 @@
  * others from their definitions) and everything computed from them, by the row tape.
  * rv, rw: the tape's outputs and work. The checks and messages of scene_set_parameters. */
 int sc_batch_set_row(const cv_batch *b, scene *inst, double *pv, double *rv, double *rw,
-                     const double *row, char *err, size_t errlen)
-{
+                     const double *row, char *err, size_t errlen) {
   int n = inst->n, np = b->np;
   const double *in[1 + 2 * n + np];
   double *out[b->nrowt];
-  for (int q = 0; q < 1 + 2 * n + np; q++)
-    in[q] = NULL;
+  for (int q = 0; q < 1 + 2 * n + np; q++) in[q] = NULL;
   for (int c = 0; c < b->ncols; c++) {
     pv[b->col[c]] = row[c];
     in[1 + 2 * n + b->col[c]] = &row[c];
   }
-  for (int q = 0; q < b->nrowt; q++)
-    out[q] = rv + q;
+  for (int q = 0; q < b->nrowt; q++) out[q] = rv + q;
   ex_tape_eval(b->rowt, 1, in, out, rw);
   int k = 0;
   for (int j = 0; j < np; j++) {
@@ -40,8 +37,8 @@ int sc_batch_set_row(const cv_batch *b, scene *inst, double *pv, double *rv, dou
   inst->a = rv[k++];
   inst->b = rv[k++];
   if (!(inst->a < inst->b)) {
-    snprintf(err, errlen, "%s: interval needs a < b, got a = %.17g, b = %.17g", inst->file,
-             inst->a, inst->b);
+    snprintf(err, errlen, "%s: interval needs a < b, got a = %.17g, b = %.17g", inst->file, inst->a,
+             inst->b);
     return -1;
   }
   for (int i = 0; i < n; i++)
@@ -49,28 +46,25 @@ int sc_batch_set_row(const cv_batch *b, scene *inst, double *pv, double *rv, dou
       if (!inst->bc[i].free_end[end]) {
         inst->bc[i].value[end] = rv[k++];
         if (!isfinite(inst->bc[i].value[end])) {
-          snprintf(err, errlen, "%s:%d: [boundary] %s at %s is not a finite number",
-                   inst->file, inst->bc[i].line, inst->unknowns[i], end ? "b" : "a");
+          snprintf(err, errlen, "%s:%d: [boundary] %s at %s is not a finite number", inst->file,
+                   inst->bc[i].line, inst->unknowns[i], end ? "b" : "a");
           return -1;
         }
       }
   for (int q = 0; q < inst->nints; q++) {
     inst->ints[q].value = rv[k++];
     if (!isfinite(inst->ints[q].value)) {
-      snprintf(err, errlen, "%s:%d: [integrals] %s: the value c is not a finite number",
-               inst->file, inst->ints[q].line, inst->ints[q].name);
+      snprintf(err, errlen, "%s:%d: [integrals] %s: the value c is not a finite number", inst->file,
+               inst->ints[q].line, inst->ints[q].name);
       return -1;
     }
   }
-  if (inst->has_exact_action)
-    inst->exact_action = rv[k++];
+  if (inst->has_exact_action) inst->exact_action = rv[k++];
   return 0;
 }
 
-cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err, size_t errlen)
-{
-  if (!b || (b->ncols > 0 && !row))
-    return CVAR_EINVAL;
+cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err, size_t errlen) {
+  if (!b || (b->ncols > 0 && !row)) return CVAR_EINVAL;
   double *pv = cv_calloc((size_t)b->np + 1, sizeof *pv);
   double *rv = cv_malloc(((size_t)b->nrowt + 1) * sizeof *rv);
   double *rw = cv_malloc((ex_tape_work_size(b->rowt, 1) + 1) * sizeof *rw);
@@ -78,31 +72,26 @@ cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err, size_t e
   cv_free(pv);
   cv_free(rv);
   cv_free(rw);
-  if (rc == -2)
-    return CVAR_ENOMEM;
+  if (rc == -2) return CVAR_ENOMEM;
   return rc < 0 ? CVAR_EINVAL : CVAR_OK;
 }
 
 /* A problem over the worker's clones, ends and integral constants of its instance. */
-cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w)
-{
+cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
   const scene *s = w->inst;
   cv_problem *p = cv_problem_new(s->n, s->a, s->b, NULL);
-  if (!p)
-    return NULL;
-  for (int i = 0; i < s->nparams; i++)
-    w->pv[i] = s->params[i].value;
+  if (!p) return NULL;
+  for (int i = 0; i < s->nparams; i++) w->pv[i] = s->params[i].value;
   ex_integrand_set_params(w->F, w->pv);
   int bad = cv_problem_set_integrand(p, ex_integrand_eval, w->F) != CVAR_OK;
   for (int i = 0; i < s->n && !bad; i++)
     for (int end = 0; end < 2 && !bad; end++)
-      bad = (s->bc[i].free_end[end] ? cv_problem_set_free_end(p, i, end)
-                                    : cv_problem_set_end_value(p, i, end,
-                                                               s->bc[i].value[end])) != CVAR_OK;
+      bad = (s->bc[i].free_end[end]
+                 ? cv_problem_set_free_end(p, i, end)
+                 : cv_problem_set_end_value(p, i, end, s->bc[i].value[end])) != CVAR_OK;
   for (int k = 0; k < s->ncons && !bad; k++) {
     ex_integrand_set_params(w->cons[k], w->pv);
-    bad = cv_problem_add_constraint(p, ex_integrand_eval_constraint, w->cons[k], NULL) !=
-          CVAR_OK;
+    bad = cv_problem_add_constraint(p, ex_integrand_eval_constraint, w->cons[k], NULL) != CVAR_OK;
   }
   for (int k = 0; k < s->nints && !bad; k++) {
     ex_integrand_set_params(w->ints[k], w->pv);
@@ -119,19 +108,16 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w)
 
 /* cv_guess_fn over the compiled [guess] tape; the default (the straight line between
  * fixed ends, SCENES.md [guess]) for unknowns without one. user: the worker's context. */
-int sc_batch_guess(int m, const double *x, double *y, void *user)
-{
+int sc_batch_guess(int m, const double *x, double *y, void *user) {
   worker *w = user;
   const cv_batch *b = w->owner;
   const scene *s = w->inst;
   int n = s->n, np = b->np;
   const double *in[1 + 2 * n + np];
   double *out[b->nguess + 1];
-  for (int q = 0; q < 1 + 2 * n + np; q++)
-    in[q] = NULL;
+  for (int q = 0; q < 1 + 2 * n + np; q++) in[q] = NULL;
   for (int j = 0; j < np; j++) {
-    for (int k = 0; k < QBATCH; k++)
-      w->pb[(size_t)j * QBATCH + k] = s->params[j].value;
+    for (int k = 0; k < QBATCH; k++) w->pb[(size_t)j * QBATCH + k] = s->params[j].value;
     in[1 + 2 * n + j] = w->pb + (size_t)j * QBATCH;
   }
   for (int k0 = 0; k0 < m; k0 += QBATCH) {
@@ -149,22 +135,20 @@ int sc_batch_guess(int m, const double *x, double *y, void *user)
         yi[k] = !bc->free_end[0] && !bc->free_end[1]
                     ? bc->value[0] + t * (bc->value[1] - bc->value[0])
                 : !bc->free_end[0] ? bc->value[0]
-                : !bc->free_end[1] ? bc->value[1] : 0.0;
+                : !bc->free_end[1] ? bc->value[1]
+                                   : 0.0;
       }
     }
-    if (b->guesst)
-      ex_tape_eval(b->guesst, mm, in, out, w->gw);
+    if (b->guesst) ex_tape_eval(b->guesst, mm, in, out, w->gw);
   }
   return 0;
 }
 
 /* The [report] integrals (sum of w K over the quadrature points) into out[0..nreports-1]. */
-static int eval_reports(const cv_batch *b, worker *w, double *out)
-{
+static int eval_reports(const cv_batch *b, worker *w, double *out) {
   const scene *s = w->inst;
   int n = s->n, np = b->np, nq = cv_solver_get_num_qpoints(w->sv);
-  if (nq <= 0)
-    return -1;
+  if (nq <= 0) return -1;
   size_t q = (size_t)nq;
   if (q > w->cap) {
     cv_free(w->qx), cv_free(w->qw), cv_free(w->qy), cv_free(w->qdy), cv_free(w->qv);
@@ -174,17 +158,14 @@ static int eval_reports(const cv_batch *b, worker *w, double *out)
     w->qdy = cv_malloc(q * n * sizeof *w->qdy);
     w->qv = cv_malloc((size_t)QBATCH * s->nreports * sizeof *w->qv);
     w->cap = w->qx && w->qw && w->qy && w->qdy && w->qv ? q : 0;
-    if (!w->cap)
-      return -1;
+    if (!w->cap) return -1;
   }
-  if (cv_solver_get_qpoints(w->sv, w->qx, w->qw, w->qy, w->qdy) != CVAR_OK)
-    return -1;
+  if (cv_solver_get_qpoints(w->sv, w->qx, w->qw, w->qy, w->qdy) != CVAR_OK) return -1;
   int ns = 1 + 2 * n + np;
   const double *in[ns];
   double *o[s->nreports];
   for (int j = 0; j < np; j++) {
-    for (int k = 0; k < QBATCH; k++)
-      w->pb[(size_t)j * QBATCH + k] = s->params[j].value;
+    for (int k = 0; k < QBATCH; k++) w->pb[(size_t)j * QBATCH + k] = s->params[j].value;
     in[1 + 2 * n + j] = w->pb + (size_t)j * QBATCH;
   }
   for (int r = 0; r < s->nreports; r++) {
@@ -200,15 +181,13 @@ static int eval_reports(const cv_batch *b, worker *w, double *out)
     }
     ex_tape_eval(b->rep, m, in, o, w->tw);
     for (int r = 0; r < s->nreports; r++)
-      for (int k = 0; k < m; k++)
-        out[r] += w->qw[k0 + k] * o[r][k];
+      for (int k = 0; k < m; k++) out[r] += w->qw[k0 + k] * o[r][k];
   }
   return 0;
 }
 
 /* Max nodal error against [exact]; NaN when it cannot be computed. */
-static double nodal_error(worker *w)
-{
+static double nodal_error(worker *w) {
   const scene *s = w->inst;
   int nn = cv_solver_get_num_nodes(w->sv), n = s->n;
   double *x = cv_malloc((size_t)nn * sizeof *x), *y = cv_malloc((size_t)nn * n * sizeof *y);
@@ -230,13 +209,11 @@ static double nodal_error(worker *w)
 
 /* The start of a warm row (theory (B-2)): the previous solution, shifted by the line that
  * moves its fixed end values onto this row's (node by node on the same layout). */
-static int warm_start(worker *w)
-{
+static int warm_start(worker *w) {
   const scene *s = w->inst;
   int n = s->n, nn = w->prev_len / n;
   double *y = cv_malloc((size_t)w->prev_len * sizeof *y);
-  if (!y)
-    return -1;
+  if (!y) return -1;
   for (int j = 0; j < nn; j++) {
     double t = nn > 1 ? (double)j / (nn - 1) : 0.0; /* only the ends need to be exact */
     for (int i = 0; i < n; i++) {
@@ -250,12 +227,10 @@ static int warm_start(worker *w)
   return st == CVAR_OK ? 0 : -1;
 }
 
-static void keep_for_warm(worker *w, int row)
-{
+static void keep_for_warm(worker *w, int row) {
   const scene *s = w->inst;
   int len = cv_solver_get_num_nodes(w->sv) * s->n;
-  if (len <= 0)
-    return;
+  if (len <= 0) return;
   if (len != w->prev_len) {
     cv_free(w->prev);
     w->prev = cv_malloc((size_t)len * sizeof *w->prev);
@@ -273,18 +248,19 @@ static void keep_for_warm(worker *w, int row)
 }
 
 static void compose_message(cv_batch_result *r, const cv_solver *sv, int morse, int nfree,
-                            int degenerate, const char *note)
-{
+                            int degenerate, const char *note) {
   const char *detail = cv_solver_last_error(sv);
   size_t cap = sizeof r->message, k = 0;
   if (r->status != CVAR_OK) {
-    k = (size_t)snprintf(r->message, cap, "%s", detail && detail[0] ? detail
-                                                                    : cv_strerror(r->status));
+    k = (size_t)snprintf(r->message, cap, "%s",
+                         detail && detail[0] ? detail : cv_strerror(r->status));
   } else {
     k = (size_t)snprintf(r->message, cap, "Converged in %d iteration%s", r->iterations,
                          r->iterations == 1 ? "" : "s");
-    const char *kind = degenerate ? "degenerate" : morse == 0 ? "minimum"
-                       : morse == nfree ? "maximum" : "saddle";
+    const char *kind = degenerate       ? "degenerate"
+                       : morse == 0     ? "minimum"
+                       : morse == nfree ? "maximum"
+                                        : "saddle";
     if (k < cap && morse >= 0 && degenerate)
       k += (size_t)snprintf(r->message + k, cap - k, "; the Hessian is degenerate there.");
     else if (k < cap && morse >= 0)
@@ -293,27 +269,22 @@ static void compose_message(cv_batch_result *r, const cv_solver *sv, int morse, 
     else if (k < cap)
       k += (size_t)snprintf(r->message + k, cap - k, ".");
     if (k < cap && detail && detail[0] && strncmp(detail, "converged in ", 13) != 0)
-      k += (size_t)snprintf(r->message + k, cap - k, " %c%s.",
-                            detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A'
-                                                                 : detail[0],
-                            detail + 1);
+      k += (size_t)snprintf(
+          r->message + k, cap - k, " %c%s.",
+          detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A' : detail[0], detail + 1);
   }
-  if (note && k < cap)
-    snprintf(r->message + k, cap - k, " %s", note);
+  if (note && k < cap) snprintf(r->message + k, cap - k, " %s", note);
 }
 
 /* Solve row number `row` (its values `vals`) on worker w into r. */
-void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals,
-                        cv_batch_result *r)
-{
+void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_batch_result *r) {
   double t0 = sc_batch_now();
   double *outputs = r->outputs;
   memset(r, 0, sizeof *r);
   r->outputs = outputs;
   r->action = r->error_max_nodal = r->error_estimate = NAN;
   r->morse_index = -1;
-  for (int k = 0; outputs && k < b->nout; k++)
-    outputs[k] = NAN;
+  for (int k = 0; outputs && k < b->nout; k++) outputs[k] = NAN;
   char err[400];
   cv_problem *p = NULL;
   const char *note = NULL;
@@ -327,17 +298,16 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals,
     snprintf(r->message, sizeof r->message, "out of memory while setting up the problem");
     goto done;
   }
-  if (b->nguess > 0)
-    cv_problem_set_guess(p, sc_batch_guess, w);
+  if (b->nguess > 0) cv_problem_set_guess(p, sc_batch_guess, w);
   if (scene_solver_configure(w->inst, w->sv, err, sizeof err) != CVAR_OK) {
     r->status = CVAR_EINVAL;
     snprintf(r->message, sizeof r->message, "%s", err);
     goto done;
   }
-  int warm = b->warm && w->inst->adapt <= 0 && w->inst->tol <= 0 && w->prev_row == row - 1 && w->prev_len > 0;
+  int warm = b->warm && w->inst->adapt <= 0 && w->inst->tol <= 0 && w->prev_row == row - 1 &&
+             w->prev_len > 0;
   cv_solver_set_start(w->sv, 0, NULL);
-  if (warm && warm_start(w) < 0)
-    warm = 0;
+  if (warm && warm_start(w) < 0) warm = 0;
   cv_status st = cv_solve(w->sv, p);
   if (warm && st != CVAR_OK) {
     /* the neighbour's solution led astray: the scene's own start, as `solve` would */
@@ -347,8 +317,10 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals,
     st = cv_solve(w->sv, p);
     warm = 0;
     static _Thread_local char nb[160];
-    snprintf(nb, sizeof nb, "(The warm start from row %d failed (%s); solved from the "
-             "scene's guess.)", row, why);
+    snprintf(nb, sizeof nb,
+             "(The warm start from row %d failed (%s); solved from the "
+             "scene's guess.)",
+             row, why);
     note = nb;
   }
   r->warm = warm;
@@ -359,10 +331,12 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals,
   if (st == CVAR_OK && scene_interior_singularity(w->inst, w->sv, &xs, &alpha) == 1) {
     /* as `solve` does: a finite discrete action of an infinite one (theory (SG-1)) */
     r->status = CVAR_ENONFINITE;
-    snprintf(r->message, sizeof r->message, "the integrand is singular at %s = %.6g inside "
+    snprintf(r->message, sizeof r->message,
+             "the integrand is singular at %s = %.6g inside "
              "the interval: along the path |F| grows like |%s - %.6g|^(-%.2f), so the "
              "action is infinite and the discrete answer (which changes with the mesh) is "
-             "no stationary path", w->inst->variable, xs, w->inst->variable, xs, alpha);
+             "no stationary path",
+             w->inst->variable, xs, w->inst->variable, xs, alpha);
     goto done;
   }
   if (st == CVAR_OK) {
@@ -374,20 +348,17 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals,
       degenerate = cv_solver_get_degenerate(w->sv);
       r->morse_index = morse;
     }
-    if (b->any_exact)
-      r->error_max_nodal = nodal_error(w);
+    if (b->any_exact) r->error_max_nodal = nodal_error(w);
     if (w->inst->adapt > 0 || w->inst->tol > 0)
       r->error_estimate = cv_solver_get_error_estimate(w->sv);
     if (outputs) {
       if (b->rep && eval_reports(b, w, outputs) < 0)
-        for (int k = 0; k < w->inst->nreports; k++)
-          outputs[k] = NAN;
+        for (int k = 0; k < w->inst->nreports; k++) outputs[k] = NAN;
       for (int k = 0; k < w->inst->nints; k++)
         if (cv_solver_get_multiplier(w->sv, k, &outputs[w->inst->nreports + k]) != CVAR_OK)
           outputs[w->inst->nreports + k] = NAN;
     }
-    if (b->warm)
-      keep_for_warm(w, row);
+    if (b->warm) keep_for_warm(w, row);
   }
   compose_message(r, w->sv, morse, nfree, degenerate, note);
 done:
@@ -395,23 +366,18 @@ done:
   r->time_s = sc_batch_now() - t0;
 }
 
-cv_problem *scene_batch_problem(cv_batch *b, const double *row, const scene **inst,
-                                char *err, size_t errlen)
-{
-  if (err && errlen)
-    err[0] = '\0';
+cv_problem *scene_batch_problem(cv_batch *b, const double *row, const scene **inst, char *err,
+                                size_t errlen) {
+  if (err && errlen) err[0] = '\0';
   if (!b || sc_batch_workers(b, 1) != CVAR_OK) {
     snprintf(err, errlen, "out of memory");
     return NULL;
   }
   worker *w = &b->w[0];
-  if (sc_batch_set_row(b, w->inst, w->pv, w->rv, w->rw, row, err, errlen) < 0)
-    return NULL;
+  if (sc_batch_set_row(b, w->inst, w->pv, w->rv, w->rw, row, err, errlen) < 0) return NULL;
   cv_problem *p = sc_batch_row_problem(b, w);
-  if (p && b->nguess > 0)
-    cv_problem_set_guess(p, sc_batch_guess, w);
-  if (!p)
-    snprintf(err, errlen, "%s: out of memory while setting up the problem", b->s->file);
+  if (p && b->nguess > 0) cv_problem_set_guess(p, sc_batch_guess, w);
+  if (!p) snprintf(err, errlen, "%s: out of memory while setting up the problem", b->s->file);
   *inst = w->inst;
   return p;
 }

@@ -8,22 +8,18 @@
 
 /* Only the first error matters to a person (later ones are often consequences), so a
  * message already in err is kept. line <= 0 means there is no line to point to. */
-void sc_err(char *err, size_t errlen, const char *file, int line, const char *fmt, ...)
-{
-  if (!err || errlen == 0 || err[0])
-    return;
-  int k = line > 0 ? snprintf(err, errlen, "%s:%d: ", file, line)
-                   : snprintf(err, errlen, "%s: ", file);
-  if (k < 0 || (size_t)k >= errlen)
-    return;
+void sc_err(char *err, size_t errlen, const char *file, int line, const char *fmt, ...) {
+  if (!err || errlen == 0 || err[0]) return;
+  int k =
+      line > 0 ? snprintf(err, errlen, "%s:%d: ", file, line) : snprintf(err, errlen, "%s: ", file);
+  if (k < 0 || (size_t)k >= errlen) return;
   va_list ap;
   va_start(ap, fmt);
   vsnprintf(err + k, errlen - (size_t)k, fmt, ap);
   va_end(ap);
 }
 
-char *sc_strndup(const char *s, size_t n)
-{
+char *sc_strndup(const char *s, size_t n) {
   char *r = cv_malloc(n + 1);
   if (r) {
     memcpy(r, s, n);

@@ -14,22 +14,18 @@ enum { BATCH = 256 };
  * outputs do not use them. Compiles one tape for all outputs, so shared subexpressions
  * are computed once. */
 int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const double *x,
-                  const double *y, const double *dy, double *out)
-{
+                  const double *y, const double *dy, double *out) {
   int n = s->n, np = s->params_as_inputs ? s->nparams : 0, ns = 1 + 2 * n + np, rc = -1;
-  if (nout == 0 || m == 0)
-    return 0;
+  if (nout == 0 || m == 0) return 0;
   ex_tape *t = ex_tape_new(s->dag, ns, nout, outs);
   const double **in = cv_malloc((size_t)ns * sizeof *in);
   double **o = cv_malloc((size_t)nout * sizeof *o);
   double *work = t ? cv_malloc((ex_tape_work_size(t, BATCH) + 1) * sizeof *work) : NULL;
   /* parameters as inputs: one batch per parameter filled with its value */
   double *pb = cv_malloc(((size_t)np * BATCH + 1) * sizeof *pb);
-  if (!t || !in || !o || !work || !pb)
-    goto done;
+  if (!t || !in || !o || !work || !pb) goto done;
   for (int j = 0; j < np; j++) {
-    for (int k = 0; k < BATCH; k++)
-      pb[(size_t)j * BATCH + k] = s->params[j].value;
+    for (int k = 0; k < BATCH; k++) pb[(size_t)j * BATCH + k] = s->params[j].value;
     in[1 + 2 * n + j] = pb + (size_t)j * BATCH;
   }
   for (int k0 = 0; k0 < m; k0 += BATCH) {
@@ -39,8 +35,7 @@ int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const doub
       in[1 + i] = y ? y + (size_t)i * m + k0 : NULL;
       in[1 + n + i] = dy ? dy + (size_t)i * m + k0 : NULL;
     }
-    for (int q = 0; q < nout; q++)
-      o[q] = out + (size_t)q * m + k0;
+    for (int q = 0; q < nout; q++) o[q] = out + (size_t)q * m + k0;
     ex_tape_eval(t, b, (const double *const *)in, (double *const *)o, work);
   }
   rc = 0;
@@ -53,13 +48,11 @@ done:
   return rc;
 }
 
-int scene_eval_exact(const scene *s, int m, const double *x, double *exact)
-{
+int scene_eval_exact(const scene *s, int m, const double *x, double *exact) {
   for (int i = 0; i < s->n; i++) {
     double *e = exact + (size_t)i * m;
     if (s->exact[i] < 0) {
-      for (int k = 0; k < m; k++)
-        e[k] = NAN;
+      for (int k = 0; k < m; k++) e[k] = NAN;
     } else if (sc_eval_exprs(s, 1, &s->exact[i], m, x, NULL, NULL, e) < 0) {
       return -1;
     }
@@ -69,14 +62,12 @@ int scene_eval_exact(const scene *s, int m, const double *x, double *exact)
 
 /* The default guess of SCENES.md [guess]: the straight line between the end values; with
  * one free end, the constant fixed value; with both free, 0. */
-int scene_eval_guess(const scene *s, int m, const double *x, double *y)
-{
+int scene_eval_guess(const scene *s, int m, const double *x, double *y) {
   for (int i = 0; i < s->n; i++) {
     double *g = y + (size_t)i * m;
     const sc_boundary *bc = &s->bc[i];
     if (s->guess[i] >= 0) {
-      if (sc_eval_exprs(s, 1, &s->guess[i], m, x, NULL, NULL, g) < 0)
-        return -1;
+      if (sc_eval_exprs(s, 1, &s->guess[i], m, x, NULL, NULL, g) < 0) return -1;
       continue;
     }
     for (int k = 0; k < m; k++) {
@@ -96,20 +87,14 @@ int scene_eval_guess(const scene *s, int m, const double *x, double *y)
 
 int scene_F_depends_on_variable(const scene *s) { return ex_depends_on(s->dag, s->F, 0); }
 
-int scene_F_depends_on_unknown(const scene *s, int i)
-{
-  return ex_depends_on(s->dag, s->F, 1 + i);
-}
+int scene_F_depends_on_unknown(const scene *s, int i) { return ex_depends_on(s->dag, s->F, 1 + i); }
 
 int scene_eval_reports(scene *s, int m, const double *x, const double *y, const double *dy,
-                       double *out)
-{
+                       double *out) {
   int nr = s->nreports, rc;
   ex_id *outs = cv_malloc((size_t)(nr + 1) * sizeof *outs);
-  if (!outs)
-    return -1;
-  for (int r = 0; r < nr; r++)
-    outs[r] = s->reports[r].expr;
+  if (!outs) return -1;
+  for (int r = 0; r < nr; r++) outs[r] = s->reports[r].expr;
   rc = sc_eval_exprs(s, nr, outs, m, x, y, dy, out);
   cv_free(outs);
   return rc;
@@ -117,19 +102,16 @@ int scene_eval_reports(scene *s, int m, const double *x, const double *y, const 
 
 /* Parameters as inputs: the values and everything computed from them, in the order the
  * loader computed them (scene.h). */
-int scene_set_parameters(scene *s, const unsigned char *given, const double *vals,
-                         char *err, size_t errlen)
-{
-  if (err && errlen)
-    err[0] = '\0';
+int scene_set_parameters(scene *s, const unsigned char *given, const double *vals, char *err,
+                         size_t errlen) {
+  if (err && errlen) err[0] = '\0';
   if (!s->params_as_inputs) {
     sc_err(err, errlen, s->file, 0, "the scene was loaded with its parameters folded");
     return -1;
   }
   for (int i = 0; i < s->nparams; i++) {
     double v = vals && given && given[i] ? vals[i] : NAN;
-    if (!(given && given[i]) && sc_eval_params(s, s->params[i].expr2, &v) < 0)
-      goto nomem;
+    if (!(given && given[i]) && sc_eval_params(s, s->params[i].expr2, &v) < 0) goto nomem;
     if (!isfinite(v)) {
       sc_err(err, errlen, s->file, 0, "parameter '%s' is not a finite number (%g)",
              s->params[i].name, v);
@@ -140,28 +122,28 @@ int scene_set_parameters(scene *s, const unsigned char *given, const double *val
   if (sc_eval_params(s, s->a_expr, &s->a) < 0 || sc_eval_params(s, s->b_expr, &s->b) < 0)
     goto nomem;
   if (!(s->a < s->b)) { /* also false for NaN */
-    sc_err(err, errlen, s->file, 0, "interval needs a < b, got a = %.17g, b = %.17g", s->a,
-           s->b);
+    sc_err(err, errlen, s->file, 0, "interval needs a < b, got a = %.17g, b = %.17g", s->a, s->b);
     return -1;
   }
   for (int i = 0; i < s->n; i++)
     for (int end = 0; end < 2; end++) {
-      if (s->bc[i].free_end[end])
-        continue;
-      if (sc_eval_params(s, s->bc[i].expr[end], &s->bc[i].value[end]) < 0)
-        goto nomem;
+      if (s->bc[i].free_end[end]) continue;
+      if (sc_eval_params(s, s->bc[i].expr[end], &s->bc[i].value[end]) < 0) goto nomem;
       if (!isfinite(s->bc[i].value[end])) {
-        sc_err(err, errlen, s->file, s->bc[i].line, "[boundary] %s at %s is not a finite "
-               "number", s->unknowns[i], end ? "b" : "a");
+        sc_err(err, errlen, s->file, s->bc[i].line,
+               "[boundary] %s at %s is not a finite "
+               "number",
+               s->unknowns[i], end ? "b" : "a");
         return -1;
       }
     }
   for (int k = 0; k < s->nints; k++) {
-    if (sc_eval_params(s, s->ints[k].expr2, &s->ints[k].value) < 0)
-      goto nomem;
+    if (sc_eval_params(s, s->ints[k].expr2, &s->ints[k].value) < 0) goto nomem;
     if (!isfinite(s->ints[k].value)) {
-      sc_err(err, errlen, s->file, s->ints[k].line, "[integrals] %s: the value c is not a "
-             "finite number", s->ints[k].name);
+      sc_err(err, errlen, s->file, s->ints[k].line,
+             "[integrals] %s: the value c is not a "
+             "finite number",
+             s->ints[k].name);
       return -1;
     }
   }
@@ -173,11 +155,9 @@ nomem:
   return -1;
 }
 
-scene *scene_instance_new(const scene *s)
-{
+scene *scene_instance_new(const scene *s) {
   scene *c = cv_malloc(sizeof *c);
-  if (!c)
-    return NULL;
+  if (!c) return NULL;
   *c = *s;
   c->is_instance = 1;
   c->params = cv_malloc(((size_t)s->nparams + 1) * sizeof *c->params);

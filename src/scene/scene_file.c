@@ -20,17 +20,18 @@
 
 #define STDIN_NAME "<stdin>"
 
-static const char *kind_of(mode_t m)
-{
-  return S_ISDIR(m) ? "a directory" : S_ISCHR(m) ? "a character device"
-         : S_ISBLK(m) ? "a block device" : S_ISFIFO(m) ? "a FIFO (named pipe)"
-         : S_ISSOCK(m) ? "a socket" : "not a regular file";
+static const char *kind_of(mode_t m) {
+  return S_ISDIR(m)    ? "a directory"
+         : S_ISCHR(m)  ? "a character device"
+         : S_ISBLK(m)  ? "a block device"
+         : S_ISFIFO(m) ? "a FIFO (named pipe)"
+         : S_ISSOCK(m) ? "a socket"
+                       : "not a regular file";
 }
 
 /* Read all of fd, at most SC_MAX_BYTES. Returns a malloc'd buffer (*len bytes) or NULL
  * with a message. */
-static char *read_all(int fd, const char *name, size_t *len, char *err, size_t errlen)
-{
+static char *read_all(int fd, const char *name, size_t *len, char *err, size_t errlen) {
   size_t cap = 4096, n = 0;
   char *buf = cv_malloc(cap);
   /* one byte more than the cap is read, to tell "exactly the cap" from "more" */
@@ -38,23 +39,20 @@ static char *read_all(int fd, const char *name, size_t *len, char *err, size_t e
     if (n == cap) {
       size_t ncap = cap * 2 > (size_t)SC_MAX_BYTES + 1 ? (size_t)SC_MAX_BYTES + 1 : cap * 2;
       char *nb = cv_realloc(buf, ncap);
-      if (!nb)
-        cv_free(buf);
+      if (!nb) cv_free(buf);
       buf = nb;
       cap = ncap;
       continue;
     }
     ssize_t k = read(fd, buf + n, cap - n);
-    if (k < 0 && errno == EINTR)
-      continue;
+    if (k < 0 && errno == EINTR) continue;
     if (k < 0) {
       int e = errno;
       cv_free(buf);
       sc_err(err, errlen, name, 0, "read error: %s", strerror(e));
       return NULL;
     }
-    if (k == 0)
-      break;
+    if (k == 0) break;
     n += (size_t)k;
   }
   if (!buf) {
@@ -63,21 +61,21 @@ static char *read_all(int fd, const char *name, size_t *len, char *err, size_t e
   }
   if (n > SC_MAX_BYTES) {
     cv_free(buf);
-    sc_err(err, errlen, name, 0, "the scene is larger than %d bytes (%d MiB), the most "
-           "calcvar reads; is this a scene file?", SC_MAX_BYTES, SC_MAX_BYTES >> 20);
+    sc_err(err, errlen, name, 0,
+           "the scene is larger than %d bytes (%d MiB), the most "
+           "calcvar reads; is this a scene file?",
+           SC_MAX_BYTES, SC_MAX_BYTES >> 20);
     return NULL;
   }
   *len = n;
   return buf;
 }
 
-static scene *load_file(const char *path, int nset, const sc_set *set, int inputs,
-                        char *err, size_t errlen)
-{
-  scene *(*from_buffer)(const char *, size_t, const char *, int, const sc_set *, char *,
-                        size_t) = inputs ? scene_load_buffer_inputs : scene_load_buffer;
-  if (err && errlen)
-    err[0] = '\0';
+static scene *load_file(const char *path, int nset, const sc_set *set, int inputs, char *err,
+                        size_t errlen) {
+  scene *(*from_buffer)(const char *, size_t, const char *, int, const sc_set *, char *, size_t) =
+      inputs ? scene_load_buffer_inputs : scene_load_buffer;
+  if (err && errlen) err[0] = '\0';
   size_t len = 0;
   char *buf;
   const char *name = path;
@@ -98,8 +96,10 @@ static scene *load_file(const char *path, int nset, const sc_set *set, int input
       return NULL;
     }
     if (!S_ISREG(st.st_mode)) {
-      sc_err(err, errlen, path, 0, "cannot read a scene from %s; give a scene file, or '-' "
-             "for standard input", kind_of(st.st_mode));
+      sc_err(err, errlen, path, 0,
+             "cannot read a scene from %s; give a scene file, or '-' "
+             "for standard input",
+             kind_of(st.st_mode));
       return NULL;
     }
     int fd = open(path, O_RDONLY | O_NOCTTY | O_NONBLOCK);
@@ -110,28 +110,26 @@ static scene *load_file(const char *path, int nset, const sc_set *set, int input
     /* the path may have been replaced between stat and open: check what was opened */
     if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
       close(fd);
-      sc_err(err, errlen, path, 0, "cannot read a scene from %s; give a scene file, or '-' "
-             "for standard input", kind_of(st.st_mode));
+      sc_err(err, errlen, path, 0,
+             "cannot read a scene from %s; give a scene file, or '-' "
+             "for standard input",
+             kind_of(st.st_mode));
       return NULL;
     }
     buf = read_all(fd, path, &len, err, errlen);
     close(fd);
   }
-  if (!buf)
-    return NULL;
+  if (!buf) return NULL;
   scene *s = from_buffer(buf, len, name, nset, set, err, errlen);
   cv_free(buf);
   return s;
 }
 
-scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err,
-                       size_t errlen)
-{
+scene *scene_load_file(const char *path, int nset, const sc_set *set, char *err, size_t errlen) {
   return load_file(path, nset, set, 0, err, errlen);
 }
 
 scene *scene_load_file_inputs(const char *path, int nset, const sc_set *set, char *err,
-                              size_t errlen)
-{
+                              size_t errlen) {
   return load_file(path, nset, set, 1, err, errlen);
 }

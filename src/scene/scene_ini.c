@@ -19,18 +19,16 @@
 typedef struct {
   sc_llines *ll;
   sc_raw *raw;
-  int next;   /* next logical line the reader hands out */
-  int cur;    /* the logical line inih is processing */
+  int next; /* next logical line the reader hands out */
+  int cur;  /* the logical line inih is processing */
   char *err;
   size_t errlen;
   int failed;
 } feed;
 
-static char *reader(char *str, int num, void *stream)
-{
+static char *reader(char *str, int num, void *stream) {
   feed *f = stream;
-  if (f->next >= f->ll->n)
-    return NULL;
+  if (f->next >= f->ll->n) return NULL;
   f->cur = f->next++;
   const sc_lline *l = &f->ll->l[f->cur];
   if (l->is_section)
@@ -40,8 +38,7 @@ static char *reader(char *str, int num, void *stream)
   return str;
 }
 
-static int handler(void *user, const char *section, const char *name, const char *value)
-{
+static int handler(void *user, const char *section, const char *name, const char *value) {
   feed *f = user;
   sc_lline *l = &f->ll->l[f->cur];
   const char *file = f->raw->file;
@@ -57,8 +54,8 @@ static int handler(void *user, const char *section, const char *name, const char
   }
   int sec = sc_section_from_name(section);
   if (sec < 0) {
-    sc_err(f->err, f->errlen, file, l->line,
-           "'%s' is outside any section (start with [scene])", name);
+    sc_err(f->err, f->errlen, file, l->line, "'%s' is outside any section (start with [scene])",
+           name);
     f->failed = 1;
     return 0;
   }
@@ -82,11 +79,9 @@ static int handler(void *user, const char *section, const char *name, const char
   return 1;
 }
 
-void sc_raw_free(sc_raw *raw)
-{
+void sc_raw_free(sc_raw *raw) {
   for (int s = 0; s < SEC_COUNT; s++) {
-    for (int i = 0; i < raw->ne[s]; i++)
-      sc_entry_free(&raw->e[s][i]);
+    for (int i = 0; i < raw->ne[s]; i++) sc_entry_free(&raw->e[s][i]);
     cv_free(raw->e[s]);
     raw->e[s] = NULL;
     raw->ne[s] = 0;
@@ -94,16 +89,13 @@ void sc_raw_free(sc_raw *raw)
 }
 
 int sc_raw_read(sc_raw *raw, const char *text, size_t len, const char *file, char *err,
-                size_t errlen)
-{
+                size_t errlen) {
   sc_llines ll;
   memset(raw, 0, sizeof *raw);
   raw->file = file;
-  if (sc_llines_read(&ll, text, len, file, err, errlen) < 0)
-    return -1;
+  if (sc_llines_read(&ll, text, len, file, err, errlen) < 0) return -1;
   for (int i = 0; i < ll.n; i++)
-    if (ll.l[i].is_section)
-      raw->sec_line[ll.l[i].section] = ll.l[i].line;
+    if (ll.l[i].is_section) raw->sec_line[ll.l[i].section] = ll.l[i].line;
 
   feed f = {&ll, raw, 0, 0, err, errlen, 0};
   int r = ini_parse_stream(reader, &f, handler, &f);

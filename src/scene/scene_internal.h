@@ -29,8 +29,20 @@ typedef struct {
 } sc_entry;
 
 typedef enum {
-  SEC_SCENE, SEC_PARAMETERS, SEC_DEFINITIONS, SEC_BOUNDARY, SEC_GUESS, SEC_CONSTRAINTS,
-  SEC_INTEGRALS, SEC_EXACT, SEC_REPORT, SEC_MESH, SEC_SOLVER, SEC_TABLES, SEC_PLOT, SEC_COUNT
+  SEC_SCENE,
+  SEC_PARAMETERS,
+  SEC_DEFINITIONS,
+  SEC_BOUNDARY,
+  SEC_GUESS,
+  SEC_CONSTRAINTS,
+  SEC_INTEGRALS,
+  SEC_EXACT,
+  SEC_REPORT,
+  SEC_MESH,
+  SEC_SOLVER,
+  SEC_TABLES,
+  SEC_PLOT,
+  SEC_COUNT
 } sc_section;
 
 /* A logical line: a section header or a key line (with its continuations). */
@@ -96,8 +108,8 @@ typedef struct {
 
 /* scene_parse.c */
 ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what);
-int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
-                   const char *what, double *value);
+int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what,
+                   double *value);
 /* The same, also giving the expression (an expression of the parameters when they are
  * inputs; node may be NULL). */
 int sc_parse_const_node(sc_loader *L, const sc_entry *e, int off, const char *text,

@@ -16,47 +16,40 @@
 #include "scene/scene_internal.h"
 
 static const char *const section_names[SEC_COUNT] = {
-  "scene", "parameters", "definitions", "boundary", "guess", "constraints",
-  "integrals", "exact", "report", "mesh", "solver", "tables", "plot"};
+    "scene", "parameters", "definitions", "boundary", "guess",  "constraints", "integrals",
+    "exact", "report",     "mesh",        "solver",   "tables", "plot"};
 
 /* Longest key passed to inih: its reader hands out at most INI_MAX_LINE = 200 bytes per
  * line, and "KEY = @INDEX\n" must fit. No legitimate name comes close. */
 enum { MAX_KEY = 100 };
 
-const char *sc_section_name(int sec)
-{
+const char *sc_section_name(int sec) {
   return sec >= 0 && sec < SEC_COUNT ? section_names[sec] : "?";
 }
 
-int sc_section_from_name(const char *name)
-{
+int sc_section_from_name(const char *name) {
   for (int i = 0; i < SEC_COUNT; i++)
-    if (strcmp(name, section_names[i]) == 0)
-      return i;
+    if (strcmp(name, section_names[i]) == 0) return i;
   return -1;
 }
 
 static int is_ws(char c) { return c == ' ' || c == '\t'; }
 
-void sc_entry_free(sc_entry *e)
-{
+void sc_entry_free(sc_entry *e) {
   cv_free(e->key);
   cv_free(e->value);
   cv_free(e->pieces);
   memset(e, 0, sizeof *e);
 }
 
-void sc_llines_free(sc_llines *ll)
-{
-  for (int i = 0; i < ll->n; i++)
-    sc_entry_free(&ll->l[i].entry);
+void sc_llines_free(sc_llines *ll) {
+  for (int i = 0; i < ll->n; i++) sc_entry_free(&ll->l[i].entry);
   cv_free(ll->l);
   ll->l = NULL;
   ll->n = 0;
 }
 
-void sc_entry_locate(const sc_entry *e, int off, int *line, int *col)
-{
+void sc_entry_locate(const sc_entry *e, int off, int *line, int *col) {
   *line = e->line;
   *col = 0;
   for (int i = 0; i < e->npieces; i++)
@@ -67,8 +60,7 @@ void sc_entry_locate(const sc_entry *e, int off, int *line, int *col)
 }
 
 /* Show at most 40 characters of a bad line in a message. */
-static void excerpt(char *dst, size_t cap, const char *s, size_t n)
-{
+static void excerpt(char *dst, size_t cap, const char *s, size_t n) {
   size_t k = n < cap - 4 ? n : cap - 4;
   memcpy(dst, s, k);
   if (k < n)
@@ -77,13 +69,11 @@ static void excerpt(char *dst, size_t cap, const char *s, size_t n)
     dst[k] = '\0';
 }
 
-static sc_lline *push(sc_llines *ll, int *cap)
-{
+static sc_lline *push(sc_llines *ll, int *cap) {
   if (ll->n == *cap) {
     int nc = *cap ? 2 * *cap : 16;
     sc_lline *l = cv_realloc(ll->l, (size_t)nc * sizeof *l);
-    if (!l)
-      return NULL;
+    if (!l) return NULL;
     ll->l = l;
     *cap = nc;
   }
@@ -93,20 +83,15 @@ static sc_lline *push(sc_llines *ll, int *cap)
 }
 
 /* Append a continuation piece (text t of length n, read at line/col) to entry e. */
-static int append_piece(sc_entry *e, const char *t, size_t n, int line, int col)
-{
+static int append_piece(sc_entry *e, const char *t, size_t n, int line, int col) {
   size_t old = strlen(e->value);
   char *v = cv_realloc(e->value, old + n + 2);
   sc_piece *p = cv_realloc(e->pieces, (size_t)(e->npieces + 1) * sizeof *p);
-  if (v)
-    e->value = v;
-  if (p)
-    e->pieces = p;
-  if (!v || !p)
-    return -1;
+  if (v) e->value = v;
+  if (p) e->pieces = p;
+  if (!v || !p) return -1;
   size_t off = old;
-  if (old > 0)
-    v[off++] = ' ';
+  if (old > 0) v[off++] = ' ';
   memcpy(v + off, t, n);
   v[off + n] = '\0';
   e->pieces[e->npieces].off = (int)off;
@@ -118,8 +103,7 @@ static int append_piece(sc_entry *e, const char *t, size_t n, int line, int col)
 
 /* Read the text into logical lines. Returns 0, or -1 with a message in err. */
 int sc_llines_read(sc_llines *ll, const char *text, size_t len, const char *file, char *err,
-                   size_t errlen)
-{
+                   size_t errlen) {
   int cap = 0, line = 0, seen[SEC_COUNT] = {0};
   sc_lline *cur_key = NULL; /* the key line that indented lines continue */
   char buf[48];
@@ -141,8 +125,7 @@ int sc_llines_read(sc_llines *ll, const char *text, size_t len, const char *file
       sc_err(err, errlen, file, line, "a NUL byte: this is not a text file");
       goto fail;
     }
-    if (n > 0 && s[n - 1] == '\r')
-      n--; /* CRLF line ends */
+    if (n > 0 && s[n - 1] == '\r') n--; /* CRLF line ends */
 
     /* A comment starts at '#' or ';' at the start of the line or after white space. */
     for (size_t i = 0; i < n; i++)
@@ -151,18 +134,14 @@ int sc_llines_read(sc_llines *ll, const char *text, size_t len, const char *file
         break;
       }
     size_t lead = 0;
-    while (lead < n && is_ws(s[lead]))
-      lead++;
-    while (n > lead && is_ws(s[n - 1]))
-      n--;
-    if (lead == n)
-      continue; /* blank or comment: does not end a continued value (as in inih) */
+    while (lead < n && is_ws(s[lead])) lead++;
+    while (n > lead && is_ws(s[n - 1])) n--;
+    if (lead == n) continue; /* blank or comment: does not end a continued value (as in inih) */
     const char *t = s + lead;
     size_t tn = n - lead;
 
     if (lead > 0 && cur_key) {
-      if (append_piece(&cur_key->entry, t, tn, line, (int)lead + 1) < 0)
-        goto nomem;
+      if (append_piece(&cur_key->entry, t, tn, line, (int)lead + 1) < 0) goto nomem;
       continue;
     }
     cur_key = NULL;
@@ -171,15 +150,15 @@ int sc_llines_read(sc_llines *ll, const char *text, size_t len, const char *file
       if (!close || close != t + tn - 1) {
         excerpt(buf, sizeof buf, t, tn);
         sc_err(err, errlen, file, line,
-               close ? "text after the section header '%s'" : "a section header needs a "
-                       "closing ']': '%s'", buf);
+               close ? "text after the section header '%s'"
+                     : "a section header needs a "
+                       "closing ']': '%s'",
+               buf);
         goto fail;
       }
       size_t a = 1, b = tn - 1;
-      while (a < b && is_ws(t[a]))
-        a++;
-      while (b > a && is_ws(t[b - 1]))
-        b--;
+      while (a < b && is_ws(t[a])) a++;
+      while (b > a && is_ws(t[b - 1])) b--;
       char name[32];
       int sec = -1;
       if (b - a < sizeof name) {
@@ -191,18 +170,18 @@ int sc_llines_read(sc_llines *ll, const char *text, size_t len, const char *file
         excerpt(buf, sizeof buf, t + a, b - a);
         sc_err(err, errlen, file, line,
                "unknown section [%s] (known: scene, parameters, definitions, boundary, "
-               "guess, constraints, integrals, exact, report, mesh, solver)", buf);
+               "guess, constraints, integrals, exact, report, mesh, solver)",
+               buf);
         goto fail;
       }
       if (seen[sec]) {
-        sc_err(err, errlen, file, line, "section [%s] is given twice (first at line %d)",
-               name, seen[sec]);
+        sc_err(err, errlen, file, line, "section [%s] is given twice (first at line %d)", name,
+               seen[sec]);
         goto fail;
       }
       seen[sec] = line;
       sc_lline *l = push(ll, &cap);
-      if (!l)
-        goto nomem;
+      if (!l) goto nomem;
       l->is_section = 1;
       l->section = sec;
       l->line = line;
@@ -211,13 +190,11 @@ int sc_llines_read(sc_llines *ll, const char *text, size_t len, const char *file
     const char *eq = memchr(t, '=', tn);
     if (!eq) {
       excerpt(buf, sizeof buf, t, tn);
-      sc_err(err, errlen, file, line, "expected 'name = value' or '[section]', got '%s'",
-             buf);
+      sc_err(err, errlen, file, line, "expected 'name = value' or '[section]', got '%s'", buf);
       goto fail;
     }
     size_t kn = (size_t)(eq - t);
-    while (kn > 0 && is_ws(t[kn - 1]))
-      kn--;
+    while (kn > 0 && is_ws(t[kn - 1])) kn--;
     if (kn == 0) {
       sc_err(err, errlen, file, line, "a name is missing before '='");
       goto fail;
@@ -227,19 +204,15 @@ int sc_llines_read(sc_llines *ll, const char *text, size_t len, const char *file
       goto fail;
     }
     const char *v = eq + 1;
-    while (v < t + tn && is_ws(*v))
-      v++;
+    while (v < t + tn && is_ws(*v)) v++;
     sc_lline *l = push(ll, &cap);
-    if (!l)
-      goto nomem;
+    if (!l) goto nomem;
     l->line = line;
     l->entry.line = line;
     l->entry.key = sc_strndup(t, kn);
     l->entry.value = sc_strdup("");
-    if (!l->entry.key || !l->entry.value)
-      goto nomem;
-    if (append_piece(&l->entry, v, (size_t)(t + tn - v), line, (int)(v - s) + 1) < 0)
-      goto nomem;
+    if (!l->entry.key || !l->entry.value) goto nomem;
+    if (append_piece(&l->entry, v, (size_t)(t + tn - v), line, (int)(v - s) + 1) < 0) goto nomem;
     cur_key = l;
   }
   return 0;

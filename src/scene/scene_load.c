@@ -18,17 +18,13 @@ int sc_load_mesh(sc_loader *L);
 int sc_load_solver(sc_loader *L);
 int sc_load_plot(sc_loader *L);
 
-static void items_free(sc_item *it, int n)
-{
-  for (int i = 0; i < n; i++)
-    cv_free(it[i].name);
+static void items_free(sc_item *it, int n) {
+  for (int i = 0; i < n; i++) cv_free(it[i].name);
   cv_free(it);
 }
 
-void scene_free(scene *s)
-{
-  if (!s)
-    return;
+void scene_free(scene *s) {
+  if (!s) return;
   if (s->is_instance) { /* only what scene_instance_new copied */
     cv_free(s->params);
     cv_free(s->bc);
@@ -39,8 +35,7 @@ void scene_free(scene *s)
   cv_free(s->file);
   cv_free(s->title);
   cv_free(s->variable);
-  for (int i = 0; i < s->n; i++)
-    cv_free(s->unknowns[i]);
+  for (int i = 0; i < s->n; i++) cv_free(s->unknowns[i]);
   cv_free(s->unknowns);
   cv_free(s->plot_down);
   cv_free(s->bc);
@@ -56,25 +51,21 @@ void scene_free(scene *s)
   cv_free(s);
 }
 
-static const sc_entry *find_entry(const sc_loader *L, int sec, const char *key)
-{
+static const sc_entry *find_entry(const sc_loader *L, int sec, const char *key) {
   for (int i = 0; i < L->raw.ne[sec]; i++)
-    if (strcmp(L->raw.e[sec][i].key, key) == 0)
-      return &L->raw.e[sec][i];
+    if (strcmp(L->raw.e[sec][i].key, key) == 0) return &L->raw.e[sec][i];
   return NULL;
 }
 
 /* Keys of a fixed-key section must come from `keys` (NULL-terminated). */
-int sc_check_keys(sc_loader *L, int sec, const char *const *keys, const char *list)
-{
+int sc_check_keys(sc_loader *L, int sec, const char *const *keys, const char *list) {
   for (int i = 0; i < L->raw.ne[sec]; i++) {
     const sc_entry *e = &L->raw.e[sec][i];
     int ok = 0;
-    for (int k = 0; keys[k]; k++)
-      ok |= strcmp(e->key, keys[k]) == 0;
+    for (int k = 0; keys[k]; k++) ok |= strcmp(e->key, keys[k]) == 0;
     if (!ok) {
-      sc_err(L->err, L->errlen, L->file, e->line, "unknown key '%s' in [%s] (known: %s)",
-             e->key, sc_section_name(sec), list);
+      sc_err(L->err, L->errlen, L->file, e->line, "unknown key '%s' in [%s] (known: %s)", e->key,
+             sc_section_name(sec), list);
       return -1;
     }
   }
@@ -82,37 +73,29 @@ int sc_check_keys(sc_loader *L, int sec, const char *const *keys, const char *li
 }
 
 /* Is `name` already taken by the variable, an unknown, a parameter or a definition? */
-static const char *taken(const scene *s, const char *name)
-{
-  if (s->variable && strcmp(name, s->variable) == 0)
-    return "the variable";
+static const char *taken(const scene *s, const char *name) {
+  if (s->variable && strcmp(name, s->variable) == 0) return "the variable";
   for (int i = 0; i < s->n; i++)
-    if (strcmp(name, s->unknowns[i]) == 0)
-      return "an unknown";
+    if (strcmp(name, s->unknowns[i]) == 0) return "an unknown";
   for (int i = 0; i < s->nparams; i++)
-    if (s->params[i].name && strcmp(name, s->params[i].name) == 0)
-      return "a parameter";
+    if (s->params[i].name && strcmp(name, s->params[i].name) == 0) return "a parameter";
   for (int i = 0; i < s->ndefs; i++)
-    if (s->defs[i].name && strcmp(name, s->defs[i].name) == 0)
-      return "a definition";
-  if (ex_dag_find_table(s->dag, name) >= 0)
-    return "a table";
+    if (s->defs[i].name && strcmp(name, s->defs[i].name) == 0) return "a definition";
+  if (ex_dag_find_table(s->dag, name) >= 0) return "a table";
   return NULL;
 }
 
 /* A new name for the variable, an unknown, a parameter or a definition. */
-int sc_check_new_name(sc_loader *L, int line, const char *name, const char *role)
-{
+int sc_check_new_name(sc_loader *L, int line, const char *name, const char *role) {
   const char *t;
   if (!ex_is_identifier(name)) {
     sc_err(L->err, L->errlen, L->file, line,
-           "'%s' is not a valid %s name (letters, digits and '_', starting with a letter)",
-           name, role);
+           "'%s' is not a valid %s name (letters, digits and '_', starting with a letter)", name,
+           role);
     return -1;
   }
   if (sc_is_reserved(name)) {
-    sc_err(L->err, L->errlen, L->file, line, "'%s' is reserved and cannot name %s", name,
-           role);
+    sc_err(L->err, L->errlen, L->file, line, "'%s' is reserved and cannot name %s", name, role);
     return -1;
   }
   if ((t = taken(L->s, name)) != NULL) {
@@ -122,10 +105,9 @@ int sc_check_new_name(sc_loader *L, int line, const char *name, const char *role
   return 0;
 }
 
-static int load_scene_section(sc_loader *L)
-{
-  static const char *const keys[] = {"title", "variable", "interval", "unknowns",
-                                     "integrand", NULL};
+static int load_scene_section(sc_loader *L) {
+  static const char *const keys[] = {"title",    "variable",  "interval",
+                                     "unknowns", "integrand", NULL};
   scene *s = L->s;
   int hl = L->raw.sec_line[SEC_SCENE];
   if (!hl) {
@@ -137,11 +119,9 @@ static int load_scene_section(sc_loader *L)
   const sc_entry *e = find_entry(L, SEC_SCENE, "title");
   s->title = sc_strdup(e ? e->value : L->file);
   e = find_entry(L, SEC_SCENE, "variable");
-  if (e && sc_check_new_name(L, e->line, e->value, "variable") < 0)
-    return -1;
+  if (e && sc_check_new_name(L, e->line, e->value, "variable") < 0) return -1;
   s->variable = sc_strdup(e ? e->value : "x");
-  if (!s->title || !s->variable)
-    goto nomem;
+  if (!s->title || !s->variable) goto nomem;
 
   e = find_entry(L, SEC_SCENE, "unknowns");
   if (!e) {
@@ -149,8 +129,7 @@ static int load_scene_section(sc_loader *L)
     return -1;
   }
   ex_list list;
-  if (ex_list_split(e->value, &list) < 0)
-    goto nomem;
+  if (ex_list_split(e->value, &list) < 0) goto nomem;
   s->unknowns = cv_calloc((size_t)list.n, sizeof *s->unknowns);
   if (!s->unknowns) {
     ex_list_free(&list);
@@ -172,8 +151,7 @@ static int load_scene_section(sc_loader *L)
     return -1;
   }
   if (!find_entry(L, SEC_SCENE, "integrand")) {
-    sc_err(L->err, L->errlen, L->file, hl, "[scene] needs 'integrand = F(%s, ...)'",
-           s->variable);
+    sc_err(L->err, L->errlen, L->file, hl, "[scene] needs 'integrand = F(%s, ...)'", s->variable);
     return -1;
   }
   return 0;
@@ -184,8 +162,7 @@ nomem:
 
 /* [parameters] in order; an override replaces a parameter's expression, so later
  * parameters built from it follow. */
-static int load_parameters(sc_loader *L, int nset, const sc_set *set)
-{
+static int load_parameters(sc_loader *L, int nset, const sc_set *set) {
   scene *s = L->s;
   int ne = L->raw.ne[SEC_PARAMETERS];
   s->params = cv_calloc((size_t)ne + 1, sizeof *s->params);
@@ -195,8 +172,7 @@ static int load_parameters(sc_loader *L, int nset, const sc_set *set)
   }
   for (int i = 0; i < ne; i++) {
     const sc_entry *e = &L->raw.e[SEC_PARAMETERS][i];
-    if (sc_check_new_name(L, e->line, e->key, "parameter") < 0)
-      return -1;
+    if (sc_check_new_name(L, e->line, e->key, "parameter") < 0) return -1;
     s->params[i].name = sc_strdup(e->key);
     s->params[i].line = e->line;
     s->params[i].expr2 = -1;
@@ -208,12 +184,12 @@ static int load_parameters(sc_loader *L, int nset, const sc_set *set)
   }
   for (int k = 0; k < nset; k++) {
     int found = 0;
-    for (int i = 0; i < ne; i++)
-      found |= strcmp(set[k].name, s->params[i].name) == 0;
+    for (int i = 0; i < ne; i++) found |= strcmp(set[k].name, s->params[i].name) == 0;
     if (!found) {
-      sc_err(L->err, L->errlen, L->file, 0, "--set %s=%s: '%s' is not a parameter of this "
-             "scene%s", set[k].name, set[k].value, set[k].name,
-             ne ? "" : " (it has no [parameters])");
+      sc_err(L->err, L->errlen, L->file, 0,
+             "--set %s=%s: '%s' is not a parameter of this "
+             "scene%s",
+             set[k].name, set[k].value, set[k].name, ne ? "" : " (it has no [parameters])");
       return -1;
     }
   }
@@ -222,8 +198,7 @@ static int load_parameters(sc_loader *L, int nset, const sc_set *set)
     const sc_entry *e = &L->raw.e[SEC_PARAMETERS][i];
     const sc_set *over = NULL;
     for (int k = 0; k < nset; k++)
-      if (strcmp(set[k].name, e->key) == 0)
-        over = &set[k]; /* the last --set of a name wins */
+      if (strcmp(set[k].name, e->key) == 0) over = &set[k]; /* the last --set of a name wins */
     L->limit = i;
     char what[160];
     ex_id *def = &s->params[i].expr2; /* kept only with parameters as inputs */
@@ -235,8 +210,7 @@ static int load_parameters(sc_loader *L, int nset, const sc_set *set)
         return -1;
     } else {
       snprintf(what, sizeof what, "parameter '%s'", e->key);
-      if (sc_parse_const_node(L, e, 0, e->value, what, &s->params[i].value, def) < 0)
-        return -1;
+      if (sc_parse_const_node(L, e, 0, e->value, what, &s->params[i].value, def) < 0) return -1;
     }
     s->params[i].expr = s->params_as_inputs ? ex_slot(s->dag, 1 + 2 * s->n + i)
                                             : ex_num(s->dag, s->params[i].value);
@@ -248,8 +222,7 @@ static int load_parameters(sc_loader *L, int nset, const sc_set *set)
   return 0;
 }
 
-static int load_definitions(sc_loader *L)
-{
+static int load_definitions(sc_loader *L) {
   scene *s = L->s;
   int ne = L->raw.ne[SEC_DEFINITIONS];
   s->defs = cv_calloc((size_t)ne + 1, sizeof *s->defs);
@@ -260,8 +233,7 @@ static int load_definitions(sc_loader *L)
   /* Names first, so that a use before the definition is told as such. */
   for (int i = 0; i < ne; i++) {
     const sc_entry *e = &L->raw.e[SEC_DEFINITIONS][i];
-    if (sc_check_new_name(L, e->line, e->key, "definition") < 0)
-      return -1;
+    if (sc_check_new_name(L, e->line, e->key, "definition") < 0) return -1;
     s->defs[i].name = sc_strdup(e->key);
     s->defs[i].line = e->line;
     s->defs[i].expr = s->defs[i].expr2 = -1;
@@ -277,15 +249,13 @@ static int load_definitions(sc_loader *L)
     char what[160];
     snprintf(what, sizeof what, "definition '%s'", e->key);
     L->limit = i;
-    if ((s->defs[i].expr = sc_parse(L, e, 0, e->value, what)) < 0)
-      return -1;
+    if ((s->defs[i].expr = sc_parse(L, e, 0, e->value, what)) < 0) return -1;
   }
   L->limit = ne;
   return 0;
 }
 
-static int load_interval_integrand(sc_loader *L)
-{
+static int load_interval_integrand(sc_loader *L) {
   scene *s = L->s;
   const sc_entry *e = find_entry(L, SEC_SCENE, "interval");
   ex_list list;
@@ -295,24 +265,21 @@ static int load_interval_integrand(sc_loader *L)
   }
   int rc = -1;
   if (list.n != 2) {
-    sc_err(L->err, L->errlen, L->file, e->line,
-           "interval needs two values 'a, b', got %d", list.n);
+    sc_err(L->err, L->errlen, L->file, e->line, "interval needs two values 'a, b', got %d", list.n);
     goto done;
   }
-  if (sc_parse_const_node(L, e, list.off[0], list.item[0], "interval start a", &s->a,
-                          &s->a_expr) < 0 ||
-      sc_parse_const_node(L, e, list.off[1], list.item[1], "interval end b", &s->b,
-                          &s->b_expr) < 0)
+  if (sc_parse_const_node(L, e, list.off[0], list.item[0], "interval start a", &s->a, &s->a_expr) <
+          0 ||
+      sc_parse_const_node(L, e, list.off[1], list.item[1], "interval end b", &s->b, &s->b_expr) < 0)
     goto done;
   if (!(s->a < s->b)) {
-    sc_err(L->err, L->errlen, L->file, e->line,
-           "interval needs a < b, got a = %.17g, b = %.17g", s->a, s->b);
+    sc_err(L->err, L->errlen, L->file, e->line, "interval needs a < b, got a = %.17g, b = %.17g",
+           s->a, s->b);
     goto done;
   }
   e = find_entry(L, SEC_SCENE, "integrand");
   s->F_line = e->line;
-  if ((s->F = sc_parse(L, e, 0, e->value, "integrand")) < 0)
-    goto done;
+  if ((s->F = sc_parse(L, e, 0, e->value, "integrand")) < 0) goto done;
   rc = 0;
 done:
   ex_list_free(&list);
@@ -320,12 +287,10 @@ done:
 }
 
 static scene *load_buffer(const char *text, size_t len, const char *name, int nset,
-                          const sc_set *set, int inputs, char *err, size_t errlen)
-{
+                          const sc_set *set, int inputs, char *err, size_t errlen) {
   sc_loader L;
   memset(&L, 0, sizeof L);
-  if (err && errlen)
-    err[0] = '\0';
+  if (err && errlen) err[0] = '\0';
   scene *s = cv_calloc(1, sizeof *s);
   if (!s || !(s->file = sc_strdup(name ? name : "scene")) || !(s->dag = ex_dag_new())) {
     scene_free(s);
@@ -343,12 +308,10 @@ static scene *load_buffer(const char *text, size_t len, const char *name, int ns
     scene_free(s);
     return NULL;
   }
-  if (load_scene_section(&L) < 0 || sc_load_tables(&L) < 0 ||
-      load_parameters(&L, nset, set) < 0 ||
-      load_definitions(&L) < 0 || load_interval_integrand(&L) < 0 ||
-      sc_load_boundary(&L) < 0 || sc_load_guess_exact(&L) < 0 ||
-      sc_load_constraints(&L) < 0 || sc_load_report(&L) < 0 || sc_load_mesh(&L) < 0 ||
-      sc_load_solver(&L) < 0 || sc_load_plot(&L) < 0) {
+  if (load_scene_section(&L) < 0 || sc_load_tables(&L) < 0 || load_parameters(&L, nset, set) < 0 ||
+      load_definitions(&L) < 0 || load_interval_integrand(&L) < 0 || sc_load_boundary(&L) < 0 ||
+      sc_load_guess_exact(&L) < 0 || sc_load_constraints(&L) < 0 || sc_load_report(&L) < 0 ||
+      sc_load_mesh(&L) < 0 || sc_load_solver(&L) < 0 || sc_load_plot(&L) < 0) {
     sc_raw_free(&L.raw);
     scene_free(s);
     return NULL;
@@ -358,13 +321,11 @@ static scene *load_buffer(const char *text, size_t len, const char *name, int ns
 }
 
 scene *scene_load_buffer(const char *text, size_t len, const char *name, int nset,
-                         const sc_set *set, char *err, size_t errlen)
-{
+                         const sc_set *set, char *err, size_t errlen) {
   return load_buffer(text, len, name, nset, set, 0, err, errlen);
 }
 
 scene *scene_load_buffer_inputs(const char *text, size_t len, const char *name, int nset,
-                                const sc_set *set, char *err, size_t errlen)
-{
+                                const sc_set *set, char *err, size_t errlen) {
   return load_buffer(text, len, name, nset, set, 1, err, errlen);
 }

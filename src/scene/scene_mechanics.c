@@ -15,15 +15,13 @@ typedef struct {
   double *start;      /* [n] */
 } adapter;
 
-static void adapter_free(adapter *a)
-{
+static void adapter_free(adapter *a) {
   cv_free(a->ids);
   cv_free(a->names);
   cv_free(a->start);
 }
 
-static int adapter_new(const scene *s, int with_start, adapter *a)
-{
+static int adapter_new(const scene *s, int with_start, adapter *a) {
   int n = s->n, nc = s->ncons, ni = s->nints;
   memset(a, 0, sizeof *a);
   a->ids = cv_malloc((size_t)(nc + ni + 1) * sizeof *a->ids);
@@ -34,8 +32,7 @@ static int adapter_new(const scene *s, int with_start, adapter *a)
     adapter_free(a);
     return -1;
   }
-  for (int i = 0; i < n; i++)
-    a->names[i] = s->unknowns[i];
+  for (int i = 0; i < n; i++) a->names[i] = s->unknowns[i];
   for (int c = 0; c < nc; c++) {
     a->ids[c] = s->cons[c].expr;
     a->names[n + c] = s->cons[c].name;
@@ -62,52 +59,42 @@ static int adapter_new(const scene *s, int with_start, adapter *a)
 }
 
 /* The scene line of a mech_problem entry (MECH_AT_*), 0 for none. */
-static int line_of(const scene *s, int at)
-{
-  if (at == MECH_AT_F)
-    return s->F_line;
+static int line_of(const scene *s, int at) {
+  if (at == MECH_AT_F) return s->F_line;
   int k = at - MECH_AT_CONS;
-  if (k >= 0 && k < s->ncons)
-    return s->cons[k].line;
-  if (k >= s->ncons && k < s->ncons + s->nints)
-    return s->ints[k - s->ncons].line;
+  if (k >= 0 && k < s->ncons) return s->cons[k].line;
+  if (k >= s->ncons && k < s->ncons + s->nints) return s->ints[k - s->ncons].line;
   return 0;
 }
 
-cv_status scene_equations_new(const scene *s, mech_equations *eq, char *err, size_t errlen)
-{
+cv_status scene_equations_new(const scene *s, mech_equations *eq, char *err, size_t errlen) {
   char why[SC_ERRLEN] = "";
   adapter a;
   memset(eq, 0, sizeof *eq);
   eq->hamiltonian = -1;
-  if (err && errlen)
-    err[0] = '\0';
+  if (err && errlen) err[0] = '\0';
   if (adapter_new(s, 0, &a) < 0) {
     sc_err(err, errlen, s->file, 0, "out of memory while building the equations");
     return CVAR_ENOMEM;
   }
   cv_status st = mech_equations_new(&a.mp, eq, why, sizeof why);
   adapter_free(&a);
-  if (st != CVAR_OK)
-    sc_err(err, errlen, s->file, 0, "%s", why);
+  if (st != CVAR_OK) sc_err(err, errlen, s->file, 0, "%s", why);
   return st;
 }
 
-cv_status scene_modes_new(const scene *s, mech_modes *md, char *err, size_t errlen)
-{
+cv_status scene_modes_new(const scene *s, mech_modes *md, char *err, size_t errlen) {
   char why[SC_ERRLEN] = "";
   int at = MECH_AT_NONE;
   adapter a;
   memset(md, 0, sizeof *md);
-  if (err && errlen)
-    err[0] = '\0';
+  if (err && errlen) err[0] = '\0';
   if (adapter_new(s, 1, &a) < 0) {
     sc_err(err, errlen, s->file, 0, "out of memory while computing the modes");
     return CVAR_ENOMEM;
   }
   cv_status st = mech_modes_new(&a.mp, md, &at, why, sizeof why);
   adapter_free(&a);
-  if (st != CVAR_OK)
-    sc_err(err, errlen, s->file, line_of(s, at), "%s", why);
+  if (st != CVAR_OK) sc_err(err, errlen, s->file, line_of(s, at), "%s", why);
   return st;
 }

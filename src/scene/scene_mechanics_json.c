@@ -14,25 +14,21 @@
 #include "scene/scene_mechanics.h"
 
 /* e printed in the scene grammar; NULL on allocation failure. */
-static char *print_expr(const scene *s, const mech_equations *eq, ex_id e)
-{
+static char *print_expr(const scene *s, const mech_equations *eq, ex_id e) {
   const char *const *names = (const char *const *)eq->names;
   size_t len = ex_print(s->dag, e, names, NULL, 0) + 1;
   char *buf = cv_malloc(len);
-  if (buf)
-    ex_print(s->dag, e, names, buf, len);
+  if (buf) ex_print(s->dag, e, names, buf, len);
   return buf;
 }
 
-int scene_eq_texts_make(scene_eq_texts *t, const scene *s, const mech_equations *eq)
-{
+int scene_eq_texts_make(scene_eq_texts *t, const scene *s, const mech_equations *eq) {
   int n = s->n;
   memset(t, 0, sizeof *t);
   t->n = n;
   t->mom = cv_calloc((size_t)n + 1, sizeof *t->mom);
   t->el = cv_calloc((size_t)n + 1, sizeof *t->el);
-  if (!t->mom || !t->el)
-    return -1;
+  if (!t->mom || !t->el) return -1;
   for (int i = 0; i < n; i++)
     if (!(t->mom[i] = print_expr(s, eq, eq->momentum[i])) ||
         !(t->el[i] = print_expr(s, eq, eq->el[i])))
@@ -43,13 +39,10 @@ int scene_eq_texts_make(scene_eq_texts *t, const scene *s, const mech_equations 
   return 0;
 }
 
-void scene_eq_texts_free(scene_eq_texts *t)
-{
+void scene_eq_texts_free(scene_eq_texts *t) {
   for (int i = 0; i < t->n; i++) {
-    if (t->mom)
-      cv_free(t->mom[i]);
-    if (t->el)
-      cv_free(t->el[i]);
+    if (t->mom) cv_free(t->mom[i]);
+    if (t->el) cv_free(t->el[i]);
   }
   cv_free(t->mom);
   cv_free(t->el);
@@ -58,8 +51,7 @@ void scene_eq_texts_free(scene_eq_texts *t)
   memset(t, 0, sizeof *t);
 }
 
-char *scene_equations_json(const scene *s, const mech_equations *eq, const scene_eq_texts *t)
-{
+char *scene_equations_json(const scene *s, const mech_equations *eq, const scene_eq_texts *t) {
   json_t *o = json_object(), *mom = json_object(), *el = json_object(), *cyc = json_array();
   char *text = NULL;
   if (!o || !mom || !el || !cyc) {
@@ -71,8 +63,7 @@ char *scene_equations_json(const scene *s, const mech_equations *eq, const scene
   for (int i = 0; i < s->n; i++) {
     json_object_set_new(mom, s->unknowns[i], json_string(t->mom[i]));
     json_object_set_new(el, s->unknowns[i], json_string(t->el[i]));
-    if (eq->cyclic[i])
-      json_array_append_new(cyc, json_string(s->unknowns[i]));
+    if (eq->cyclic[i]) json_array_append_new(cyc, json_string(s->unknowns[i]));
   }
   json_object_set_new(o, "momenta", mom);
   json_object_set_new(o, "euler_lagrange", el);
@@ -85,13 +76,11 @@ done:
   return text;
 }
 
-const char *scene_mode_kind_name(mech_mode_kind k)
-{
+const char *scene_mode_kind_name(mech_mode_kind k) {
   return k == MECH_MODE_STABLE ? "stable" : k == MECH_MODE_UNSTABLE ? "unstable" : "neutral";
 }
 
-char *scene_modes_json(const scene *s, const mech_modes *md)
-{
+char *scene_modes_json(const scene *s, const mech_modes *md) {
   int n = s->n;
   json_t *o = json_object(), *eqm = json_object(), *modes = json_array();
   char *text = NULL;
@@ -123,8 +112,7 @@ char *scene_modes_json(const scene *s, const mech_modes *md)
   /* Addition to the contract: the multipliers of [constraints] at the equilibrium. */
   if (md->nc > 0) {
     json_t *mu = json_object();
-    if (!mu)
-      goto done;
+    if (!mu) goto done;
     for (int c = 0; c < md->nc; c++)
       json_object_set_new(mu, s->cons[c].name, json_real(md->multipliers[c]));
     json_object_set_new(o, "multipliers", mu);

@@ -12,8 +12,7 @@
 #endif
 
 /* The name of a slot for messages: the variable, y or y'. */
-const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap)
-{
+const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap) {
   if (slot == 0)
     snprintf(buf, cap, "%s", s->variable);
   else if (slot <= s->n)
@@ -24,46 +23,40 @@ const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap)
 }
 
 /* First slot in [from, to] that e depends on, or -1. */
-int sc_first_slot(const scene *s, ex_id e, int from, int to)
-{
+int sc_first_slot(const scene *s, ex_id e, int from, int to) {
   for (int k = from; k <= to; k++)
-    if (ex_depends_on(s->dag, e, k))
-      return k;
+    if (ex_depends_on(s->dag, e, k)) return k;
   return -1;
 }
 
-static int find_name(char *const *names, int n, const char *name)
-{
+static int find_name(char *const *names, int n, const char *name) {
   for (int i = 0; i < n; i++)
-    if (strcmp(names[i], name) == 0)
-      return i;
+    if (strcmp(names[i], name) == 0) return i;
   return -1;
 }
 
-static int find_item(const sc_item *it, int n, const char *name)
-{
+static int find_item(const sc_item *it, int n, const char *name) {
   for (int i = 0; i < n; i++)
-    if (it[i].name && strcmp(it[i].name, name) == 0)
-      return i;
+    if (it[i].name && strcmp(it[i].name, name) == 0) return i;
   return -1;
 }
 
 /* Resolve a name for ex_parse. Parameters become their numbers and definitions their
  * nodes, so both are substituted where named (SCENES.md [definitions]). */
 static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *err,
-                     size_t errlen)
-{
+                     size_t errlen) {
   sc_loader *L = user;
   scene *s = L->s;
   int i;
 
-  if (strcmp(name, "pi") == 0 && primes == 0)
-    return ex_num(d, M_PI);
+  if (strcmp(name, "pi") == 0 && primes == 0) return ex_num(d, M_PI);
   if ((i = find_item(s->params, s->nparams, name)) >= 0) {
     if (L->mode == SC_R_PARAM && i >= L->limit) {
-      snprintf(err, errlen, i == L->limit ? "parameter '%s' refers to itself"
-                                          : "parameter '%s' is used before it is defined "
-                                            "(line %d)", name, s->params[i].line);
+      snprintf(err, errlen,
+               i == L->limit ? "parameter '%s' refers to itself"
+                             : "parameter '%s' is used before it is defined "
+                               "(line %d)",
+               name, s->params[i].line);
       return -1;
     }
     if (primes) {
@@ -72,22 +65,25 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
     }
     if (s->params_as_inputs) {
       ex_id r = ex_slot(d, 1 + 2 * s->n + i); /* an input of the tape, not a number */
-      if (r < 0)
-        snprintf(err, errlen, "out of memory");
+      if (r < 0) snprintf(err, errlen, "out of memory");
       return r;
     }
     return ex_num(d, s->params[i].value);
   }
   if (L->mode == SC_R_PARAM) {
-    snprintf(err, errlen, "unknown name '%s' (a parameter may use only numbers, pi and "
-             "earlier parameters)", name);
+    snprintf(err, errlen,
+             "unknown name '%s' (a parameter may use only numbers, pi and "
+             "earlier parameters)",
+             name);
     return -1;
   }
   if ((i = find_item(s->defs, s->ndefs, name)) >= 0) {
     if (i >= L->limit) {
-      snprintf(err, errlen, i == L->limit ? "definition '%s' refers to itself"
-                                          : "definition '%s' is used before it is defined "
-                                            "(line %d)", name, s->defs[i].line);
+      snprintf(err, errlen,
+               i == L->limit ? "definition '%s' refers to itself"
+                             : "definition '%s' is used before it is defined "
+                               "(line %d)",
+               name, s->defs[i].line);
       return -1;
     }
     if (primes) {
@@ -98,16 +94,17 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
   }
   if (strcmp(name, s->variable) == 0) {
     if (primes) {
-      snprintf(err, errlen, "a prime is only allowed on an unknown, not on the variable "
-               "'%s'", name);
+      snprintf(err, errlen,
+               "a prime is only allowed on an unknown, not on the variable "
+               "'%s'",
+               name);
       return -1;
     }
     return ex_slot(d, 0);
   }
   if ((i = find_name(s->unknowns, s->n, name)) >= 0) {
     if (primes > 1) {
-      snprintf(err, errlen, "only first derivatives may appear: '%s' has %d primes", name,
-               primes);
+      snprintf(err, errlen, "only first derivatives may appear: '%s' has %d primes", name, primes);
       return -1;
     }
     return ex_slot(d, primes ? 1 + s->n + i : 1 + i);
@@ -118,8 +115,7 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
 
 /* Parse text, which starts at offset off of entry e's value. On failure the message
  * points at the physical line (and column) of the offending character. */
-ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what)
-{
+ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what) {
   char msg[400] = "";
   int line, col;
   if (text[0] == '\0') {
@@ -132,8 +128,7 @@ ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const
     /* A constant that is not finite (0/0, log(0), sqrt(-1)*0) is bad input, never a NaN
      * carried into the solve (theory (EX-1)). */
     ex_id bad = ex_nonfinite_const(L->s->dag, r);
-    if (bad == -1)
-      return r;
+    if (bad == -1) return r;
     char sub[160] = "?";
     double v = NAN;
     if (bad >= 0) {
@@ -144,8 +139,13 @@ ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const
     if (bad == -2)
       sc_err(L->err, L->errlen, L->file, line, "%s: out of memory", what);
     else
-      sc_err(L->err, L->errlen, L->file, line, "%s: the constant '%s' is not a finite number "
-             "(%s)", what, sub, isnan(v) ? "NaN" : v > 0 ? "+inf" : "-inf");
+      sc_err(L->err, L->errlen, L->file, line,
+             "%s: the constant '%s' is not a finite number "
+             "(%s)",
+             what, sub,
+             isnan(v) ? "NaN"
+             : v > 0  ? "+inf"
+                      : "-inf");
     return -1;
   }
   int c = 0, k = 0;
@@ -161,25 +161,20 @@ ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const
 
 /* A constant expression (numbers, pi, parameters, definitions built from those), which
  * must be finite. Returns 0, or -1 with a message. */
-int sc_eval_params(const scene *s, ex_id e, double *value)
-{
+int sc_eval_params(const scene *s, ex_id e, double *value) {
   int ns = 1 + 2 * s->n + s->nparams;
   double *slots = cv_calloc((size_t)ns, sizeof *slots);
-  if (!slots)
-    return -1;
-  for (int i = 0; i < s->nparams; i++)
-    slots[1 + 2 * s->n + i] = s->params[i].value;
+  if (!slots) return -1;
+  for (int i = 0; i < s->nparams; i++) slots[1 + 2 * s->n + i] = s->params[i].value;
   int rc = ex_eval(s->dag, e, slots, value);
   cv_free(slots);
   return rc;
 }
 
-int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
-                   const char *what, double *value)
-{
+int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what,
+                   double *value) {
   ex_id node;
-  if (sc_parse_const_node(L, e, off, text, what, value, &node) < 0)
-    return -1;
+  if (sc_parse_const_node(L, e, off, text, what, value, &node) < 0) return -1;
   /* A [mesh] or [solver] number: kept as a number even when it uses parameters (the
    * batch refuses such a scene when a row sets one, docs/cli.md). */
   if (L->s->params_as_inputs && !L->s->settings_line &&
@@ -189,15 +184,12 @@ int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text,
 }
 
 int sc_parse_const_node(sc_loader *L, const sc_entry *e, int off, const char *text,
-                        const char *what, double *value, ex_id *node)
-{
+                        const char *what, double *value, ex_id *node) {
   char nb[128];
   int line, col;
   ex_id r = sc_parse(L, e, off, text, what);
-  if (node)
-    *node = -1;
-  if (r < 0)
-    return -1;
+  if (node) *node = -1;
+  if (r < 0) return -1;
   sc_entry_locate(e, off, &line, &col);
   int slot = sc_first_slot(L->s, r, 0, 2 * L->s->n);
   int bad = slot >= 0;
@@ -216,11 +208,12 @@ int sc_parse_const_node(sc_loader *L, const sc_entry *e, int off, const char *te
     return -1;
   }
   if (!isfinite(*value)) {
-    sc_err(L->err, L->errlen, L->file, line, "%s '%s' is not a finite number (%s)", what,
-           text, isnan(*value) ? "NaN" : *value > 0 ? "+inf" : "-inf");
+    sc_err(L->err, L->errlen, L->file, line, "%s '%s' is not a finite number (%s)", what, text,
+           isnan(*value) ? "NaN"
+           : *value > 0  ? "+inf"
+                         : "-inf");
     return -1;
   }
-  if (node)
-    *node = r;
+  if (node) *node = r;
   return 0;
 }

@@ -8,15 +8,12 @@
 #include "scene/scene_internal.h"
 
 /* cv_guess_fn over the scene's [guess] (and the default for unknowns without one). */
-static int guess_cb(int m, const double *x, double *y, void *user)
-{
+static int guess_cb(int m, const double *x, double *y, void *user) {
   return scene_eval_guess(user, m, x, y) < 0 ? -1 : 0;
 }
 
 /* An integrand object for e; with parameters as inputs they are set to their values. */
-static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *msg,
-                             size_t len)
-{
+static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *msg, size_t len) {
   int np = s->params_as_inputs ? s->nparams : 0;
   ex_integrand *g = ex_integrand_new_params(s->dag, s->n, np, e, max_need, msg, len);
   if (g && np) {
@@ -25,20 +22,17 @@ static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *m
       ex_integrand_free(g);
       return NULL;
     }
-    for (int i = 0; i < np; i++)
-      v[i] = s->params[i].value;
+    for (int i = 0; i < np; i++) v[i] = s->params[i].value;
     ex_integrand_set_params(g, v);
     cv_free(v);
   }
   return g;
 }
 
-cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size_t errlen)
-{
+cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size_t errlen) {
   cv_status why;
   char msg[512] = "";
-  if (err && errlen)
-    err[0] = '\0';
+  if (err && errlen) err[0] = '\0';
   cv_problem *p = cv_problem_new(s->n, s->a, s->b, &why);
   if (!p) {
     sc_err(err, errlen, s->file, 0, "cannot create the problem: %s", cv_strerror(why));
@@ -76,8 +70,8 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
              msg[0] ? msg : "out of memory");
       goto fail;
     }
-    why = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g,
-                                          ex_integrand_release, NULL);
+    why = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g, ex_integrand_release,
+                                          NULL);
     if (why == CVAR_OK && ex_integrand_has_tables(g))
       why = cv_problem_add_note(p, ex_integrand_note, g);
     if (why != CVAR_OK) {
@@ -93,8 +87,8 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
              msg[0] ? msg : "out of memory");
       goto fail;
     }
-    why = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release,
-                                        it->value, NULL);
+    why = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release, it->value,
+                                        NULL);
     if (why == CVAR_OK && ex_integrand_has_tables(g))
       why = cv_problem_add_note(p, ex_integrand_note, g);
     if (why != CVAR_OK) {
@@ -103,8 +97,7 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
     }
   }
   int any_guess = 0;
-  for (int i = 0; i < s->n; i++)
-    any_guess |= s->guess[i] >= 0;
+  for (int i = 0; i < s->n; i++) any_guess |= s->guess[i] >= 0;
   /* Without [guess] the core's default is the same as ours (SCENES.md). */
   if (any_guess && (why = cv_problem_set_guess(p, guess_cb, (void *)s)) != CVAR_OK) {
     sc_err(err, errlen, s->file, 0, "[guess]: %s", cv_strerror(why));
@@ -116,11 +109,9 @@ fail:
   return NULL;
 }
 
-cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_t errlen)
-{
+cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_t errlen) {
   const char *what = "elements";
-  if (err && errlen)
-    err[0] = '\0';
+  if (err && errlen) err[0] = '\0';
   cv_status st = s->grading > 0
                      ? cv_solver_set_mesh_graded(sv, s->elements, s->grading, s->graded_end)
                      : cv_solver_set_elements(sv, s->elements);
@@ -153,7 +144,6 @@ cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_
     st = cv_solver_set_method(sv, s->method);
   }
   if (st != CVAR_OK)
-    sc_err(err, errlen, s->file, 0, "%s: %s (%s)", what, cv_solver_last_error(sv),
-           cv_strerror(st));
+    sc_err(err, errlen, s->file, 0, "%s: %s (%s)", what, cv_solver_last_error(sv), cv_strerror(st));
   return st;
 }

@@ -14,25 +14,18 @@
 
 #include "scene/scene_report.h"
 
-const char *cli_status_string(cv_status st)
-{
+const char *cli_status_string(cv_status st) {
   switch (st) {
-  case CVAR_OK:
-    return "converged";
-  case CVAR_EMAXITER:
-    return "max_iterations";
+  case CVAR_OK: return "converged";
+  case CVAR_EMAXITER: return "max_iterations";
   case CVAR_ENONFINITE:
-  case CVAR_EDIVERGED:
-    return "diverged";
-  case CVAR_ESINGULAR:
-    return "singular";
-  default:
-    return "no_progress";
+  case CVAR_EDIVERGED: return "diverged";
+  case CVAR_ESINGULAR: return "singular";
+  default: return "no_progress";
   }
 }
 
-void cli_report_free(cli_report *r)
-{
+void cli_report_free(cli_report *r) {
   cv_free(r->has_mom);
   cv_free(r->mom_min);
   cv_free(r->mom_max);
@@ -48,13 +41,11 @@ void cli_report_free(cli_report *r)
 }
 
 /* min and max of v[0..m-1]; returns 0 when every value is finite, else -1. */
-static int range(const double *v, int m, double *lo, double *hi)
-{
+static int range(const double *v, int m, double *lo, double *hi) {
   *lo = INFINITY;
   *hi = -INFINITY;
   for (int k = 0; k < m; k++) {
-    if (!isfinite(v[k]))
-      return -1;
+    if (!isfinite(v[k])) return -1;
     *lo = v[k] < *lo ? v[k] : *lo;
     *hi = v[k] > *hi ? v[k] : *hi;
   }
@@ -63,13 +54,10 @@ static int range(const double *v, int m, double *lo, double *hi)
 
 /* Max over nodes and unknowns of |y_h - y_exact| at the nodes, over the unknowns that
  * have an [exact] expression. */
-static int nodal_error(cli_report *r, const scene *s)
-{
+static int nodal_error(cli_report *r, const scene *s) {
   int nn = r->nodes, n = s->n, any = 0;
-  for (int i = 0; i < n; i++)
-    any |= s->exact[i] >= 0;
-  if (!any)
-    return 0;
+  for (int i = 0; i < n; i++) any |= s->exact[i] >= 0;
+  if (!any) return 0;
   double *ex = cv_malloc((size_t)nn * n * sizeof *ex);
   if (!ex || scene_eval_exact(s, nn, r->x, ex) < 0) {
     cv_free(ex);
@@ -97,11 +85,8 @@ static int nodal_error(cli_report *r, const scene *s)
  * equation of a cyclic unknown makes exactly these averages of its momentum equal
  * (discrete Noether, docs/theory.md), whereas inside an element the momentum varies by
  * O(h^p); energy averages drift at O(h^2p) on smooth problems (docs/cli.md). */
-static int elem_avg_range(const double *v, const double *w, int nq, int E, double *lo,
-                          double *hi)
-{
-  if (E <= 0 || nq % E != 0)
-    return range(v, nq, lo, hi);
+static int elem_avg_range(const double *v, const double *w, int nq, int E, double *lo, double *hi) {
+  if (E <= 0 || nq % E != 0) return range(v, nq, lo, hi);
   int q = nq / E;
   *lo = INFINITY;
   *hi = -INFINITY;
@@ -112,8 +97,7 @@ static int elem_avg_range(const double *v, const double *w, int nq, int E, doubl
       sw += w[k];
     }
     double a = sv / sw;
-    if (!isfinite(a))
-      return -1;
+    if (!isfinite(a)) return -1;
     *lo = a < *lo ? a : *lo;
     *hi = a > *hi ? a : *hi;
   }
@@ -121,32 +105,26 @@ static int elem_avg_range(const double *v, const double *w, int nq, int E, doubl
 }
 
 /* Whether any [constraints] or [integrals] expression depends on the slot. */
-static int constraints_depend_on(const scene *s, int slot)
-{
+static int constraints_depend_on(const scene *s, int slot) {
   for (int k = 0; k < s->ncons; k++)
-    if (ex_depends_on(s->dag, s->cons[k].expr, slot))
-      return 1;
+    if (ex_depends_on(s->dag, s->cons[k].expr, slot)) return 1;
   for (int k = 0; k < s->nints; k++)
-    if (ex_depends_on(s->dag, s->ints[k].expr, slot))
-      return 1;
+    if (ex_depends_on(s->dag, s->ints[k].expr, slot)) return 1;
   return 0;
 }
 
 /* Energy, momenta and report integrals at the quadrature points. Energy and momenta come
  * from the problem's compiled integrand (the partials the solver used). */
-static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv)
-{
+static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv) {
   int n = s->n, nq = cv_solver_get_num_qpoints(sv), rc = -1;
-  if (nq <= 0)
-    return 0;
+  if (nq <= 0) return 0;
   size_t q = (size_t)nq;
   double *x = cv_malloc(q * sizeof *x), *w = cv_malloc(q * sizeof *w);
   double *y = cv_malloc(q * n * sizeof *y), *dy = cv_malloc(q * n * sizeof *dy);
   size_t nv = q * (size_t)(n > s->nreports ? n : s->nreports);
   double *v = cv_malloc((nv > q ? nv : q) * sizeof *v);
   double *H = cv_malloc(q * sizeof *H), *mom = cv_malloc(q * n * sizeof *mom);
-  if (!x || !w || !y || !dy || !v || !H || !mom)
-    goto done;
+  if (!x || !w || !y || !dy || !v || !H || !mom) goto done;
   if (cv_solver_get_qpoints(sv, x, w, y, dy) != CVAR_OK) {
     rc = 0; /* nothing to evaluate on: leave the keys out */
     goto done;
@@ -155,23 +133,19 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
    * variable and there is no integral constraint (whose multiplier enters the conserved
    * quantity); a momentum only when no constraint involves that unknown (docs/cli.md). */
   cv_status st = cv_problem_eval_energy(p, nq, x, y, dy, H, mom);
-  if (st == CVAR_ENOMEM)
-    goto done;
+  if (st == CVAR_ENOMEM) goto done;
   /* A callback that fails here leaves energy and momenta out, as non-finite values do. */
   int have = st == CVAR_OK;
-  if (have && !scene_F_depends_on_variable(s) && s->nints == 0 &&
-      !constraints_depend_on(s, 0))
+  if (have && !scene_F_depends_on_variable(s) && s->nints == 0 && !constraints_depend_on(s, 0))
     r->has_energy = elem_avg_range(H, w, nq, r->elements, &r->emin, &r->emax) == 0;
   for (int i = 0; i < n && have; i++)
     if (!scene_F_depends_on_unknown(s, i) && !constraints_depend_on(s, 1 + i))
-      r->has_mom[i] = elem_avg_range(mom + (size_t)i * q, w, nq, r->elements,
-                                     &r->mom_min[i], &r->mom_max[i]) == 0;
-  if (s->nreports > 0 && scene_eval_reports(s, nq, x, y, dy, v) < 0)
-    goto done;
+      r->has_mom[i] = elem_avg_range(mom + (size_t)i * q, w, nq, r->elements, &r->mom_min[i],
+                                     &r->mom_max[i]) == 0;
+  if (s->nreports > 0 && scene_eval_reports(s, nq, x, y, dy, v) < 0) goto done;
   for (int k = 0; k < s->nreports; k++) {
     double sum = 0;
-    for (int j = 0; j < nq; j++)
-      sum += w[j] * v[(size_t)k * q + j];
+    for (int j = 0; j < nq; j++) sum += w[j] * v[(size_t)k * q + j];
     r->rep[k] = sum;
     r->has_rep[k] = isfinite(sum);
   }
@@ -187,16 +161,15 @@ done:
   return rc;
 }
 
-static void compose_message(cli_report *r, cv_solver *sv)
-{
+static void compose_message(cli_report *r, cv_solver *sv) {
   const char *detail = cv_solver_last_error(sv);
   if (r->st != CVAR_OK) {
-    snprintf(r->message, sizeof r->message, "%s", detail && detail[0] ? detail
-                                                                      : cv_strerror(r->st));
+    snprintf(r->message, sizeof r->message, "%s",
+             detail && detail[0] ? detail : cv_strerror(r->st));
     return;
   }
-  int k = snprintf(r->message, sizeof r->message, "Converged in %d iteration%s",
-                   r->iterations, r->iterations == 1 ? "" : "s");
+  int k = snprintf(r->message, sizeof r->message, "Converged in %d iteration%s", r->iterations,
+                   r->iterations == 1 ? "" : "s");
   if (r->kind && k > 0 && (size_t)k < sizeof r->message) {
     if (strcmp(r->kind, "degenerate") == 0)
       snprintf(r->message + k, sizeof r->message - (size_t)k,
@@ -213,14 +186,12 @@ static void compose_message(cli_report *r, cv_solver *sv)
   if (detail && detail[0] && strncmp(detail, "converged in ", 13) != 0 &&
       used + 2 < sizeof r->message)
     snprintf(r->message + used, sizeof r->message - used, " %c%s.",
-             detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A' : detail[0],
-             detail + 1);
+             detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A' : detail[0], detail + 1);
 }
 
 /* Fill r after cv_solve returned st. Returns 0, or -1 on allocation failure. */
-int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv,
-                       cv_method m, cv_status st)
-{
+int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv, cv_method m,
+                       cv_status st) {
   int n = s->n;
   memset(r, 0, sizeof *r);
   r->sc = s;
@@ -233,8 +204,7 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
   r->nodes = cv_solver_get_num_nodes(sv);
   if (r->elements > 0) {
     r->degrees = cv_malloc((size_t)r->elements * sizeof *r->degrees);
-    if (!r->degrees)
-      return -1;
+    if (!r->degrees) return -1;
     cv_solver_get_degrees(sv, r->degrees);
   }
   r->iterations = cv_solver_get_num_iterations(sv);
@@ -255,8 +225,8 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
   r->y = cv_calloc((size_t)nn * n + 1, sizeof *r->y);
   if (!r->has_mom || !r->mom_min || !r->mom_max || !r->has_rep || !r->rep || !r->x || !r->y)
     return -1;
-  if (nn > 0 && (cv_solver_get_nodes(sv, r->x) != CVAR_OK ||
-                 cv_solver_get_values(sv, r->y) != CVAR_OK))
+  if (nn > 0 &&
+      (cv_solver_get_nodes(sv, r->x) != CVAR_OK || cv_solver_get_values(sv, r->y) != CVAR_OK))
     r->nodes = nn = 0;
 
   /* The Morse index describes a stationary point: reported only when Newton converged to
@@ -276,42 +246,34 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
         r->kind = "saddle";
     }
   }
-  if (nn > 0 && nodal_error(r, s) < 0)
-    return -1;
+  if (nn > 0 && nodal_error(r, s) < 0) return -1;
   /* Multiplier fields (CSV lambda_NAME) and integral multipliers (JSON multipliers). */
   if (nn > 0 && s->ncons > 0) {
     r->lam = cv_malloc((size_t)nn * s->ncons * sizeof *r->lam);
-    if (!r->lam)
-      return -1;
+    if (!r->lam) return -1;
     for (int c = 0; c < s->ncons; c++)
       if (cv_solver_get_multiplier_field(sv, c, r->lam + (size_t)c * nn) != CVAR_OK)
-        for (int j = 0; j < nn; j++)
-          r->lam[(size_t)c * nn + j] = NAN;
+        for (int j = 0; j < nn; j++) r->lam[(size_t)c * nn + j] = NAN;
   }
   r->has_mu = cv_calloc((size_t)s->nints + 1, sizeof *r->has_mu);
   r->mu = cv_calloc((size_t)s->nints + 1, sizeof *r->mu);
-  if (!r->has_mu || !r->mu)
-    return -1;
+  if (!r->has_mu || !r->mu) return -1;
   for (int k = 0; k < s->nints; k++)
     r->has_mu[k] = cv_solver_get_multiplier(sv, k, &r->mu[k]) == CVAR_OK && isfinite(r->mu[k]);
   if (s->has_exact_action && r->has_action) {
     r->has_err_action = 1;
     r->err_action = fabs(r->action - s->exact_action);
   }
-  if (nn > 0 && qpoint_quantities(r, s, p, sv) < 0)
-    return -1;
+  if (nn > 0 && qpoint_quantities(r, s, p, sv) < 0) return -1;
   compose_message(r, sv);
   return 0;
 }
 
 int cli_report_build(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv, cv_status st,
-                     int adaptive)
-{
-  if (cli_report_collect(r, s, p, sv, cv_solver_get_method(sv), st) < 0)
-    return -1;
+                     int adaptive) {
+  if (cli_report_collect(r, s, p, sv, cv_solver_get_method(sv), st) < 0) return -1;
   int any_exact = 0;
-  for (int i = 0; i < s->n; i++)
-    any_exact |= s->exact[i] >= 0;
+  for (int i = 0; i < s->n; i++) any_exact |= s->exact[i] >= 0;
   if (adaptive) {
     /* the rounds' own estimate (theory HP-2); with --tol always, and the degrees */
     double est = cv_solver_get_error_estimate(sv);

@@ -51,16 +51,16 @@ typedef struct {
 } cli_report;
 
 const char *cli_status_string(cv_status st);
-int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv,
-                       cv_method m, cv_status st);
+int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *sv, cv_method m,
+                       cv_status st);
 /* scene_estimate.c: the max nodal error of the solver's last solve, from the core's
  * estimator (theory HP-2, HP-3; docs/cli.md). cli_estimate_error gives the max over all
  * nodes and over the element boundaries (NaN, and the reason in why, when there is no
  * bound); cli_report_estimate puts it into r (or the reason into its message). Both return
  * 0, or -1 on allocation failure. */
 int cli_report_estimate(cli_report *r, const cv_solver *sv, const cv_problem *p);
-int cli_estimate_error(const cv_solver *sv, const cv_problem *p, double *e_all,
-                       double *e_vertex, char *why, size_t len);
+int cli_estimate_error(const cv_solver *sv, const cv_problem *p, double *e_all, double *e_vertex,
+                       char *why, size_t len);
 void cli_report_free(cli_report *r);
 
 /* Collect and, without [exact], estimate the error: the rounds' own estimate when

@@ -14,31 +14,24 @@ int sc_load_guess_exact(sc_loader *L);
 int sc_load_constraints(sc_loader *L);
 int sc_load_report(sc_loader *L);
 
-static int unknown_index(const scene *s, const char *name)
-{
+static int unknown_index(const scene *s, const char *name) {
   for (int i = 0; i < s->n; i++)
-    if (strcmp(s->unknowns[i], name) == 0)
-      return i;
+    if (strcmp(s->unknowns[i], name) == 0) return i;
   return -1;
 }
 
-static int nomem(sc_loader *L, int line)
-{
+static int nomem(sc_loader *L, int line) {
   sc_err(L->err, L->errlen, L->file, line, "out of memory");
   return -1;
 }
 
 /* Levenshtein distance of two short words, capped: for "did you mean 'free'?". */
-static int distance(const char *a, const char *b)
-{
+static int distance(const char *a, const char *b) {
   size_t na = strlen(a), nb = strlen(b);
-  if (na > 12 || nb > 12)
-    return 99;
+  if (na > 12 || nb > 12) return 99;
   int d[13][13];
-  for (size_t i = 0; i <= na; i++)
-    d[i][0] = (int)i;
-  for (size_t j = 0; j <= nb; j++)
-    d[0][j] = (int)j;
+  for (size_t i = 0; i <= na; i++) d[i][0] = (int)i;
+  for (size_t j = 0; j <= nb; j++) d[0][j] = (int)j;
   for (size_t i = 1; i <= na; i++)
     for (size_t j = 1; j <= nb; j++) {
       int c = d[i - 1][j - 1] + (tolower((unsigned char)a[i - 1]) != b[j - 1]);
@@ -50,44 +43,33 @@ static int distance(const char *a, const char *b)
 
 /* Is this item a misspelt `free` (Free, FREE, fre, frее...)? Only bare words that are not
  * names of the scene qualify, so a parameter called `fee` still works. */
-static int looks_like_free(const scene *s, const char *t)
-{
-  if (!ex_is_identifier(t) || strcmp(t, "free") == 0 || distance(t, "free") > 1)
-    return 0;
-  if (unknown_index(s, t) >= 0 || strcmp(t, s->variable) == 0)
-    return 0;
+static int looks_like_free(const scene *s, const char *t) {
+  if (!ex_is_identifier(t) || strcmp(t, "free") == 0 || distance(t, "free") > 1) return 0;
+  if (unknown_index(s, t) >= 0 || strcmp(t, s->variable) == 0) return 0;
   for (int i = 0; i < s->nparams; i++)
-    if (strcmp(t, s->params[i].name) == 0)
-      return 0;
+    if (strcmp(t, s->params[i].name) == 0) return 0;
   for (int i = 0; i < s->ndefs; i++)
-    if (strcmp(t, s->defs[i].name) == 0)
-      return 0;
+    if (strcmp(t, s->defs[i].name) == 0) return 0;
   return 1;
 }
 
-int sc_load_boundary(sc_loader *L)
-{
+int sc_load_boundary(sc_loader *L) {
   scene *s = L->s;
   s->bc = cv_calloc((size_t)s->n, sizeof *s->bc);
-  if (!s->bc)
-    return nomem(L, 0);
-  for (int k = 0; k < s->n; k++)
-    s->bc[k].expr[0] = s->bc[k].expr[1] = -1;
+  if (!s->bc) return nomem(L, 0);
+  for (int k = 0; k < s->n; k++) s->bc[k].expr[0] = s->bc[k].expr[1] = -1;
   for (int i = 0; i < L->raw.ne[SEC_BOUNDARY]; i++) {
     const sc_entry *e = &L->raw.e[SEC_BOUNDARY][i];
     int k = unknown_index(s, e->key);
     if (k < 0) {
-      sc_err(L->err, L->errlen, L->file, e->line, "'%s' in [boundary] is not an unknown",
-             e->key);
+      sc_err(L->err, L->errlen, L->file, e->line, "'%s' in [boundary] is not an unknown", e->key);
       return -1;
     }
     ex_list list;
-    if (ex_list_split(e->value, &list) < 0)
-      return nomem(L, e->line);
+    if (ex_list_split(e->value, &list) < 0) return nomem(L, e->line);
     if (list.n != 2) {
       sc_err(L->err, L->errlen, L->file, e->line,
-             "[boundary] %s needs two values 'value_at_a, value_at_b', got %d", e->key,
-             list.n);
+             "[boundary] %s needs two values 'value_at_a, value_at_b', got %d", e->key, list.n);
       ex_list_free(&list);
       return -1;
     }
@@ -101,8 +83,7 @@ int sc_load_boundary(sc_loader *L)
       }
       if (looks_like_free(s, t)) {
         sc_err(L->err, L->errlen, L->file, e->line,
-               "[boundary] %s: '%s' is not a value; did you mean 'free' (lower case)?",
-               e->key, t);
+               "[boundary] %s: '%s' is not a value; did you mean 'free' (lower case)?", e->key, t);
         ex_list_free(&list);
         return -1;
       }
@@ -124,19 +105,18 @@ int sc_load_boundary(sc_loader *L)
             line = L->raw.e[SEC_SCENE][i].line;
       sc_err(L->err, L->errlen, L->file, line,
              "[boundary] has no line for the unknown '%s' (write '%s = value_at_a, "
-             "value_at_b', either may be 'free')", s->unknowns[k], s->unknowns[k]);
+             "value_at_b', either may be 'free')",
+             s->unknowns[k], s->unknowns[k]);
       return -1;
     }
   return 0;
 }
 
 /* An expression of the variable alone (a [guess] or an [exact] solution). */
-static ex_id parse_of_variable(sc_loader *L, const sc_entry *e, const char *what)
-{
+static ex_id parse_of_variable(sc_loader *L, const sc_entry *e, const char *what) {
   char nb[128];
   ex_id r = sc_parse(L, e, 0, e->value, what);
-  if (r < 0)
-    return -1;
+  if (r < 0) return -1;
   int slot = sc_first_slot(L->s, r, 1, 2 * L->s->n);
   if (slot >= 0) {
     sc_err(L->err, L->errlen, L->file, e->line,
@@ -147,15 +127,12 @@ static ex_id parse_of_variable(sc_loader *L, const sc_entry *e, const char *what
   return r;
 }
 
-int sc_load_guess_exact(sc_loader *L)
-{
+int sc_load_guess_exact(sc_loader *L) {
   scene *s = L->s;
   s->guess = cv_malloc((size_t)s->n * sizeof *s->guess);
   s->exact = cv_malloc((size_t)s->n * sizeof *s->exact);
-  if (!s->guess || !s->exact)
-    return nomem(L, 0);
-  for (int i = 0; i < s->n; i++)
-    s->guess[i] = s->exact[i] = -1;
+  if (!s->guess || !s->exact) return nomem(L, 0);
+  for (int i = 0; i < s->n; i++) s->guess[i] = s->exact[i] = -1;
   for (int sec = SEC_GUESS; sec <= SEC_EXACT; sec += SEC_EXACT - SEC_GUESS) {
     for (int i = 0; i < L->raw.ne[sec]; i++) {
       const sc_entry *e = &L->raw.e[sec][i];
@@ -170,13 +147,12 @@ int sc_load_guess_exact(sc_loader *L)
       }
       int k = unknown_index(s, e->key);
       if (k < 0) {
-        sc_err(L->err, L->errlen, L->file, e->line, "'%s' in [%s] is not an unknown%s",
-               e->key, sc_section_name(sec), sec == SEC_EXACT ? " (nor 'action')" : "");
+        sc_err(L->err, L->errlen, L->file, e->line, "'%s' in [%s] is not an unknown%s", e->key,
+               sc_section_name(sec), sec == SEC_EXACT ? " (nor 'action')" : "");
         return -1;
       }
       ex_id r = parse_of_variable(L, e, what);
-      if (r < 0)
-        return -1;
+      if (r < 0) return -1;
       (sec == SEC_GUESS ? s->guess : s->exact)[k] = r;
     }
   }
@@ -184,51 +160,44 @@ int sc_load_guess_exact(sc_loader *L)
 }
 
 /* Items of [constraints], [integrals] and [report]: a name and one expression. */
-static int load_named(sc_loader *L, int sec, sc_item **out, int *nout)
-{
+static int load_named(sc_loader *L, int sec, sc_item **out, int *nout) {
   int ne = L->raw.ne[sec];
   *out = cv_calloc((size_t)ne + 1, sizeof **out);
-  if (!*out)
-    return nomem(L, 0);
+  if (!*out) return nomem(L, 0);
   for (int i = 0; i < ne; i++) {
     const sc_entry *e = &L->raw.e[sec][i];
     sc_item *it = &(*out)[i];
     char what[160];
     if (!ex_is_identifier(e->key)) {
-      sc_err(L->err, L->errlen, L->file, e->line, "'%s' is not a valid name in [%s]",
-             e->key, sc_section_name(sec));
+      sc_err(L->err, L->errlen, L->file, e->line, "'%s' is not a valid name in [%s]", e->key,
+             sc_section_name(sec));
       return -1;
     }
     it->name = sc_strdup(e->key);
     it->line = e->line;
     it->expr = it->expr2 = -1;
     *nout = i + 1;
-    if (!it->name)
-      return nomem(L, e->line);
+    if (!it->name) return nomem(L, e->line);
     snprintf(what, sizeof what, "[%s] %s", sc_section_name(sec), e->key);
     if (sec != SEC_INTEGRALS) {
-      if ((it->expr = sc_parse(L, e, 0, e->value, what)) < 0)
-        return -1;
+      if ((it->expr = sc_parse(L, e, 0, e->value, what)) < 0) return -1;
       continue;
     }
     ex_list list;
-    if (ex_list_split(e->value, &list) < 0)
-      return nomem(L, e->line);
+    if (ex_list_split(e->value, &list) < 0) return nomem(L, e->line);
     int rc = -1;
     if (list.n != 2)
       sc_err(L->err, L->errlen, L->file, e->line,
-             "[integrals] %s needs 'K, c' (the integral of K equals c), got %d values",
-             e->key, list.n);
+             "[integrals] %s needs 'K, c' (the integral of K equals c), got %d values", e->key,
+             list.n);
     else if ((it->expr = sc_parse(L, e, list.off[0], list.item[0], what)) >= 0 &&
-             sc_parse_const_node(L, e, list.off[1], list.item[1], "[integrals] value c",
-                                 &it->value, &it->expr2) == 0) {
-      if (!L->s->params_as_inputs)
-        it->expr2 = ex_num(L->s->dag, it->value);
+             sc_parse_const_node(L, e, list.off[1], list.item[1], "[integrals] value c", &it->value,
+                                 &it->expr2) == 0) {
+      if (!L->s->params_as_inputs) it->expr2 = ex_num(L->s->dag, it->value);
       rc = 0;
     }
     ex_list_free(&list);
-    if (rc < 0)
-      return -1;
+    if (rc < 0) return -1;
   }
   return 0;
 }
@@ -236,17 +205,14 @@ static int load_named(sc_loader *L, int sec, sc_item **out, int *nout)
 /* A pointwise constraint must hold at the fixed end values (SCENES.md). Tolerance: the
  * first-order effect of rounding the ends, |G| <= 1e-8 (1 + sum_i |y_i dG/dy_i|), so that
  * x^2 + y^2 - l^2 passes at (l sin 1, -l cos 1) for any scale of l. */
-static int check_constraint_ends(sc_loader *L, const sc_item *c)
-{
+static int check_constraint_ends(sc_loader *L, const sc_item *c) {
   scene *s = L->s;
   int n = s->n;
   for (int end = 0; end < 2; end++) {
     int fixed = 1;
     for (int i = 0; i < n; i++)
-      if (ex_depends_on(s->dag, c->expr, 1 + i) && s->bc[i].free_end[end])
-        fixed = 0;
-    if (!fixed)
-      continue;
+      if (ex_depends_on(s->dag, c->expr, 1 + i) && s->bc[i].free_end[end]) fixed = 0;
+    if (!fixed) continue;
     int ns = 1 + 2 * n;
     ex_id *outs = cv_malloc((size_t)(n + 1) * sizeof *outs);
     double x = end ? s->b : s->a, *y = cv_calloc((size_t)(ns + n + 1), sizeof *y);
@@ -259,19 +225,14 @@ static int check_constraint_ends(sc_loader *L, const sc_item *c)
     outs[0] = c->expr;
     int rc = 0;
     for (int i = 0; i < n; i++)
-      if ((outs[1 + i] = ex_diff(s->dag, c->expr, 1 + i)) < 0)
-        rc = -1;
-    for (int i = 0; i < n; i++)
-      y[i] = s->bc[i].free_end[end] ? 0.0 : s->bc[i].value[end];
-    if (rc == 0)
-      rc = sc_eval_exprs(s, n + 1, outs, 1, &x, y, y + n, v);
+      if ((outs[1 + i] = ex_diff(s->dag, c->expr, 1 + i)) < 0) rc = -1;
+    for (int i = 0; i < n; i++) y[i] = s->bc[i].free_end[end] ? 0.0 : s->bc[i].value[end];
+    if (rc == 0) rc = sc_eval_exprs(s, n + 1, outs, 1, &x, y, y + n, v);
     double scale = 1.0, g = v[0];
-    for (int i = 0; i < n; i++)
-      scale += fabs(y[i] * v[1 + i]);
+    for (int i = 0; i < n; i++) scale += fabs(y[i] * v[1 + i]);
     cv_free(outs);
     cv_free(y);
-    if (rc < 0)
-      return nomem(L, c->line);
+    if (rc < 0) return nomem(L, c->line);
     if (!(fabs(g) <= 1e-8 * scale)) {
       sc_err(L->err, L->errlen, L->file, c->line,
              "[constraints] %s does not hold at the fixed end %s = %.17g: it is %.6g there",
@@ -282,8 +243,7 @@ static int check_constraint_ends(sc_loader *L, const sc_item *c)
   return 0;
 }
 
-int sc_load_constraints(sc_loader *L)
-{
+int sc_load_constraints(sc_loader *L) {
   scene *s = L->s;
   char nb[128];
   if (load_named(L, SEC_CONSTRAINTS, &s->cons, &s->ncons) < 0 ||
@@ -294,8 +254,8 @@ int sc_load_constraints(sc_loader *L)
     int slot = sc_first_slot(s, c->expr, 1 + s->n, 2 * s->n);
     if (slot >= 0) {
       sc_err(L->err, L->errlen, L->file, c->line,
-             "[constraints] %s is a pointwise constraint G(%s, y) and may not use '%s'",
-             c->name, s->variable, sc_slot_name(s, slot, nb, sizeof nb));
+             "[constraints] %s is a pointwise constraint G(%s, y) and may not use '%s'", c->name,
+             s->variable, sc_slot_name(s, slot, nb, sizeof nb));
       return -1;
     }
     if (sc_first_slot(s, c->expr, 1, s->n) < 0) {
@@ -303,19 +263,16 @@ int sc_load_constraints(sc_loader *L)
              "[constraints] %s involves no unknown, so it cannot be imposed", c->name);
       return -1;
     }
-    if (check_constraint_ends(L, c) < 0)
-      return -1;
+    if (check_constraint_ends(L, c) < 0) return -1;
   }
   if (s->ncons >= s->n) {
     sc_err(L->err, L->errlen, L->file, s->cons[s->n - 1].line,
-           "%d pointwise constraints on %d unknowns leave no degree of freedom", s->ncons,
-           s->n);
+           "%d pointwise constraints on %d unknowns leave no degree of freedom", s->ncons, s->n);
     return -1;
   }
   return 0;
 }
 
-int sc_load_report(sc_loader *L)
-{
+int sc_load_report(sc_loader *L) {
   return load_named(L, SEC_REPORT, &L->s->reports, &L->s->nreports);
 }

@@ -19,27 +19,21 @@
 enum { GRID = 4096 };
 
 /* Depends on the variable x (slot 0) and on no unknown or derivative. */
-static int x_only(const scene *s, ex_id e)
-{
-  if (!ex_depends_on(s->dag, e, 0))
-    return 0;
+static int x_only(const scene *s, ex_id e) {
+  if (!ex_depends_on(s->dag, e, 0)) return 0;
   for (int k = 1; k <= 2 * s->n; k++)
-    if (ex_depends_on(s->dag, e, k))
-      return 0;
+    if (ex_depends_on(s->dag, e, k)) return 0;
   return 1;
 }
 
-static double eval_at(const scene *s, ex_id e, double x)
-{
+static double eval_at(const scene *s, ex_id e, double x) {
   double v = NAN;
-  if (sc_eval_exprs(s, 1, &e, 1, &x, NULL, NULL, &v) < 0)
-    return NAN;
+  if (sc_eval_exprs(s, 1, &e, 1, &x, NULL, NULL, &v) < 0) return NAN;
   return v;
 }
 
 /* A zero of e (x only) strictly inside (a, b): 1 and *xs, else 0 (-1 out of memory). */
-static int interior_zero(const scene *s, ex_id e, double *xs)
-{
+static int interior_zero(const scene *s, ex_id e, double *xs) {
   double a = s->a, b = s->b, h = (b - a) / GRID;
   double *x = cv_malloc((GRID + 1) * sizeof *x), *v = cv_malloc((GRID + 1) * sizeof *v);
   int found = 0;
@@ -47,8 +41,7 @@ static int interior_zero(const scene *s, ex_id e, double *xs)
     found = -1;
     goto done;
   }
-  for (int k = 0; k <= GRID; k++)
-    x[k] = a + h * k;
+  for (int k = 0; k <= GRID; k++) x[k] = a + h * k;
   if (sc_eval_exprs(s, 1, &e, GRID + 1, x, NULL, NULL, v) < 0) {
     found = -1;
     goto done;
@@ -61,8 +54,7 @@ static int interior_zero(const scene *s, ex_id e, double *xs)
     }
   }
   for (int k = 0; k < GRID && !found; k++) {
-    if (!(v[k] * v[k + 1] < 0))
-      continue;
+    if (!(v[k] * v[k + 1] < 0)) continue;
     double lo = x[k], hi = x[k + 1], flo = v[k];
     for (int it = 0; it < 80 && hi - lo > 4 * DBL_EPSILON * fabs(hi); it++) {
       double mid = 0.5 * (lo + hi), fm = eval_at(s, e, mid);
@@ -88,37 +80,30 @@ done:
 }
 
 /* max |F| at x* - d and x* + d along the solution (NaN when it cannot be evaluated). */
-static double f_near(const scene *s, cv_solver *sv, double xs, double d)
-{
+static double f_near(const scene *s, cv_solver *sv, double xs, double d) {
   int n = s->n;
   double x[2] = {xs - d, xs + d}, out[2] = {NAN, NAN};
   double *y = cv_malloc((size_t)4 * n * sizeof *y), *dy = y ? y + 2 * n : NULL;
   int ok = y && cv_solver_eval(sv, 2, x, y, dy) == CVAR_OK &&
            sc_eval_exprs(s, 1, &s->F, 2, x, y, dy, out) == 0;
   cv_free(y);
-  if (!ok)
-    return NAN;
-  if (isnan(out[0]) || isnan(out[1]))
-    return INFINITY;
+  if (!ok) return NAN;
+  if (isnan(out[0]) || isnan(out[1])) return INFINITY;
   return fabs(out[0]) > fabs(out[1]) ? fabs(out[0]) : fabs(out[1]);
 }
 
-int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double *alpha)
-{
+int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double *alpha) {
   ex_dag *d = s->dag;
   int N = s->F + 1, rc = 0;
   unsigned char *mark = cv_calloc((size_t)N, 1);
-  if (!mark)
-    return -1;
+  if (!mark) return -1;
   mark[s->F] = 1;
   /* the nodes of F (children have smaller ids: one pass downwards) */
   for (ex_id e = s->F; e >= 0 && rc == 0; e--) {
-    if (!mark[e])
-      continue;
+    if (!mark[e]) continue;
     for (int i = 0; i < 3; i++) {
       ex_id c = ex_node_arg(d, e, i);
-      if (c >= 0 && c < N)
-        mark[c] = 1;
+      if (c >= 0 && c < N) mark[c] = 1;
     }
     ex_op op = ex_node_op(d, e);
     ex_id cand = -1;
@@ -130,18 +115,15 @@ int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double
              ex_node_value(d, ex_node_arg(d, e, 1)) < 0)
       cand = ex_node_arg(d, e, 0);
     double x0;
-    if (cand < 0 || !x_only(s, cand))
-      continue;
+    if (cand < 0 || !x_only(s, cand)) continue;
     int z = interior_zero(s, cand, &x0);
     if (z < 0) {
       rc = -1;
       break;
     }
-    if (z == 0)
-      continue;
+    if (z == 0) continue;
     double L = s->b - s->a, g1 = f_near(s, sv, x0, 1e-3 * L), g2 = f_near(s, sv, x0, 1e-5 * L);
-    if (isnan(g1) || isnan(g2))
-      continue;
+    if (isnan(g1) || isnan(g2)) continue;
     double al = g1 > 0 && isfinite(g2) ? log(g2 / g1) / log(100.0) : INFINITY;
     if (!(al < 0.85)) {
       *xs = x0;

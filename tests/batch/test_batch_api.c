@@ -10,8 +10,7 @@
 
 static int failures, checks;
 
-static void check(const char *what, int ok, double expected, double actual)
-{
+static void check(const char *what, int ok, double expected, double actual) {
   checks++;
   if (!ok) {
     failures++;
@@ -20,16 +19,14 @@ static void check(const char *what, int ok, double expected, double actual)
 }
 
 /* y = A + s x + (c/4) x (x - L) on [0, L], F = y'^2 + c y (data/line.scene). */
-static double exact_action(double A, double B, double L, double c)
-{
+static double exact_action(double A, double B, double L, double c) {
   double s = (B - A) / L;
   return L * s * s + c * A * L + c * s * L * L / 2 - c * c * L * L * L / 48;
 }
 
 enum { ROWS = 64 };
 
-int main(int argc, char **argv)
-{
+int main(int argc, char **argv) {
   char path[4096], err[512];
   snprintf(path, sizeof path, "%s/line.scene", argc > 1 ? argv[1] : ".");
   cv_batch *b = cv_batch_new(path, err, sizeof err);
@@ -38,19 +35,23 @@ int main(int argc, char **argv)
     return 1;
   }
   check("five parameters", cv_batch_num_parameters(b) == 5, 5, cv_batch_num_parameters(b));
-  check("one output (len)", cv_batch_num_outputs(b) == 1 &&
-        strcmp(cv_batch_output_name(b, 0), "len") == 0, 1, cv_batch_num_outputs(b));
+  check("one output (len)",
+        cv_batch_num_outputs(b) == 1 && strcmp(cv_batch_output_name(b, 0), "len") == 0, 1,
+        cv_batch_num_outputs(b));
   const char *bad[] = {"A", "nosuch"};
-  check("unknown column refused", cv_batch_set_columns(b, 2, bad, err, sizeof err) ==
-        CVAR_EINVAL && strstr(err, "nosuch") != NULL, CVAR_EINVAL, 0);
+  check("unknown column refused",
+        cv_batch_set_columns(b, 2, bad, err, sizeof err) == CVAR_EINVAL &&
+            strstr(err, "nosuch") != NULL,
+        CVAR_EINVAL, 0);
   const char *cols[] = {"A", "B", "L", "c"};
   if (cv_batch_set_columns(b, 4, cols, err, sizeof err) != CVAR_OK) {
     printf("FAIL set_columns: %s\n", err);
     return 1;
   }
   double neg[4] = {0, 1, -1, 0};
-  check("a >= b refused by check_row", cv_batch_check_row(b, neg, err, sizeof err) ==
-        CVAR_EINVAL && strstr(err, "a < b") != NULL, CVAR_EINVAL, 0);
+  check("a >= b refused by check_row",
+        cv_batch_check_row(b, neg, err, sizeof err) == CVAR_EINVAL && strstr(err, "a < b") != NULL,
+        CVAR_EINVAL, 0);
   /* a smooth sweep: neighbouring rows are close, so warm starts apply */
   double rows[ROWS * 4], outs[2][ROWS];
   cv_batch_result res[2][ROWS];
@@ -62,8 +63,7 @@ int main(int argc, char **argv)
   cv_batch_set_threads(b, 2);
   for (int warm = 0; warm < 2; warm++) {
     cv_batch_set_warm_start(b, warm);
-    for (int r = 0; r < ROWS; r++)
-      res[warm][r].outputs = &outs[warm][r];
+    for (int r = 0; r < ROWS; r++) res[warm][r].outputs = &outs[warm][r];
     check("solve returns OK", cv_batch_solve(b, ROWS, rows, res[warm]) == CVAR_OK, 0, 0);
     int nwarm = 0;
     for (int r = 0; r < ROWS; r++) {
@@ -71,8 +71,7 @@ int main(int argc, char **argv)
       double act = exact_action(v[0], v[1], v[2], v[3]);
       cv_batch_result *q = &res[warm][r];
       check("converged", q->status == CVAR_OK && q->has_result, CVAR_OK, q->status);
-      check("action to 1e-10", fabs(q->action - act) <= 1e-10 * fmax(1, fabs(act)), act,
-            q->action);
+      check("action to 1e-10", fabs(q->action - act) <= 1e-10 * fmax(1, fabs(act)), act, q->action);
       check("nodal error < 1e-11", q->error_max_nodal < 1e-11, 0, q->error_max_nodal);
       check("Morse index 0", q->morse_index == 0, 0, q->morse_index);
       check("no estimate without adapt", isnan(q->error_estimate), NAN, q->error_estimate);
@@ -83,8 +82,8 @@ int main(int argc, char **argv)
       /* 64 rows on 2 threads in blocks of 4: the first row of every block starts cold */
       check("most rows warm-started", nwarm >= ROWS / 2, ROWS / 2, nwarm);
       for (int r = 0; r < ROWS; r++)
-        check("warm and cold agree (len)", fabs(outs[0][r] - outs[1][r]) <= 1e-12 *
-              fabs(outs[0][r]), outs[0][r], outs[1][r]);
+        check("warm and cold agree (len)",
+              fabs(outs[0][r] - outs[1][r]) <= 1e-12 * fabs(outs[0][r]), outs[0][r], outs[1][r]);
     } else {
       check("no row warm-started when off", nwarm == 0, 0, nwarm);
     }

@@ -9,14 +9,24 @@
 
 static int nan_F(int m, const double *x, const double *y, const double *dy, unsigned need,
                  cv_partials *o, void *user) {
-  (void)x; (void)y; (void)dy; (void)need; (void)user;
+  (void)x;
+  (void)y;
+  (void)dy;
+  (void)need;
+  (void)user;
   for (int k = 0; k < m; k++) o->F[k] = NAN;
   return 0;
 }
 
 static int abort_F(int m, const double *x, const double *y, const double *dy, unsigned need,
                    cv_partials *o, void *user) {
-  (void)m; (void)x; (void)y; (void)dy; (void)need; (void)o; (void)user;
+  (void)m;
+  (void)x;
+  (void)y;
+  (void)dy;
+  (void)need;
+  (void)o;
+  (void)user;
   return -1;
 }
 
@@ -159,8 +169,10 @@ int main(void) {
       double ep = fabs(P[k] - ys[k] * ds[k] / r) / fmax(1e-300, fabs(ys[k] * ds[k] / r)) / 8;
       worst = fmax(worst, fmax(eh, ep));
     }
-    CHECK(st == CVAR_OK && worst <= DBL_EPSILON, "energy/momenta at %d points: %s, worst "
-          "error %.3g eps of its tolerance", M, cv_status_name(st), worst / DBL_EPSILON);
+    CHECK(st == CVAR_OK && worst <= DBL_EPSILON,
+          "energy/momenta at %d points: %s, worst "
+          "error %.3g eps of its tolerance",
+          M, cv_status_name(st), worst / DBL_EPSILON);
     CHECK(cv_problem_eval_energy(p, M, xs, NULL, ds, H, P) == CVAR_EINVAL, "NULL y accepted");
     cv_problem_set_integrand(p, abort_F, NULL);
     st = cv_problem_eval_energy(p, M, xs, ys, ds, H, NULL);
@@ -177,9 +189,11 @@ int main(void) {
     cv_debug_fail_alloc_after(k);
     st = cv_solve(s, p);
     cv_debug_fail_alloc_after(-1);
-    if (st == CVAR_OK) saw_ok = 1;
-    else CHECK(st == CVAR_ENOMEM || st == CVAR_EDEPENDENCY,
-               "allocation failure %d gave %s", k, cv_status_name(st));
+    if (st == CVAR_OK)
+      saw_ok = 1;
+    else
+      CHECK(st == CVAR_ENOMEM || st == CVAR_EDEPENDENCY, "allocation failure %d gave %s", k,
+            cv_status_name(st));
   }
   CHECK(saw_ok, "solve never succeeded within 200 allocations");
   printf("allocation-failure sweep: %d injection points\n", k);
@@ -188,7 +202,9 @@ int main(void) {
   cv_problem_free(p);
   cv_solver_free(NULL);
   cv_problem_free(NULL);
-  if (n_failed) fprintf(stderr, "%d check(s) failed\n", n_failed);
-  else printf("all API checks passed\n");
+  if (n_failed)
+    fprintf(stderr, "%d check(s) failed\n", n_failed);
+  else
+    printf("all API checks passed\n");
   return n_failed ? 1 : 0;
 }

@@ -15,8 +15,10 @@ static double cycloid_time(double X, double Y) {
   double lo = 1e-9, hi = 2 * PI - 1e-15;
   for (int it = 0; it < 200; it++) {
     double f = 0.5 * (lo + hi), g = (1 - cos(f)) / (f - sin(f)) - Y / X;
-    if (g > 0) lo = f;
-    else hi = f;
+    if (g > 0)
+      lo = f;
+    else
+      hi = f;
   }
   double f = 0.5 * (lo + hi), r = X / (f - sin(f));
   return f * sqrt(2 * r);
@@ -43,12 +45,12 @@ int main(void) {
              cv_strerror(st), Th - T, rel, near ? ", end found nearly singular" : "");
       CHECK(st == CVAR_OK, "(%g, %g) E=%d p=%d: %s", X, Y, E, deg, cv_solver_last_error(s));
       /* never below the exact minimum (round-off: 1e-12 relative) */
-      CHECK(rel >= -1e-12, "(%g, %g) E=%d p=%d: time %.15g undercuts the exact %.15g", X, Y,
-            E, deg, Th, T);
+      CHECK(rel >= -1e-12, "(%g, %g) E=%d p=%d: time %.15g undercuts the exact %.15g", X, Y, E, deg,
+            Th, T);
       /* and close to it: degree >= 2 within 5e-4 (the worst, (2, 0.05) at p = 2: 1.2e-4),
        * degree 1 within 1e-3 */
-      CHECK(rel <= (deg >= 2 ? 5e-4 : 1e-3), "(%g, %g) E=%d p=%d: relative error %.2e", X,
-            Y, E, deg, rel);
+      CHECK(rel <= (deg >= 2 ? 5e-4 : 1e-3), "(%g, %g) E=%d p=%d: relative error %.2e", X, Y, E,
+            deg, rel);
       if (Y / X <= 0.002 && deg >= 2)
         CHECK(near, "(%g, %g) E=%d p=%d: the nearly singular end was not found", X, Y, E, deg);
       cv_solver_free(s);

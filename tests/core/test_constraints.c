@@ -15,13 +15,24 @@ static int length_K(int m, const double *x, const double *y, const double *dy, u
 }
 
 /* F = -y: minus the area under the curve. */
-static int minus_area_F(int m, const double *x, const double *y, const double *dy,
-                        unsigned need, cv_partials *o, void *user) {
-  (void)x; (void)y; (void)dy; (void)need; (void)user;
+static int minus_area_F(int m, const double *x, const double *y, const double *dy, unsigned need,
+                        cv_partials *o, void *user) {
+  (void)x;
+  (void)y;
+  (void)dy;
+  (void)need;
+  (void)user;
   for (int k = 0; k < m; k++) {
     o->F[k] = -y[k];
-    if (o->Fy) { o->Fy[k] = -1; o->Fp[k] = 0; }
-    if (o->Fyy) { o->Fyy[k] = 0; o->Fyp[k] = 0; o->Fpp[k] = 0; }
+    if (o->Fy) {
+      o->Fy[k] = -1;
+      o->Fp[k] = 0;
+    }
+    if (o->Fyy) {
+      o->Fyy[k] = 0;
+      o->Fyp[k] = 0;
+      o->Fpp[k] = 0;
+    }
   }
   return 0;
 }
@@ -39,26 +50,39 @@ static int bulge_guess(int m, const double *x, double *y, void *user) {
 }
 
 /* Pendulum, m = l = 1: angle form F = th'^2/2 + g cos th. */
-static int pend_angle_F(int m, const double *x, const double *y, const double *dy,
-                        unsigned need, cv_partials *o, void *user) {
-  (void)x; (void)need; (void)user;
+static int pend_angle_F(int m, const double *x, const double *y, const double *dy, unsigned need,
+                        cv_partials *o, void *user) {
+  (void)x;
+  (void)need;
+  (void)user;
   for (int k = 0; k < m; k++) {
     o->F[k] = 0.5 * dy[k] * dy[k] + GRAV * cos(y[k]);
-    if (o->Fy) { o->Fy[k] = -GRAV * sin(y[k]); o->Fp[k] = dy[k]; }
-    if (o->Fyy) { o->Fyy[k] = -GRAV * cos(y[k]); o->Fyp[k] = 0; o->Fpp[k] = 1; }
+    if (o->Fy) {
+      o->Fy[k] = -GRAV * sin(y[k]);
+      o->Fp[k] = dy[k];
+    }
+    if (o->Fyy) {
+      o->Fyy[k] = -GRAV * cos(y[k]);
+      o->Fyp[k] = 0;
+      o->Fpp[k] = 1;
+    }
   }
   return 0;
 }
 
 /* Cartesian form F = (x'^2 + y'^2)/2 - g y (n = 2); constraint x^2 + y^2 - 1 = 0. */
-static int pend_cart_F(int m, const double *t, const double *q, const double *dq,
-                       unsigned need, cv_partials *o, void *user) {
-  (void)t; (void)need; (void)user;
+static int pend_cart_F(int m, const double *t, const double *q, const double *dq, unsigned need,
+                       cv_partials *o, void *user) {
+  (void)t;
+  (void)need;
+  (void)user;
   const int n = 2;
   for (int k = 0; k < m; k++) {
     o->F[k] = 0.5 * (dq[k] * dq[k] + dq[m + k] * dq[m + k]) - GRAV * q[m + k];
-    SET1(o->Fy, 0, k, 0); SET1(o->Fy, 1, k, -GRAV);
-    SET1(o->Fp, 0, k, dq[k]); SET1(o->Fp, 1, k, dq[m + k]);
+    SET1(o->Fy, 0, k, 0);
+    SET1(o->Fy, 1, k, -GRAV);
+    SET1(o->Fp, 0, k, dq[k]);
+    SET1(o->Fp, 1, k, dq[m + k]);
     for (int i = 0; i < 2; i++)
       for (int j = 0; j < 2; j++) {
         SET2(o->Fyy, i, j, k, 0);
@@ -72,7 +96,8 @@ static int pend_cart_F(int m, const double *t, const double *q, const double *dq
 /* |q|^2 - 1 for n = *(int *)user unknowns. */
 static int unit_sphere_G(int m, const double *t, const double *q, unsigned need, double *G,
                          double *Gy, double *Gyy, void *user) {
-  (void)t; (void)need;
+  (void)t;
+  (void)need;
   int n = *(const int *)user;
   for (int k = 0; k < m; k++) {
     double r2 = 0;
@@ -99,7 +124,10 @@ static int pend_guess(int m, const double *t, double *q, void *user) {
 /* Energy x'^2 + y'^2 + z'^2 (n = 3). */
 static int energy3_F(int m, const double *t, const double *q, const double *dq, unsigned need,
                      cv_partials *o, void *user) {
-  (void)t; (void)q; (void)need; (void)user;
+  (void)t;
+  (void)q;
+  (void)need;
+  (void)user;
   const int n = 3;
   for (int k = 0; k < m; k++) {
     double e = 0;
@@ -242,7 +270,11 @@ int main(void) {
     CHECK(cv_solver_get_morse_index(sc) == cv_solver_get_morse_index(sa),
           "pendulum Morse index %d (cartesian) vs %d (angle)", cv_solver_get_morse_index(sc),
           cv_solver_get_morse_index(sa));
-    free(t); free(th); free(q); free(lam); free(dth);
+    free(t);
+    free(th);
+    free(q);
+    free(lam);
+    free(dth);
     cv_solver_free(sc);
     cv_problem_free(pc);
     cv_solver_free(sa);

@@ -35,14 +35,16 @@ static void study(const char *name, cv_integrand_fn F, double a, double b, doubl
     for (int r = 0; r < 2; r++) {
       double order = log2(e[r] / e[r + 1]), oall = log2(ea[r] / ea[r + 1]);
       printf("%-9s p=%d E=%3d->%3d  boundary err %.3e -> %.3e order %.2f (expected %d);"
-             " all nodes order %.2f\n", name, p, N0[p] << r, N0[p] << (r + 1), e[r], e[r + 1],
-             order, 2 * p, oall);
+             " all nodes order %.2f\n",
+             name, p, N0[p] << r, N0[p] << (r + 1), e[r], e[r + 1], order, 2 * p, oall);
       char what[64];
       snprintf(what, sizeof what, "%s order p=%d", name, p);
       /* The finest pair is asymptotic: 2p +- 0.3. The coarse pair may still be
        * pre-asymptotic (fish-eye, p = 4: 8.47), so there only order >= 2p - 0.3. */
-      if (r == 1) CHECK_NEAR(what, order, 2.0 * p, 0.3);
-      else CHECK(order >= 2.0 * p - 0.3, "%s: %.2f < %d - 0.3", what, order, 2 * p);
+      if (r == 1)
+        CHECK_NEAR(what, order, 2.0 * p, 0.3);
+      else
+        CHECK(order >= 2.0 * p - 0.3, "%s: %.2f < %d - 0.3", what, order, 2 * p);
       CHECK(oall >= p + 1 - 0.3, "%s all-node order %.2f < %d", name, oall, p + 1);
     }
   }

@@ -31,8 +31,8 @@ static double cat_lam, cat_c;
 static double scaled_cat_exact(double x) { return cat_lam * cat_c * cosh(x / (cat_lam * cat_c)); }
 
 /* NaN beyond x = 0.5: the integrand is undefined on part of the domain. */
-static int half_nan_F(int m, const double *x, const double *y, const double *dy,
-                      unsigned need, cv_partials *o, void *user) {
+static int half_nan_F(int m, const double *x, const double *y, const double *dy, unsigned need,
+                      cv_partials *o, void *user) {
   catenary_F(m, x, y, dy, need, o, user);
   for (int k = 0; k < m; k++)
     if (x[k] > 0.5) o->F[k] = NAN;
@@ -44,7 +44,13 @@ static double hlong_exact(double t) { return sin(t) / sin(100.0); }
 /* Aborts at once: the solve must clean up after the analysis running on its thread. */
 static int abort_F(int m, const double *x, const double *y, const double *dy, unsigned need,
                    cv_partials *o, void *user) {
-  (void)m; (void)x; (void)y; (void)dy; (void)need; (void)o; (void)user;
+  (void)m;
+  (void)x;
+  (void)y;
+  (void)dy;
+  (void)need;
+  (void)o;
+  (void)user;
   return -1;
 }
 
@@ -52,9 +58,12 @@ static int abort_F(int m, const double *x, const double *y, const double *dy, un
  * element adds c * int B^2 = (2/3) c = 1e308 to a node's diagonal entry, finite, and every
  * point's term is below that (largest weight 0.36), but an interior node sums two
  * elements: 2e308 overflows. Every output of the callback is finite. */
-static int overflow_F(int m, const double *x, const double *y, const double *dy,
-                      unsigned need, cv_partials *o, void *user) {
-  (void)x; (void)dy; (void)need; (void)user;
+static int overflow_F(int m, const double *x, const double *y, const double *dy, unsigned need,
+                      cv_partials *o, void *user) {
+  (void)x;
+  (void)dy;
+  (void)need;
+  (void)user;
   const double c = 1.5e308;
   for (int k = 0; k < m; k++) {
     o->F[k] = 0.5 * c * y[k] * y[k];
@@ -67,7 +76,10 @@ static int overflow_F(int m, const double *x, const double *y, const double *dy,
 /* K = y, for a problem with thousands of integral constraints (dense KKT columns). */
 static int ysum_K(int m, const double *x, const double *y, const double *dy, unsigned need,
                   cv_partials *o, void *user) {
-  (void)x; (void)dy; (void)need; (void)user;
+  (void)x;
+  (void)dy;
+  (void)need;
+  (void)user;
   for (int k = 0; k < m; k++) {
     o->F[k] = y[k];
     if (o->Fy) o->Fy[k] = 1, o->Fp[k] = 0;
@@ -152,12 +164,13 @@ int main(void) {
         if (kind == 2) cv_solver_set_mesh_graded(s, 120, 3.0, CVAR_GRADE_A);
         if (kind == 3) { /* irregular user mesh */
           double t[41];
-          for (int i = 0; i <= 40; i++) t[i] = pow(i / 40.0, 2) * (1 + 0.3 * sin(7.0 * i)) ;
+          for (int i = 0; i <= 40; i++) t[i] = pow(i / 40.0, 2) * (1 + 0.3 * sin(7.0 * i));
           t[0] = 0;
           t[40] = 1;
           for (int i = 1; i < 40; i++)
             if (!(t[i] > t[i - 1])) t[i] = t[i - 1] + 1e-3;
-          for (int i = 1; i < 40; i++) if (t[i] >= 1) t[i] = 1 - (40 - i) * 1e-4;
+          for (int i = 1; i < 40; i++)
+            if (t[i] >= 1) t[i] = 1 - (40 - i) * 1e-4;
           cv_solver_set_mesh(s, 40, t);
         }
         st = cv_solve(s, p);
@@ -193,8 +206,8 @@ int main(void) {
         double rel = fabs(cv_solver_get_action(s) - BRACH_TIME) / BRACH_TIME;
         int morse = cv_solver_get_morse_index(s);
         const char *msg = cv_solver_last_error(s);
-        printf("brachistochrone %s guess p=%d E=%d: %s rel %.2e morse %d\n",
-               g ? "x^(2/3)" : "sqrt", deg, E, cv_status_name(st), rel, morse);
+        printf("brachistochrone %s guess p=%d E=%d: %s rel %.2e morse %d\n", g ? "x^(2/3)" : "sqrt",
+               deg, E, cv_status_name(st), rel, morse);
         CHECK(st == CVAR_OK, "brachistochrone p=%d E=%d: %s", deg, E, msg);
         CHECK(rel < 1e-9, "brachistochrone p=%d E=%d: time error %.3g", deg, E, rel);
         /* from the steep guess at p = 8, 100 elements Newton converges, to a discrete
@@ -296,22 +309,21 @@ int main(void) {
   {
     cv_solver *s;
     int E = 60000;
-    cv_status st = solve1(catenary_F, NULL, -1, 1, catenary_exact(-1), catenary_exact(1), E, 1,
-                          &s);
+    cv_status st = solve1(catenary_F, NULL, -1, 1, catenary_exact(-1), catenary_exact(1), E, 1, &s);
     double err = 0.0, y[3];
     for (int j = 0; j <= 2; j++) { /* x = -1/2, 0, 1/2 are nodes (E divisible by 4) */
       double x = -0.5 + 0.5 * j;
       cv_solver_eval(s, 1, &x, y + j, NULL);
       err = fmax(err, fabs(y[j] - catenary_exact(x)));
     }
-    printf("catenary, %d elements (threaded analysis): %s, error %.3g\n", E,
-           cv_status_name(st), err);
+    printf("catenary, %d elements (threaded analysis): %s, error %.3g\n", E, cv_status_name(st),
+           err);
     CHECK(st == CVAR_OK, "catenary at %d elements: %s", E, cv_solver_last_error(s));
     /* The nodal error of degree 1 is 2.504e-8 (1000 / E)^2 (2.504e-8 at 10^3 elements and
      * 2.504e-10 at 10^4, docs/performance.md): 6.96e-12 here, to 10 %. */
     double pred = 2.504e-8 * (1000.0 / E) * (1000.0 / E);
-    CHECK(fabs(err - pred) <= 0.1 * pred, "catenary at %d elements: error %.3g, h^2 law %.3g",
-          E, err, pred);
+    CHECK(fabs(err - pred) <= 0.1 * pred, "catenary at %d elements: error %.3g, h^2 law %.3g", E,
+          err, pred);
     cv_solver_free(s);
 
     st = solve1(abort_F, NULL, 0, 1, 0, 1, E, 1, &s);
@@ -350,8 +362,7 @@ int main(void) {
     printf("2200 integral constraints on 10^6 elements: %s: %s\n", cv_status_name(st),
            cv_solver_last_error(s));
     CHECK(st == CVAR_EINVAL, "too many matrix entries: %s", cv_status_name(st));
-    CHECK(strstr(cv_solver_last_error(s), "2^31") != NULL, "message: %s",
-          cv_solver_last_error(s));
+    CHECK(strstr(cv_solver_last_error(s), "2^31") != NULL, "message: %s", cv_solver_last_error(s));
     cv_solver_free(s);
     cv_problem_free(p);
   }

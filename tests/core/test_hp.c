@@ -75,8 +75,10 @@ static double mixed_error(int halvings, cv_solver **keep) {
   CHECK(st == CVAR_OK, "mixed degrees: %s", cv_solver_last_error(s));
   double err = max_nodal_error(s, catenary_exact);
   cv_problem_free(p);
-  if (keep) *keep = s;
-  else cv_solver_free(s);
+  if (keep)
+    *keep = s;
+  else
+    cv_solver_free(s);
   return err;
 }
 
@@ -151,8 +153,8 @@ static void tol_rounds(void) {
     for (int e = 0; e < E; e++) sum += deg[e], dmax = deg[e] > dmax ? deg[e] : dmax;
     printf("--tol 1e-10 (%s): %d elements, %d nodes, estimate %.2e, true %.2e\n",
            k ? "oscillator" : "catenary", E, cv_solver_get_num_nodes(s), est, err);
-    CHECK(cv_solver_get_num_nodes(s) == 1 + sum, "nodes %d, 1 + sum %d",
-          cv_solver_get_num_nodes(s), 1 + sum);
+    CHECK(cv_solver_get_num_nodes(s) == 1 + sum, "nodes %d, 1 + sum %d", cv_solver_get_num_nodes(s),
+          1 + sum);
     CHECK(cv_solver_get_degree(s) == dmax, "degree %d, largest %d", cv_solver_get_degree(s), dmax);
     CHECK(est <= 1e-10, "estimate %.3g", est);
     CHECK(err <= 1e-9, "true error %.3g", err);

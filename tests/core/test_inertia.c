@@ -20,8 +20,15 @@ static int osc_F(int m, const double *x, const double *y, const double *dy, unsi
   double w2 = c->w * c->w;
   for (int k = 0; k < m; k++) {
     o->F[k] = 0.5 * dy[k] * dy[k] - 0.5 * w2 * y[k] * y[k];
-    if (o->Fy) { o->Fy[k] = -w2 * y[k]; o->Fp[k] = dy[k]; }
-    if (o->Fyy) { o->Fyy[k] = -w2; o->Fyp[k] = 0; o->Fpp[k] = 1; }
+    if (o->Fy) {
+      o->Fy[k] = -w2 * y[k];
+      o->Fp[k] = dy[k];
+    }
+    if (o->Fyy) {
+      o->Fyy[k] = -w2;
+      o->Fyp[k] = 0;
+      o->Fpp[k] = 1;
+    }
   }
   return 0;
 }
@@ -58,9 +65,8 @@ int main(void) {
    * step through the shifted factor must be as right as the ordinary one. */
   static const osc fam[2] = {{2 * PI, 1.25, 1.0}, {PI / 0.3, 1.0, 1.0}};
   static const int morse_exact[2] = {2, 3};
-  static const int cases[2][6][2] = {
-      {{100, 4}, {10, 8}, {20, 8}, {40, 4}, {50, 3}, {100, 2}},
-      {{10, 8}, {30, 4}, {60, 3}, {20, 6}, {100, 2}, {30, 5}}};
+  static const int cases[2][6][2] = {{{100, 4}, {10, 8}, {20, 8}, {40, 4}, {50, 3}, {100, 2}},
+                                     {{10, 8}, {30, 4}, {60, 3}, {20, 6}, {100, 2}, {30, 5}}};
   int nsolved = 0;
   for (int f = 0; f < 2; f++) {
     for (int i = 0; i < 6; i++) {
@@ -68,8 +74,8 @@ int main(void) {
       double err, err1;
       cv_status st = solve_osc(&fam[f], E, p, &morse, &err, &degen);
       cv_status st1 = solve_osc(&fam[f], E + 1, p, &m1, &err1, &d1);
-      printf("w=%.6f b=%g E=%d p=%d: %s, Morse %d (exact %d), error %.2e (E+1: %.2e)\n",
-             fam[f].w, fam[f].b, E, p, cv_strerror(st), morse, morse_exact[f], err, err1);
+      printf("w=%.6f b=%g E=%d p=%d: %s, Morse %d (exact %d), error %.2e (E+1: %.2e)\n", fam[f].w,
+             fam[f].b, E, p, cv_strerror(st), morse, morse_exact[f], err, err1);
       CHECK(st == CVAR_OK, "E=%d p=%d: conjugate point on a node not solved", E, p);
       CHECK(st1 == CVAR_OK, "E+1=%d p=%d not solved", E + 1, p);
       CHECK(morse == morse_exact[f], "E=%d p=%d: Morse index %d, exact %d", E, p, morse,
@@ -78,8 +84,8 @@ int main(void) {
       CHECK(!degen, "E=%d p=%d flagged degenerate", E, p);
       /* 1e-5: the coarsest cases (p = 2 on 100 elements) have discretisation errors of
        * ~1e-6; the factor 3 allows the node-position dependence of that error. */
-      CHECK(err <= 1e-5 && err <= 3 * err1 + 1e-12,
-            "E=%d p=%d: error %.3g (E+1: %.3g)", E, p, err, err1);
+      CHECK(err <= 1e-5 && err <= 3 * err1 + 1e-12, "E=%d p=%d: error %.3g (E+1: %.3g)", E, p, err,
+            err1);
       nsolved += st == CVAR_OK;
     }
   }

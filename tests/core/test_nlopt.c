@@ -30,7 +30,7 @@ static double diff(const cv_solver *a, const cv_solver *b, int n) {
 }
 
 static const cv_method all[] = {CVAR_METHOD_LBFGS, CVAR_METHOD_TNEWTON, CVAR_METHOD_MMA,
-                                CVAR_METHOD_CCSAQ, CVAR_METHOD_SLSQP,  CVAR_METHOD_AUGLAG};
+                                CVAR_METHOD_CCSAQ, CVAR_METHOD_SLSQP,   CVAR_METHOD_AUGLAG};
 
 /* A minimiser stops on the flatness of S, so its nodal values agree with Newton's only to
  * about sqrt(ftol) relative: 1e-5 is the stated tolerance (rtol 1e-10, S ~ 1). */
@@ -64,10 +64,15 @@ static void compare(const char *name, cv_problem *p, int n, int E, int deg) {
 /* G = ph - (pi/2) s: holds at the sphere geodesic's ends; used for the size limit only. */
 static int linear_ph_G(int m, const double *x, const double *y, unsigned need, double *G,
                        double *Gy, double *Gyy, void *user) {
-  (void)need; (void)user; (void)Gyy;
+  (void)need;
+  (void)user;
+  (void)Gyy;
   for (int k = 0; k < m; k++) {
     G[k] = y[m + k] - PI / 2 * x[k];
-    if (Gy) { Gy[k] = 0; Gy[m + k] = 1; }
+    if (Gy) {
+      Gy[k] = 0;
+      Gy[m + k] = 1;
+    }
   }
   return 0;
 }
@@ -115,8 +120,9 @@ int main(void) {
       cv_solver_get_nodes(s, x);
       cv_solver_get_values(s, y);
       for (int j = 0; j < nn; j++) err = fmax(err, fabs(y[j] - (cosh(x[j]) - cosh(1.0))));
-      printf("chain      %-8s %-14s err %.2e  mu %.10f  evals %d (%s) gnorm %.2e\n", cv_method_name(con[k]),
-             cv_status_name(st), err, mu, cv_solver_get_num_iterations(s), cv_solver_last_error(s), cv_solver_get_gradient_norm(s));
+      printf("chain      %-8s %-14s err %.2e  mu %.10f  evals %d (%s) gnorm %.2e\n",
+             cv_method_name(con[k]), cv_status_name(st), err, mu, cv_solver_get_num_iterations(s),
+             cv_solver_last_error(s), cv_solver_get_gradient_norm(s));
       CHECK(st == CVAR_OK, "chain %s: %s", cv_method_name(con[k]), cv_solver_last_error(s));
       CHECK_NEAR("chain nodal error (nlopt)", err, 0, 1e-5);
       CHECK_NEAR("chain |mu| (nlopt, least squares)", fabs(mu), cosh(1.0), 1e-4);
@@ -188,10 +194,9 @@ int main(void) {
     cv_status st = cv_solve(s, p);
     printf("saddle     %-8s %-14s %s\n", cv_method_name(all[k]), cv_status_name(st),
            cv_solver_last_error(s));
-    CHECK(st != CVAR_OK, "%s claimed a minimum on the harmonic saddle",
-          cv_method_name(all[k]));
-    CHECK(st != CVAR_ENOTMIN || strstr(cv_solver_last_error(s), "saddle"),
-          "no saddle sentence: %s", cv_solver_last_error(s));
+    CHECK(st != CVAR_OK, "%s claimed a minimum on the harmonic saddle", cv_method_name(all[k]));
+    CHECK(st != CVAR_ENOTMIN || strstr(cv_solver_last_error(s), "saddle"), "no saddle sentence: %s",
+          cv_solver_last_error(s));
     cv_solver_free(s);
   }
   cv_problem_free(p);

@@ -13,14 +13,17 @@
 
 #define EPS_END 0.01
 
-static int poincare_F(int m, const double *x, const double *y, const double *dy,
-                      unsigned need, cv_partials *o, void *user) {
+static int poincare_F(int m, const double *x, const double *y, const double *dy, unsigned need,
+                      cv_partials *o, void *user) {
   (void)x, (void)need, (void)user;
   for (int k = 0; k < m; k++) {
     if (!(y[k] > 0)) return 1; /* outside the half-plane: cannot evaluate here */
     double p = dy[k], s = sqrt(1 + p * p), v = y[k];
     o->F[k] = s / v;
-    if (o->Fy) { o->Fy[k] = -s / (v * v); o->Fp[k] = p / (s * v); }
+    if (o->Fy) {
+      o->Fy[k] = -s / (v * v);
+      o->Fp[k] = p / (s * v);
+    }
     if (o->Fyy) {
       o->Fyy[k] = 2 * s / (v * v * v);
       o->Fyp[k] = -p / (s * v * v);
@@ -32,13 +35,20 @@ static int poincare_F(int m, const double *x, const double *y, const double *dy,
 
 /* y'^2/2 - pi^2 y^2/2 on [0, 1]: the conjugate point of 0 is the end 1, so with y(1) = 1
  * there is no stationary path (the Jacobi field sin(pi x) vanishes at both ends). */
-static int resonant_F(int m, const double *x, const double *y, const double *dy,
-                      unsigned need, cv_partials *o, void *user) {
+static int resonant_F(int m, const double *x, const double *y, const double *dy, unsigned need,
+                      cv_partials *o, void *user) {
   (void)x, (void)need, (void)user;
   for (int k = 0; k < m; k++) {
     o->F[k] = 0.5 * dy[k] * dy[k] - 0.5 * PI * PI * y[k] * y[k];
-    if (o->Fy) { o->Fy[k] = -PI * PI * y[k]; o->Fp[k] = dy[k]; }
-    if (o->Fyy) { o->Fyy[k] = -PI * PI; o->Fyp[k] = 0; o->Fpp[k] = 1; }
+    if (o->Fy) {
+      o->Fy[k] = -PI * PI * y[k];
+      o->Fp[k] = dy[k];
+    }
+    if (o->Fyy) {
+      o->Fyy[k] = -PI * PI;
+      o->Fyp[k] = 0;
+      o->Fpp[k] = 1;
+    }
   }
   return 0;
 }
@@ -62,11 +72,14 @@ int main(void) {
     double rel = fabs(cv_solver_get_action(s) - L) / L;
     double err = st == CVAR_OK ? max_nodal_error(s, circle) : NAN;
     printf("Poincare p=%d: %s, length %.12f (exact %.12f, relative %.1e), nodal error %.1e, "
-           "Morse %d\n  %s\n", deg[i], cv_strerror(st), cv_solver_get_action(s), L, rel, err,
+           "Morse %d\n  %s\n",
+           deg[i], cv_strerror(st), cv_solver_get_action(s), L, rel, err,
            cv_solver_get_morse_index(s), cv_solver_last_error(s));
     CHECK(st == CVAR_OK, "Poincare p=%d not solved", deg[i]);
-    CHECK(cv_solver_get_morse_index(s) == 0, "Poincare p=%d: Morse index %d, a minimum "
-          "expected", deg[i], cv_solver_get_morse_index(s));
+    CHECK(cv_solver_get_morse_index(s) == 0,
+          "Poincare p=%d: Morse index %d, a minimum "
+          "expected",
+          deg[i], cv_solver_get_morse_index(s));
     CHECK(rel <= 1e-10, "Poincare p=%d: length error %.3g", deg[i], rel);
     CHECK(err <= 1e-6, "Poincare p=%d: nodal error %.3g", deg[i], err);
     cv_solver_free(s);

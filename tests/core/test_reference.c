@@ -5,11 +5,14 @@
 
 #include "refproblems.h"
 
-static cv_problem *scalar_problem(double a, double b, cv_integrand_fn F, void *user,
-                                  double ya, double yb) {
+static cv_problem *scalar_problem(double a, double b, cv_integrand_fn F, void *user, double ya,
+                                  double yb) {
   cv_status why;
   cv_problem *p = cv_problem_new(1, a, b, &why);
-  if (!p) { fprintf(stderr, "cv_problem_new: %s\n", cv_strerror(why)); exit(1); }
+  if (!p) {
+    fprintf(stderr, "cv_problem_new: %s\n", cv_strerror(why));
+    exit(1);
+  }
   cv_problem_set_integrand(p, F, user);
   cv_problem_set_dirichlet(p, 0, ya, yb);
   return p;

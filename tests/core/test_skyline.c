@@ -13,13 +13,13 @@
 #include "core/cv_internal.h"
 
 static int fails;
-#define CHECK(c, ...)                  \
-  do {                                 \
-    if (!(c)) {                        \
-      fails++;                         \
-      printf("FAIL: " __VA_ARGS__);    \
-      printf("\n");                    \
-    }                                  \
+#define CHECK(c, ...)                                                                              \
+  do {                                                                                             \
+    if (!(c)) {                                                                                    \
+      fails++;                                                                                     \
+      printf("FAIL: " __VA_ARGS__);                                                                \
+      printf("\n");                                                                                \
+    }                                                                                              \
   } while (0)
 
 static int F2(int m, const double *x, const double *y, const double *dy, unsigned need,
@@ -32,8 +32,6 @@ static int F2(int m, const double *x, const double *y, const double *dy, unsigne
   }
   return 0;
 }
-
-
 
 static unsigned long rng = 12345;
 static double urand(void) { /* in [-1, 1) */
@@ -66,8 +64,7 @@ static void compare(int n, int E, int p, int integ, int zero_at) {
   cv_ldlt_new(&d, g2, &B, msg, sizeof msg);
   cv_ldlt_skyline_max = keep;
   const int *ca = cv_ldlt_colptr(A), *cb = cv_ldlt_colptr(B);
-  CHECK(!memcmp(ca, cb, (nf + 1) * sizeof *ca) && !memcmp(g1, g2, nf * sizeof *g1),
-        "same pattern");
+  CHECK(!memcmp(ca, cb, (nf + 1) * sizeof *ca) && !memcmp(g1, g2, nf * sizeof *g1), "same pattern");
   CHECK(cv_ldlt_matches(A, &d, g1) && cv_ldlt_matches(B, &d, g2), "matches its own disc");
   for (int trial = 0; trial < 3; trial++) {
     double *xa = cv_ldlt_values(A), *xb = cv_ldlt_values(B);
@@ -77,7 +74,8 @@ static void compare(int n, int E, int p, int integ, int zero_at) {
         if (q == ca[c + 1] - 1) v = (trial == 0 ? 4.0 : 2.0 * urand()) * (ca[c + 1] - ca[c]);
         if (zero_at >= 0 && c == zero_at && q == ca[c + 1] - 1) v = 0.0;
         if (zero_at >= 0 && c == zero_at && q != ca[c + 1] - 1) v = 0.0;
-        if (zero_at >= 0 && c > zero_at && ca[c + 1] - ca[c] > c - zero_at && q == ca[c] + zero_at - (c + 1 - (ca[c + 1] - ca[c])))
+        if (zero_at >= 0 && c > zero_at && ca[c + 1] - ca[c] > c - zero_at &&
+            q == ca[c] + zero_at - (c + 1 - (ca[c + 1] - ca[c])))
           v = 0.0; /* row zero_at empty: an exactly zero pivot there */
         xa[q] = xb[q] = v;
       }
@@ -85,10 +83,10 @@ static void compare(int n, int E, int p, int integ, int zero_at) {
     double lo_a, hi_a, lo_b, hi_b;
     cv_status sa = cv_ldlt_factor(A, &na, &lo_a, &hi_a, msg, sizeof msg);
     cv_status sb = cv_ldlt_factor(B, &nb, &lo_b, &hi_b, msg, sizeof msg);
-    CHECK(sa == sb, "n=%d E=%d p=%d integ=%d trial %d: status %d vs CHOLMOD %d", n, E, p,
-          integ, trial, sa, sb);
-    CHECK(na == nb, "n=%d E=%d p=%d trial %d: %d negative pivots vs CHOLMOD %d", n, E, p,
-          trial, na, nb);
+    CHECK(sa == sb, "n=%d E=%d p=%d integ=%d trial %d: status %d vs CHOLMOD %d", n, E, p, integ,
+          trial, sa, sb);
+    CHECK(na == nb, "n=%d E=%d p=%d trial %d: %d negative pivots vs CHOLMOD %d", n, E, p, trial, na,
+          nb);
     CHECK(fabs(lo_a - lo_b) <= 1e-10 * fmax(lo_b, 1e-300) + 1e-300 &&
               fabs(hi_a - hi_b) <= 1e-10 * hi_b,
           "pivot ratio %g vs %g, largest pivot %g vs %g", lo_a, lo_b, hi_a, hi_b);
@@ -103,12 +101,14 @@ static void compare(int n, int E, int p, int integ, int zero_at) {
     CHECK(e < 1e-10, "pivots differ by %g", e);
     for (int mode = 0; mode < 3; mode++) {
       for (int f = 0; f < nf; f++) b1[f] = b2[f] = urand();
-      if (mode == 0) cv_ldlt_solve(A, b1), cv_ldlt_solve(B, b2);
-      else cv_ldlt_solve_L(A, mode - 1, b1), cv_ldlt_solve_L(B, mode - 1, b2);
+      if (mode == 0)
+        cv_ldlt_solve(A, b1), cv_ldlt_solve(B, b2);
+      else
+        cv_ldlt_solve_L(A, mode - 1, b1), cv_ldlt_solve_L(B, mode - 1, b2);
       double m = 0, sc = 0;
       for (int f = 0; f < nf; f++) m = fmax(m, fabs(b1[f] - b2[f])), sc = fmax(sc, fabs(b2[f]));
-      CHECK(m <= 1e-9 * sc, "n=%d E=%d p=%d trial %d solve mode %d differs by %g of %g", n,
-            E, p, trial, mode, m, sc);
+      CHECK(m <= 1e-9 * sc, "n=%d E=%d p=%d trial %d solve mode %d differs by %g of %g", n, E, p,
+            trial, mode, m, sc);
     }
     free(D1), free(D2), free(b1), free(b2);
   }
@@ -134,8 +134,7 @@ static void keeps_factor(void) {
   CHECK(cv_solve(s, pr) == CVAR_OK && fabs(cv_solver_get_action(s) - 0.5) < 1e-13,
         "first solve: action %.17g", cv_solver_get_action(s));
   const void *f1 = s->ldlt;
-  CHECK(cv_solve(s, pr) == CVAR_OK && fabs(cv_solver_get_action(s) - 0.5) < 1e-13,
-        "second solve");
+  CHECK(cv_solve(s, pr) == CVAR_OK && fabs(cv_solver_get_action(s) - 0.5) < 1e-13, "second solve");
   CHECK(f1 && s->ldlt == f1, "the second solve on the same mesh keeps the factor");
   cv_solver_set_elements(s, 5); /* new pattern: the factor must be replaced */
   cv_solver_set_degree(s, 3);

@@ -10,22 +10,24 @@
 #include "core/cv_memory.h"
 
 static int fails;
-#define CHECK(c, ...)                                                                          \
-  do {                                                                                         \
-    if (!(c)) {                                                                                \
-      fails++;                                                                                 \
-      printf("FAIL %s:%d: ", __FILE__, __LINE__);                                              \
-      printf(__VA_ARGS__);                                                                     \
-      printf("\n");                                                                            \
-    }                                                                                          \
+#define CHECK(c, ...)                                                                              \
+  do {                                                                                             \
+    if (!(c)) {                                                                                    \
+      fails++;                                                                                     \
+      printf("FAIL %s:%d: ", __FILE__, __LINE__);                                                  \
+      printf(__VA_ARGS__);                                                                         \
+      printf("\n");                                                                                \
+    }                                                                                              \
   } while (0)
 
 /* the root of th = sqrt(2) cosh(th/4) in [lo, hi] by bisection */
 static double theta(double lo, double hi) {
   for (int i = 0; i < 200; i++) {
     double m = 0.5 * (lo + hi);
-    if ((lo - sqrt(2.0) * cosh(lo / 4)) * (m - sqrt(2.0) * cosh(m / 4)) <= 0) hi = m;
-    else lo = m;
+    if ((lo - sqrt(2.0) * cosh(lo / 4)) * (m - sqrt(2.0) * cosh(m / 4)) <= 0)
+      hi = m;
+    else
+      lo = m;
   }
   return 0.5 * (lo + hi);
 }
@@ -38,7 +40,8 @@ int main(void) {
   cv_search_info in;
   if (!p || !s) return 1;
   CHECK(cv_problem_set_integrand_expr(p, "x", "y", "y'^2/2 - exp(y)", NULL, err, sizeof err) ==
-            CVAR_OK, "%s", err);
+            CVAR_OK,
+        "%s", err);
   cv_problem_set_dirichlet(p, 0, 0.0, 0.0);
   cv_solver_set_elements(s, 24);
   cv_solver_set_degree(s, 8);
@@ -53,8 +56,8 @@ int main(void) {
 
   CHECK(cv_solve_all(s, p, 8) == CVAR_OK, "%s", cv_solver_last_error(s));
   CHECK(cv_solver_get_num_solutions(s) == 2, "%d paths", cv_solver_get_num_solutions(s));
-  CHECK(cv_solver_get_search(s, &in) == CVAR_OK && in.found == 2 && in.starts >= 2 &&
-            in.stop[0], "search record: %d found, %d starts", in.found, in.starts);
+  CHECK(cv_solver_get_search(s, &in) == CVAR_OK && in.found == 2 && in.starts >= 2 && in.stop[0],
+        "search record: %d found, %d starts", in.found, in.starts);
   double th[2] = {theta(0.5, 4.0), theta(4.0, 20.0)}, prev = -INFINITY;
   for (int k = 0; k < cv_solver_get_num_solutions(s); k++) {
     CHECK(cv_solver_select_solution(s, k) == CVAR_OK, "select %d", k);
@@ -79,11 +82,11 @@ int main(void) {
   CHECK(cv_solver_select_solution(s, 0) == CVAR_OK && cv_solver_get_morse_index(s) == 0,
         "back to the first path");
   /* --max 1: the search stops at one path, the plain solve's from the guess */
-  CHECK(cv_solve_all(s, p, 1) == CVAR_OK && cv_solver_get_num_solutions(s) == 1,
-        "max 1");
+  CHECK(cv_solve_all(s, p, 1) == CVAR_OK && cv_solver_get_num_solutions(s) == 1, "max 1");
   /* a plain solve forgets the paths */
   CHECK(cv_solve(s, p) == CVAR_OK && cv_solver_get_num_solutions(s) == 0 &&
-            cv_solver_get_search(s, &in) == CVAR_ESTATE, "cv_solve forgets the paths");
+            cv_solver_get_search(s, &in) == CVAR_ESTATE,
+        "cv_solve forgets the paths");
   /* every allocation of a small search fails once in turn: a status, never a crash or a
    * leak (the ASan build checks the leaks); the search succeeds once allocations do */
   cv_solver_set_elements(s, 4);
@@ -94,13 +97,11 @@ int main(void) {
     cv_status st = cv_solve_all(s, p, 2);
     cv_debug_fail_alloc_after(-1);
     int np = cv_solver_get_num_solutions(s);
-    CHECK(st == CVAR_OK ? np >= 1 : np == 0, "allocation %d: status %d with %d paths", k, st,
-          np);
+    CHECK(st == CVAR_OK ? np >= 1 : np == 0, "allocation %d: status %d with %d paths", k, st, np);
     done |= st == CVAR_OK && np == 2;
   }
   CHECK(done, "the search never completed");
-  CHECK(cv_solve_all(s, p, 2) == CVAR_OK && cv_solver_get_num_solutions(s) == 2,
-        "after the sweep");
+  CHECK(cv_solve_all(s, p, 2) == CVAR_OK && cv_solver_get_num_solutions(s) == 2, "after the sweep");
   printf("allocation failures injected at %d points\n", k);
   cv_solver_free(s);
   cv_problem_free(p);

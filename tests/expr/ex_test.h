@@ -16,24 +16,24 @@ static const char *const slot_names[NSLOTS] = {"x", "y", "z", "y'", "z'"};
 
 static int failures = 0;
 
-#define CHECK(cond, ...)                                                                     \
-  do {                                                                                       \
-    if (!(cond)) {                                                                           \
-      failures++;                                                                            \
-      fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                                   \
-      fprintf(stderr, __VA_ARGS__);                                                          \
-      fprintf(stderr, "\n");                                                                 \
-    }                                                                                        \
+#define CHECK(cond, ...)                                                                           \
+  do {                                                                                             \
+    if (!(cond)) {                                                                                 \
+      failures++;                                                                                  \
+      fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                                         \
+      fprintf(stderr, __VA_ARGS__);                                                                \
+      fprintf(stderr, "\n");                                                                       \
+    }                                                                                              \
   } while (0)
 
 /* |actual - expected| <= tol * scale, printed with all three on failure. */
-#define CHECK_CLOSE(what, actual, expected, tol, scale)                                      \
-  CHECK(fabs((actual) - (expected)) <= (tol) * (scale),                                      \
-        "%s: expected %.17g, actual %.17g, tolerance %.3g (scale %.3g)", (what),              \
+#define CHECK_CLOSE(what, actual, expected, tol, scale)                                            \
+  CHECK(fabs((actual) - (expected)) <= (tol) * (scale),                                            \
+        "%s: expected %.17g, actual %.17g, tolerance %.3g (scale %.3g)", (what),                   \
         (double)(expected), (double)(actual), (double)(tol), (double)(scale))
 
 static inline ex_id test_resolve(ex_dag *d, const char *name, int primes, void *user, char *err,
-                          size_t errlen) {
+                                 size_t errlen) {
   (void)user;
   if (strcmp(name, "x") == 0) {
     if (primes) {

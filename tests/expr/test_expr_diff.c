@@ -11,14 +11,13 @@
  * Second derivatives: second differences of f itself (not of the symbolic first
  * derivative, so the check is independent) with h = 1e-4: truncation h^2 f''''/12 ~ 1e-9
  * f'''', round-off ~ 4 eps |f| / h^2 ~ 1e-7 |f|; tolerance 1e-4 * max(1, |f|, |f''|). */
-#define H1 1e-5
-#define H2 1e-4
-#define TOL1 1e-6
-#define TOL2 1e-4
+#define H1      1e-5
+#define H2      1e-4
+#define TOL1    1e-6
+#define TOL2    1e-4
 #define NPOINTS 12
 
-static double f_at(const ex_dag *d, ex_id e, const double *s, int i, double hi, int j,
-                   double hj) {
+static double f_at(const ex_dag *d, ex_id e, const double *s, int i, double hi, int j, double hj) {
   double p[NSLOTS];
   memcpy(p, s, sizeof p);
   p[i] += hi;
@@ -41,8 +40,8 @@ static void check_corpus(void) {
       d1[i] = ex_diff(d, e, i);
       CHECK(d1[i] >= 0, "%s: d/d%s failed", corpus[c].src, slot_names[i]);
       if (!ex_depends_on(d, e, i))
-        CHECK(d1[i] == ex_num(d, 0), "%s: d/d%s of an absent slot is not the node 0",
-              corpus[c].src, slot_names[i]);
+        CHECK(d1[i] == ex_num(d, 0), "%s: d/d%s of an absent slot is not the node 0", corpus[c].src,
+              slot_names[i]);
     }
     for (int i = 0; i < NSLOTS; i++)
       for (int j = 0; j < NSLOTS; j++) d2[i][j] = ex_diff(d, d1[i], j);
@@ -70,8 +69,8 @@ static void check_corpus(void) {
                    f_at(d, e, s, i, -H2, j, H2) + f_at(d, e, s, i, -H2, j, -H2)) /
                   (4 * H2 * H2);
           }
-          snprintf(what, sizeof what, "d2(%s)/d%s d%s at point %d", corpus[c].src,
-                   slot_names[i], slot_names[j], pt);
+          snprintf(what, sizeof what, "d2(%s)/d%s d%s at point %d", corpus[c].src, slot_names[i],
+                   slot_names[j], pt);
           CHECK_CLOSE(what, sym2, fd2, TOL2, fmax(1, fmax(fabs(f), fabs(sym2))));
           /* Mixed partials agree symbolically up to rounding. */
           double sym2t = eval_at(d, d2[j][i], s);
@@ -83,7 +82,8 @@ static void check_corpus(void) {
     ex_dag_free(d);
   }
   printf("corpus: %d expressions, %d first and %d second derivative values checked, "
-         "%d points skipped near kinks\n", NCORPUS, checked1, checked2, skipped);
+         "%d points skipped near kinks\n",
+         NCORPUS, checked1, checked2, skipped);
   CHECK(NCORPUS >= 40, "corpus has %d expressions", NCORPUS);
   CHECK(skipped < NCORPUS * NPOINTS / 20, "too many skipped points: %d", skipped);
 }
@@ -96,9 +96,9 @@ static void check_kinks(void) {
     double at[NSLOTS];
     double expected;
   } cases[] = {
-      {"abs(y')", 3, {0, 0, 0, 0, 0}, 1},                  /* abs(u) = u for u >= 0 */
+      {"abs(y')", 3, {0, 0, 0, 0, 0}, 1}, /* abs(u) = u for u >= 0 */
       {"abs(y')", 3, {0, 0, 0, -1, 0}, -1},
-      {"min(x, y)", 0, {0.5, 0.5, 0, 0, 0}, 1},            /* tie: min takes x */
+      {"min(x, y)", 0, {0.5, 0.5, 0, 0, 0}, 1}, /* tie: min takes x */
       {"min(x, y)", 1, {0.5, 0.5, 0, 0, 0}, 0},
       {"max(x, y)", 0, {0.5, 0.5, 0, 0, 0}, 1},
       {"max(x, y)", 0, {0.4, 0.5, 0, 0, 0}, 0},
@@ -111,8 +111,7 @@ static void check_kinks(void) {
     char err[256];
     ex_id e = ex_parse(d, cases[k].src, test_resolve, NULL, 0, err, sizeof err);
     if (e < 0) { /* "x*(x > 0.5)" is not in the grammar: build it directly */
-      e = ex_binary(d, EX_MUL, ex_slot(d, 0),
-                    ex_binary(d, EX_GT, ex_slot(d, 0), ex_num(d, 0.5)));
+      e = ex_binary(d, EX_MUL, ex_slot(d, 0), ex_binary(d, EX_GT, ex_slot(d, 0), ex_num(d, 0.5)));
     }
     ex_id de = ex_diff(d, e, cases[k].slot);
     CHECK_CLOSE(cases[k].src, eval_at(d, de, cases[k].at), cases[k].expected, 0, 1);

@@ -9,15 +9,12 @@
 #include "ex_test.h"
 
 /* Same value: both NaN, or equal with the same sign (so -0 and +0 differ, inf signs too). */
-static int same(double a, double b)
-{
-  if (isnan(a) || isnan(b))
-    return isnan(a) && isnan(b);
+static int same(double a, double b) {
+  if (isnan(a) || isnan(b)) return isnan(a) && isnan(b);
   return a == b && signbit(a) == signbit(b);
 }
 
-static void check_constants(void)
-{
+static void check_constants(void) {
   const double inf = INFINITY;
   volatile double zero = 0.0, one = 1.0, two = 2.0; /* C's own IEEE results, at run time */
   const struct {
@@ -39,11 +36,11 @@ static void check_constants(void)
       {"exp(1000) - exp(1000)", exp(1000 * one) - exp(1000 * one)},
       {"acos(2)*0", acos(two) * 0.0},
       {"atanh(1) - atanh(1)", atanh(one) - atanh(one)},
-      {"(1/0)^0", pow(inf, 0.0)},           /* C's pow: 1, an IEEE result like any other */
-      {"1/(1/0)", one / inf},                /* 0, computed from a non-finite constant */
+      {"(1/0)^0", pow(inf, 0.0)}, /* C's pow: 1, an IEEE result like any other */
+      {"1/(1/0)", one / inf},     /* 0, computed from a non-finite constant */
       {"1e308 + 1e308", 1e308 + 1e308},
       {"0/0 + 1", NAN},
-      {"2*0.5", 1.0},                        /* a finite constant still folds */
+      {"2*0.5", 1.0}, /* a finite constant still folds */
   };
   for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
     ex_dag *d = ex_dag_new();
@@ -66,8 +63,7 @@ static void check_constants(void)
 }
 
 /* The symbolic rules stay for expressions in a slot (they are exact as real functions). */
-static void check_symbolic(void)
-{
+static void check_symbolic(void) {
   const char *zero_cases[] = {"x*0", "0*y", "y - y", "0/x", "sin(x)*0"};
   for (size_t i = 0; i < sizeof zero_cases / sizeof *zero_cases; i++) {
     ex_dag *d = ex_dag_new();
@@ -100,8 +96,7 @@ static void check_symbolic(void)
  * every operation is finite is what the folder turns into one number, and a number node has
  * one zero (+0); the reference does the same, so the comparison can be bit for bit. */
 static uint64_t rng = 0x9E3779B97F4A7C15ull;
-static unsigned next(void)
-{
+static unsigned next(void) {
   rng ^= rng << 13;
   rng ^= rng >> 7;
   rng ^= rng << 17;
@@ -113,8 +108,7 @@ typedef struct {
   int folded; /* every operation finite: one number node */
 } ref;
 
-static ref gen(char *buf, size_t len, int depth)
-{
+static ref gen(char *buf, size_t len, int depth) {
   static const char *const leaves[] = {"0", "1", "2", "0.5", "3", "1e300", "1e-300"};
   static const double leafv[] = {0, 1, 2, 0.5, 3, 1e300, 1e-300};
   ref r;
@@ -129,27 +123,51 @@ static ref gen(char *buf, size_t len, int depth)
   unsigned op = next() % 9;
   ref x = gen(a, sizeof a, depth - 1);
   ref y = {0, 1};
-  if (op < 5)
-    y = gen(b, sizeof b, depth - 1);
+  if (op < 5) y = gen(b, sizeof b, depth - 1);
   switch (op) {
-  case 0: r.v = x.v + y.v; snprintf(buf, len, "(%s) + (%s)", a, b); break;
-  case 1: r.v = x.v - y.v; snprintf(buf, len, "(%s) - (%s)", a, b); break;
-  case 2: r.v = x.v * y.v; snprintf(buf, len, "(%s)*(%s)", a, b); break;
-  case 3: r.v = x.v / y.v; snprintf(buf, len, "(%s)/(%s)", a, b); break;
-  case 4: r.v = pow(x.v, y.v); snprintf(buf, len, "(%s)^(%s)", a, b); break;
-  case 5: r.v = sqrt(x.v); snprintf(buf, len, "sqrt(%s)", a); break;
-  case 6: r.v = log(x.v); snprintf(buf, len, "log(%s)", a); break;
-  case 7: r.v = -x.v; snprintf(buf, len, "-(%s)", a); break;
-  default: r.v = exp(x.v); snprintf(buf, len, "exp(%s)", a); break;
+  case 0:
+    r.v = x.v + y.v;
+    snprintf(buf, len, "(%s) + (%s)", a, b);
+    break;
+  case 1:
+    r.v = x.v - y.v;
+    snprintf(buf, len, "(%s) - (%s)", a, b);
+    break;
+  case 2:
+    r.v = x.v * y.v;
+    snprintf(buf, len, "(%s)*(%s)", a, b);
+    break;
+  case 3:
+    r.v = x.v / y.v;
+    snprintf(buf, len, "(%s)/(%s)", a, b);
+    break;
+  case 4:
+    r.v = pow(x.v, y.v);
+    snprintf(buf, len, "(%s)^(%s)", a, b);
+    break;
+  case 5:
+    r.v = sqrt(x.v);
+    snprintf(buf, len, "sqrt(%s)", a);
+    break;
+  case 6:
+    r.v = log(x.v);
+    snprintf(buf, len, "log(%s)", a);
+    break;
+  case 7:
+    r.v = -x.v;
+    snprintf(buf, len, "-(%s)", a);
+    break;
+  default:
+    r.v = exp(x.v);
+    snprintf(buf, len, "exp(%s)", a);
+    break;
   }
   r.folded = x.folded && y.folded && isfinite(r.v);
-  if (r.folded && r.v == 0)
-    r.v = 0.0; /* the one zero of a number node */
+  if (r.folded && r.v == 0) r.v = 0.0; /* the one zero of a number node */
   return r;
 }
 
-static void check_fuzz(void)
-{
+static void check_fuzz(void) {
   int nonfinite = 0, n = 20000;
   char text[2048];
   for (int i = 0; i < n; i++) {
@@ -162,18 +180,18 @@ static void check_fuzz(void)
     if (e >= 0 && ex_eval_const(d, e, &v) == 0) {
       CHECK(same(v, r.v), "fuzz \"%s\": folded %.17g, IEEE %.17g", text, v, r.v);
       /* the loader's test: a non-finite constant somewhere iff some operation was not */
-      CHECK((ex_nonfinite_const(d, e) >= 0) == !r.folded, "fuzz \"%s\": nonfinite_const %d",
-            text, ex_nonfinite_const(d, e));
+      CHECK((ex_nonfinite_const(d, e) >= 0) == !r.folded, "fuzz \"%s\": nonfinite_const %d", text,
+            ex_nonfinite_const(d, e));
       nonfinite += !r.folded;
     }
     ex_dag_free(d);
   }
   printf("fuzz: %d constant expressions, %d with a non-finite part, all equal to C's IEEE "
-         "values\n", n, nonfinite);
+         "values\n",
+         n, nonfinite);
 }
 
-int main(void)
-{
+int main(void) {
   check_constants();
   check_symbolic();
   check_fuzz();

@@ -8,7 +8,7 @@
 /* Hand formulas and the tape round differently (x*x for ^2, operation order): a few ulps
  * on O(1) values. Tolerance 1e-13 * (1 + |value|). */
 #define TOL 1e-13
-#define M 300 /* more than one internal batch of 256 */
+#define M   300 /* more than one internal batch of 256 */
 
 static ex_id resolve2(ex_dag *d, const char *name, int primes, void *user, char *err,
                       size_t errlen) {
@@ -41,8 +41,8 @@ static void prefill(buffers *b, unsigned need, cv_partials *p) {
 typedef void (*hand_fn)(double x, const double *y, const double *p, double *F, double *Fy,
                         double *Fp, double *Fyy, double *Fyp, double *Fpp);
 
-static void catenary(double x, const double *y, const double *p, double *F, double *Fy,
-                     double *Fp, double *Fyy, double *Fyp, double *Fpp) {
+static void catenary(double x, const double *y, const double *p, double *F, double *Fy, double *Fp,
+                     double *Fyy, double *Fyp, double *Fpp) {
   (void)x;
   double s = sqrt(1 + p[0] * p[0]);
   *F = y[0] * s;
@@ -53,8 +53,8 @@ static void catenary(double x, const double *y, const double *p, double *F, doub
   Fpp[0] = y[0] / (s * s * s);
 }
 
-static void sphere(double x, const double *y, const double *p, double *F, double *Fy,
-                   double *Fp, double *Fyy, double *Fyp, double *Fpp) {
+static void sphere(double x, const double *y, const double *p, double *F, double *Fy, double *Fp,
+                   double *Fyy, double *Fyp, double *Fpp) {
   (void)x;
   double th = y[0], s = sin(th), c = cos(th), tp = p[0], pp = p[1];
   *F = tp * tp + s * s * pp * pp;
@@ -80,15 +80,18 @@ static void check_case(const char *F, const char *const *names, int n, hand_fn h
   char err[256];
   ex_id f = ex_parse(d, F, resolve2, (void *)names, 0, err, sizeof err);
   CHECK(f >= 0, "%s: %s", F, err);
-  ex_integrand *g = ex_integrand_new(d, n, f, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS,
-                                     err, sizeof err);
+  ex_integrand *g =
+      ex_integrand_new(d, n, f, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, err, sizeof err);
   ex_dag_free(d); /* the compiled integrand needs no DAG */
   CHECK(g != NULL, "%s: %s", F, err);
   if (!g) return;
   static buffers b;
-  const unsigned needs[] = {CVAR_NEED_F, CVAR_NEED_F | CVAR_NEED_GRAD,
-                            CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, CVAR_NEED_HESS,
-                            CVAR_NEED_GRAD, CVAR_NEED_GRAD | CVAR_NEED_HESS};
+  const unsigned needs[] = {CVAR_NEED_F,
+                            CVAR_NEED_F | CVAR_NEED_GRAD,
+                            CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS,
+                            CVAR_NEED_HESS,
+                            CVAR_NEED_GRAD,
+                            CVAR_NEED_GRAD | CVAR_NEED_HESS};
   for (size_t t = 0; t < sizeof needs / sizeof needs[0]; t++) {
     unsigned need = needs[t];
     cv_partials p;
@@ -100,10 +103,10 @@ static void check_case(const char *F, const char *const *names, int n, hand_fn h
       for (int i = 0; i < n; i++) yk[i] = y[i * M + k], pk[i] = dy[i * M + k];
       hand(x[k], yk, pk, &hF, hFy, hFp, hFyy, hFyp, hFpp);
       char what[128];
-#define CMP(name, buf, idx, ref)                                                            \
-  do {                                                                                      \
-    snprintf(what, sizeof what, "%s need %u %s[%d] point %d", F, need, name, idx, k);        \
-    CHECK_CLOSE(what, (buf)[(size_t)(idx) * M + k], ref, TOL, 1 + fabs(ref));               \
+#define CMP(name, buf, idx, ref)                                                                   \
+  do {                                                                                             \
+    snprintf(what, sizeof what, "%s need %u %s[%d] point %d", F, need, name, idx, k);              \
+    CHECK_CLOSE(what, (buf)[(size_t)(idx)*M + k], ref, TOL, 1 + fabs(ref));                        \
   } while (0)
       if (need & CVAR_NEED_F) CMP("F", b.F, 0, hF);
       if (need & CVAR_NEED_GRAD)

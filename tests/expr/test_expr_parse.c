@@ -16,14 +16,14 @@ static void check_values(void) {
       {"2 + 3*4", 2 + 3 * 4},
       {"(2 + 3)*4", (2 + 3) * 4},
       {"2*3^2", 2 * 9},
-      {"-2^2", -4},                 /* ^ binds tighter than unary minus */
+      {"-2^2", -4}, /* ^ binds tighter than unary minus */
       {"-x^2", -(X * X)},
       {"(-x)^2", X * X},
-      {"2^3^2", 512},               /* right-associative: 2^(3^2) */
+      {"2^3^2", 512}, /* right-associative: 2^(3^2) */
       {"(2^3)^2", 64},
       {"2^-1", 0.5},
       {"x^-y^2", pow(X, -(Y * Y))},
-      {"8/4/2", 1},                 /* left-associative */
+      {"8/4/2", 1}, /* left-associative */
       {"8-4-2", 2},
       {"2*-3", -6},
       {"--x", X},
@@ -38,17 +38,28 @@ static void check_values(void) {
       {"2*pi*x", 2 * pi * X},
       {"y' * z'", YP * ZP},
       {"  x\t+\n y ", X + Y},
-      {"sin(x)", sin(X)},     {"cos(x)", cos(X)},     {"tan(x)", tan(X)},
-      {"asin(y)", asin(Y)},   {"acos(y)", acos(Y)},   {"atan(z)", atan(Z)},
-      {"sinh(x)", sinh(X)},   {"cosh(x)", cosh(X)},   {"tanh(x)", tanh(X)},
-      {"asinh(y')", asinh(YP)}, {"acosh(z)", acosh(Z)}, {"atanh(y)", atanh(Y)},
-      {"exp(x)", exp(X)},     {"log(z)", log(Z)},     {"sqrt(z)", sqrt(Z)},
+      {"sin(x)", sin(X)},
+      {"cos(x)", cos(X)},
+      {"tan(x)", tan(X)},
+      {"asin(y)", asin(Y)},
+      {"acos(y)", acos(Y)},
+      {"atan(z)", atan(Z)},
+      {"sinh(x)", sinh(X)},
+      {"cosh(x)", cosh(X)},
+      {"tanh(x)", tanh(X)},
+      {"asinh(y')", asinh(YP)},
+      {"acosh(z)", acosh(Z)},
+      {"atanh(y)", atanh(Y)},
+      {"exp(x)", exp(X)},
+      {"log(z)", log(Z)},
+      {"sqrt(z)", sqrt(Z)},
       {"abs(y')", fabs(YP)},
       {"atan2(y, x)", atan2(Y, X)},
       {"atan2(1, -1)", atan2(1, -1)},
       {"pow(z, x)", pow(Z, X)},
       {"pow(2, 10)", 1024},
-      {"min(x, y)", fmin(X, Y)}, {"max(x, y)", fmax(X, Y)},
+      {"min(x, y)", fmin(X, Y)},
+      {"max(x, y)", fmax(X, Y)},
       {"min(3, 2)", 2},
       {"if(x < y, 1, 2)", X < Y ? 1 : 2},
       {"if(x <= y, 1, 2)", X <= Y ? 1 : 2},
@@ -57,7 +68,7 @@ static void check_values(void) {
       {"if(x <= x, 3, 4)", 3},
       {"if(y' > 0, y', -y')", fabs(YP)},
       {"if(x + y < z*2, x - y, x*y)", X + Y < Z * 2 ? X - Y : X * Y},
-      {"if(x, 5, 6)", 5},          /* a bare condition is true when nonzero */
+      {"if(x, 5, 6)", 5}, /* a bare condition is true when nonzero */
       {"sin(x)^2 + cos(x)^2", sin(X) * sin(X) + cos(X) * cos(X)},
       {"exp(-x^2/2)/sqrt(2*pi)", exp(-(X * X) / 2) / sqrt(2 * pi)},
       {"y*sqrt(1 + y'^2)", Y * sqrt(1 + YP * YP)},
@@ -123,26 +134,26 @@ static void check_errors(void) {
   for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
     ex_dag *d = ex_dag_new();
     char err[256] = "unchanged";
-    ex_id e = ex_parse(d, cases[i].src, test_resolve, NULL, cases[i].allow_second, err,
-                       sizeof err);
+    ex_id e = ex_parse(d, cases[i].src, test_resolve, NULL, cases[i].allow_second, err, sizeof err);
     char want[32];
     snprintf(want, sizeof want, "column %d: ", cases[i].column);
     CHECK(e < 0, "\"%s\" parsed but should fail", cases[i].src);
     CHECK(strncmp(err, want, strlen(want)) == 0 && strstr(err, cases[i].contains),
-          "\"%s\": expected message starting \"%s\" containing \"%s\", actual \"%s\"",
-          cases[i].src, want, cases[i].contains, err);
+          "\"%s\": expected message starting \"%s\" containing \"%s\", actual \"%s\"", cases[i].src,
+          want, cases[i].contains, err);
     ex_dag_free(d);
   }
   /* y'' is accepted where allowed. */
   ex_dag *d = ex_dag_new();
   char err[256];
   ex_id e = ex_parse(d, "y'' + z''", test_resolve, NULL, 1, err, sizeof err);
-  CHECK(e >= 0 && ex_depends_on(d, e, 5) && ex_depends_on(d, e, 6),
-        "y'' with allow_second: %s", e < 0 ? err : "wrong slots");
+  CHECK(e >= 0 && ex_depends_on(d, e, 5) && ex_depends_on(d, e, 6), "y'' with allow_second: %s",
+        e < 0 ? err : "wrong slots");
   /* A tiny error buffer is truncated, never overrun (ASan would catch it). */
   char tiny[8];
   CHECK(ex_parse(d, "(((", test_resolve, NULL, 0, tiny, sizeof tiny) < 0 &&
-            strlen(tiny) == sizeof tiny - 1, "truncated message \"%s\"", tiny);
+            strlen(tiny) == sizeof tiny - 1,
+        "truncated message \"%s\"", tiny);
   CHECK(ex_parse(d, "(((", test_resolve, NULL, 0, NULL, 0) < 0, "NULL err buffer");
   CHECK(ex_parse(d, NULL, test_resolve, NULL, 0, err, sizeof err) < 0, "NULL source");
   ex_dag_free(d);
@@ -226,7 +237,8 @@ static void check_sharing(void) {
   CHECK(ex_eval_const(d, parse_ok(d, "x"), &v) == -1, "ex_eval_const on x");
   ex_id e = parse_ok(d, "sin(x) + z*y'");
   CHECK(ex_depends_on(d, e, 0) && !ex_depends_on(d, e, 1) && ex_depends_on(d, e, 2) &&
-            ex_depends_on(d, e, 3) && !ex_depends_on(d, e, 4), "ex_depends_on");
+            ex_depends_on(d, e, 3) && !ex_depends_on(d, e, 4),
+        "ex_depends_on");
   /* Substitution: y' -> 2*x in sin(x) + z*y' gives sin(x) + 2*x*z. */
   ex_id s = ex_subst(d, e, 3, parse_ok(d, "2*x"));
   CHECK(s == parse_ok(d, "sin(x) + z*(2*x)"), "ex_subst");
@@ -239,7 +251,8 @@ static void check_many_slots(void) {
   ex_dag *d = ex_dag_new();
   ex_id a = ex_binary(d, EX_ADD, ex_slot(d, 1), ex_slot(d, 70));
   CHECK(ex_depends_on(d, a, 70) && ex_depends_on(d, a, 1) && !ex_depends_on(d, a, 6) &&
-            !ex_depends_on(d, a, 65), "slots beyond 64");
+            !ex_depends_on(d, a, 65),
+        "slots beyond 64");
   ex_id da = ex_diff(d, a, 65);
   CHECK(da == ex_num(d, 0), "d/d slot 65 of s1 + s70 is 0");
   ex_dag_free(d);

@@ -91,7 +91,7 @@ static const char *leftover(const char *s) {
     char prev = b > 0 ? s[b - 1] : 0;
     while (s[j] == ' ') j++;
     char next = s[j];
-    if (v == 0 && (strchr("*/^+-", prev) && prev) ) return "0 as an operand";
+    if (v == 0 && (strchr("*/^+-", prev) && prev)) return "0 as an operand";
     if (v == 0 && next && strchr("*/^+-", next)) return "0 as an operand";
     if (v == 1 && prev && strchr("*/^", prev)) return "1 as a factor, divisor or exponent";
     if (v == 1 && next == '*') return "1 as a factor";
@@ -138,8 +138,8 @@ static void check_roundtrip(void) {
         double s[NSLOTS];
         random_point(s);
         double v0 = eval_at(d, list[k], s), v1 = eval_at(d, back, s);
-        CHECK(v0 == v1 || (isnan(v0) && isnan(v1)), "\"%s\": %.17g vs re-parsed %.17g", buf,
-              v0, v1);
+        CHECK(v0 == v1 || (isnan(v0) && isnan(v1)), "\"%s\": %.17g vs re-parsed %.17g", buf, v0,
+              v1);
       }
       printed++;
     }

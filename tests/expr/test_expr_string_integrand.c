@@ -8,9 +8,9 @@ static void check_catenary_values(void) {
   cv_status why;
   cv_problem *p = cv_problem_new(1, -1.0, 1.0, &why);
   char err[256];
-  cv_status st = cv_problem_set_integrand_expr(p, NULL, " y ", "c*y*sqrt(1 + y'^2) + 0*x",
-                                               "c = 2, half = c/4*atan2(1, 1)/atan(1)", err,
-                                               sizeof err);
+  cv_status st =
+      cv_problem_set_integrand_expr(p, NULL, " y ", "c*y*sqrt(1 + y'^2) + 0*x",
+                                    "c = 2, half = c/4*atan2(1, 1)/atan(1)", err, sizeof err);
   CHECK(st == CVAR_OK, "set_integrand_expr: %s (%s)", cv_strerror(st), err);
   if (st != CVAR_OK) {
     cv_problem_free(p);
@@ -34,8 +34,8 @@ static void check_catenary_values(void) {
   /* The core's own check: central differences, error O(eps^(2/3)) ~ 1e-10 relative. */
   cv_derivcheck rep;
   st = cv_problem_check_derivatives(p, M, x, y, dy, &rep);
-  CHECK(st == CVAR_OK && rep.worst < 1e-7, "derivative check: %s, worst %g at %s",
-        cv_strerror(st), rep.worst, rep.which);
+  CHECK(st == CVAR_OK && rep.worst < 1e-7, "derivative check: %s, worst %g at %s", cv_strerror(st),
+        rep.worst, rep.which);
   /* Replacing the integrand releases the first compiled one (ASan: no leak). */
   st = cv_problem_set_integrand_expr(p, "s", "y", "y^2 + y'^2 + s", NULL, err, sizeof err);
   CHECK(st == CVAR_OK, "second integrand: %s", err);
@@ -46,14 +46,14 @@ static void check_two_unknowns(void) {
   cv_status why;
   cv_problem *p = cv_problem_new(2, 0.0, 1.0, &why);
   char err[256];
-  cv_status st = cv_problem_set_integrand_expr(p, "t", "th, ph", "th'^2 + sin(th)^2*ph'^2",
-                                               NULL, err, sizeof err);
+  cv_status st = cv_problem_set_integrand_expr(p, "t", "th, ph", "th'^2 + sin(th)^2*ph'^2", NULL,
+                                               err, sizeof err);
   CHECK(st == CVAR_OK, "sphere: %s", err);
   double x[2] = {0.1, 0.2}, y[4] = {0.3, 1.1, 0.0, 2.0}, dy[4] = {0.5, -0.2, 1.5, 0.7};
   cv_derivcheck rep;
   st = cv_problem_check_derivatives(p, 2, x, y, dy, &rep);
-  CHECK(st == CVAR_OK && rep.worst < 1e-7, "sphere derivative check: worst %g at %s",
-        rep.worst, rep.which);
+  CHECK(st == CVAR_OK && rep.worst < 1e-7, "sphere derivative check: worst %g at %s", rep.worst,
+        rep.which);
   cv_problem_free(p);
 }
 

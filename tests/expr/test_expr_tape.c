@@ -65,8 +65,7 @@ static void check_corpus(void) {
     ex_tape_free(t);
     ex_dag_free(d);
   }
-  printf("corpus: %d instructions in all, at most %d registers in one tape\n", total_ins,
-         max_work);
+  printf("corpus: %d instructions in all, at most %d registers in one tape\n", total_ins, max_work);
 }
 
 /* Shared subexpressions once; only reachable nodes; constants, slots and repeated nodes

@@ -13,22 +13,21 @@
 #include "expr/expr.h"
 
 static int failures = 0;
-#define CHECK(cond, ...)                                                                     \
-  do {                                                                                       \
-    if (!(cond)) {                                                                           \
-      failures++;                                                                            \
-      fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                                   \
-      fprintf(stderr, __VA_ARGS__);                                                          \
-      fprintf(stderr, "\n");                                                                 \
-    }                                                                                        \
+#define CHECK(cond, ...)                                                                           \
+  do {                                                                                             \
+    if (!(cond)) {                                                                                 \
+      failures++;                                                                                  \
+      fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__);                                         \
+      fprintf(stderr, __VA_ARGS__);                                                                \
+      fprintf(stderr, "\n");                                                                       \
+    }                                                                                              \
   } while (0)
 
 typedef double (*fn3)(const double *u);
 
 /* A table of f on the grid lo[k] + (hi[k] - lo[k]) i / (n - 1), or with stretched (non-
  * uniform) spacing t + 0.15 sin(pi t) of the uniform t when nonuniform. */
-static cv_table *sample(int dim, int n, const double *lo, const double *hi, fn3 f,
-                        int nonuniform) {
+static cv_table *sample(int dim, int n, const double *lo, const double *hi, fn3 f, int nonuniform) {
   double *c[3] = {NULL, NULL, NULL};
   int nn[3] = {n, n, n};
   size_t size = 1;
@@ -61,8 +60,7 @@ static cv_table *sample(int dim, int n, const double *lo, const double *hi, fn3 
 
 static double cubic3(const double *u) {
   return 1 + u[0] - 2 * u[0] * u[0] * u[0] + u[0] * u[1] * u[1] * u[1] -
-         0.5 * u[2] * u[2] * u[2] * u[1] +
-         u[0] * u[0] * u[1] * u[2];
+         0.5 * u[2] * u[2] * u[2] * u[1] + u[0] * u[0] * u[1] * u[2];
 }
 /* its exact partials: grad and a few second/third orders */
 static double cubic3_d(const double *u, const int *o) {
@@ -145,8 +143,8 @@ static void test_order_and_partials(void) {
     cv_table_free(t);
   }
   double order = log2(err[0] / err[1]);
-  printf("3-D interpolation error: h=1/8 %.3e, h=1/16 %.3e, observed order %.2f\n", err[0],
-         err[1], order);
+  printf("3-D interpolation error: h=1/8 %.3e, h=1/16 %.3e, observed order %.2f\n", err[0], err[1],
+         order);
   CHECK(order > 3.6 && order < 4.6, "interpolation order %.2f, expected 4", order);
 }
 
@@ -155,11 +153,17 @@ static void test_order_and_partials(void) {
 /* 1-D: n(y) = 1/y (the Poincare half-plane); rays are circles centred on the x axis:
  * y = sqrt(4 - x^2) on [-1.2, 1.2], through y from 1.6 to 2. */
 static double n1(const double *u) { return 1.0 / u[0]; }
-static double ray1(double x, int i) { (void)i; return sqrt(4 - x * x); }
+static double ray1(double x, int i) {
+  (void)i;
+  return sqrt(4 - x * x);
+}
 /* 2-D: Maxwell's fish-eye n = 2/(1 + x^2 + y^2): rays are circles through antipodal points
  * of the unit circle, here y = -0.5 + sqrt(1.25 - x^2) on [-0.8, 0.8] (not antipodal). */
 static double n2(const double *u) { return 2.0 / (1 + u[0] * u[0] + u[1] * u[1]); }
-static double ray2(double x, int i) { (void)i; return -0.5 + sqrt(1.25 - x * x); }
+static double ray2(double x, int i) {
+  (void)i;
+  return -0.5 + sqrt(1.25 - x * x);
+}
 /* 3-D fish-eye: rays are planar through the origin; the 2-D ray in the plane spanned by
  * e_x and (0, 0.8, 0.6): y = 0.8 Y(x), z = 0.6 Y(x). */
 static double n3(const double *u) { return 2.0 / (1 + u[0] * u[0] + u[1] * u[1] + u[2] * u[2]); }
@@ -176,13 +180,42 @@ typedef struct {
 } ray_case;
 
 static const ray_case cases[] = {
-    {"1-D n(y)", 1, 1, -1.2, 1.2, {1.5}, {2.05}, n1, ray1, "y", "n(y)*sqrt(1 + y'^2)",
+    {"1-D n(y)",
+     1,
+     1,
+     -1.2,
+     1.2,
+     {1.5},
+     {2.05},
+     n1,
+     ray1,
+     "y",
+     "n(y)*sqrt(1 + y'^2)",
      "sqrt(1 + y'^2)/y"},
-    {"2-D n(x, y)", 2, 1, -0.8, 0.8, {-0.8, 0.2}, {0.8, 0.65}, n2, ray2, "y",
+    {"2-D n(x, y)",
+     2,
+     1,
+     -0.8,
+     0.8,
+     {-0.8, 0.2},
+     {0.8, 0.65},
+     n2,
+     ray2,
+     "y",
      "n(x, y)*sqrt(1 + y'^2)",
      "2/(1 + x^2 + y^2)*sqrt(1 + y'^2)"},
-    {"3-D n(x, y, z)", 3, 2, -0.8, 0.8, {-0.8, 0.2, 0.15}, {0.8, 0.52, 0.39}, n3, ray3, "y, z",
-     "n(x, y, z)*sqrt(1 + y'^2 + z'^2)", "2/(1 + x^2 + y^2 + z^2)*sqrt(1 + y'^2 + z'^2)"},
+    {"3-D n(x, y, z)",
+     3,
+     2,
+     -0.8,
+     0.8,
+     {-0.8, 0.2, 0.15},
+     {0.8, 0.52, 0.39},
+     n3,
+     ray3,
+     "y, z",
+     "n(x, y, z)*sqrt(1 + y'^2 + z'^2)",
+     "2/(1 + x^2 + y^2 + z^2)*sqrt(1 + y'^2 + z'^2)"},
 };
 
 /* Solve; max nodal error against the analytic ray, iterations. table NULL: the formula. */
@@ -196,9 +229,8 @@ static double solve_ray(const ray_case *c, cv_table *t, int *iters, char *msg, s
   for (int i = 0; i < c->nunk; i++)
     cv_problem_set_dirichlet(p, i, c->ray(c->xa, i) + shift, c->ray(c->xb, i) + shift);
   if (t) CHECK(cv_problem_add_table(p, "n", t) == CVAR_OK, "cv_problem_add_table failed");
-  cv_status st = cv_problem_set_integrand_expr(p, "x", c->unknowns,
-                                               t ? c->table_F : c->formula_F, NULL, err,
-                                               sizeof err);
+  cv_status st = cv_problem_set_integrand_expr(p, "x", c->unknowns, t ? c->table_F : c->formula_F,
+                                               NULL, err, sizeof err);
   CHECK(st == CVAR_OK, "%s: set_integrand_expr: %s", c->name, err);
   cv_solver_set_elements(s, 16);
   cv_solver_set_degree(s, 6);
@@ -238,8 +270,10 @@ static void test_rays(void) {
       cv_table_free(t); /* the problem held its own reference while it lived */
       CHECK(e[l] >= 0, "%s: grid %d did not converge", c->name, grids[l]);
       if (l == 3)
-        CHECK(it_table == it_formula, "%s: Newton took %d iterations with the table, %d with "
-              "the formula", c->name, it_table, it_formula);
+        CHECK(it_table == it_formula,
+              "%s: Newton took %d iterations with the table, %d with "
+              "the formula",
+              c->name, it_table, it_formula);
     }
     /* Least-squares slope of log e against log h over the four grids: the ray error must
      * fall at least like h^4 (the pointwise error of the spline's order; the ray, an
@@ -294,16 +328,20 @@ static void test_api_errors(void) {
   CHECK(cv_problem_add_table(p, "c", t) == CVAR_EINVAL, "name added twice");
   char err[300];
   CHECK(cv_problem_set_integrand_expr(p, "x", "y", "c(x, y)*y'^2", NULL, err, sizeof err) ==
-            CVAR_EINVAL && strstr(err, "takes 1 argument"),
+                CVAR_EINVAL &&
+            strstr(err, "takes 1 argument"),
         "wrong argument count: %s", err);
   CHECK(cv_problem_set_integrand_expr(p, "x", "y", "c.2(x)*y'^2", NULL, err, sizeof err) ==
-            CVAR_EINVAL, "derivative along a missing coordinate accepted");
-  CHECK(cv_problem_set_integrand_expr(p, "x", "y", "(1 + c.1(x)^2)*y'^2", NULL, err,
-                                      sizeof err) == CVAR_OK, "a derivative call refused: %s", err);
+            CVAR_EINVAL,
+        "derivative along a missing coordinate accepted");
+  CHECK(cv_problem_set_integrand_expr(p, "x", "y", "(1 + c.1(x)^2)*y'^2", NULL, err, sizeof err) ==
+            CVAR_OK,
+        "a derivative call refused: %s", err);
   cv_table *s = cv_table_new(1, &n4, c, v, &why);
   CHECK(cv_problem_add_table(p, "sin", s) == CVAR_OK, "core refused an identifier");
-  CHECK(cv_problem_set_integrand_expr(p, "x", "y", "y'^2", NULL, err, sizeof err) ==
-            CVAR_EINVAL && strstr(err, "reserved"), "a table named sin: %s", err);
+  CHECK(cv_problem_set_integrand_expr(p, "x", "y", "y'^2", NULL, err, sizeof err) == CVAR_EINVAL &&
+            strstr(err, "reserved"),
+        "a table named sin: %s", err);
   cv_table_free(s);
   cv_problem_free(p);
   cv_table_free(t);

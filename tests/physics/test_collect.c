@@ -11,14 +11,12 @@
 #include "../expr/ex_test.h"
 
 #define NPOINTS 12
-#define TOL 1e-10
+#define TOL     1e-10
 
-static void same_values(const char *what, ex_dag *d, ex_id e)
-{
+static void same_values(const char *what, ex_dag *d, ex_id e) {
   ex_id c = ex_collect(d, e);
   CHECK(c >= 0, "%s: ex_collect failed", what);
-  if (c < 0)
-    return;
+  if (c < 0) return;
   /* The printed collected text parses back (to a node of equal value). */
   char text[4096];
   size_t len = ex_print(d, c, slot_names, text, sizeof text);
@@ -34,13 +32,11 @@ static void same_values(const char *what, ex_dag *d, ex_id e)
     double v = eval_at(d, e, s), w = eval_at(d, c, s);
     double sc = fmax(1.0, fabs(v));
     CHECK_CLOSE(what, w, v, TOL, sc);
-    if (r >= 0)
-      CHECK_CLOSE(what, eval_at(d, r, s), v, TOL, sc);
+    if (r >= 0) CHECK_CLOSE(what, eval_at(d, r, s), v, TOL, sc);
   }
 }
 
-static void corpus_values(void)
-{
+static void corpus_values(void) {
   int n = 0;
   for (int c = 0; c < NCORPUS; c++) {
     ex_dag *d = ex_dag_new();
@@ -68,8 +64,7 @@ static void corpus_values(void)
 }
 
 /* Expected printed forms of collected expressions. */
-static void forms(void)
-{
+static void forms(void) {
   static const struct {
     const char *in, *out;
   } cases[] = {
@@ -91,16 +86,14 @@ static void forms(void)
     ex_id e = parse_ok(d, cases[k].in);
     ex_id c = e >= 0 ? ex_collect(d, e) : -1;
     char text[512] = "";
-    if (c >= 0)
-      ex_print(d, c, slot_names, text, sizeof text);
-    CHECK(strcmp(text, cases[k].out) == 0, "collect(%s): expected '%s', got '%s'",
-          cases[k].in, cases[k].out, text);
+    if (c >= 0) ex_print(d, c, slot_names, text, sizeof text);
+    CHECK(strcmp(text, cases[k].out) == 0, "collect(%s): expected '%s', got '%s'", cases[k].in,
+          cases[k].out, text);
     ex_dag_free(d);
   }
 }
 
-int main(void)
-{
+int main(void) {
   corpus_values();
   forms();
   return finish("test_collect");

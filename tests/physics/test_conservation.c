@@ -25,8 +25,7 @@
 
 static int failures, checks;
 
-static void truth(const char *what, int ok, const char *fmt, double a, double b)
-{
+static void truth(const char *what, int ok, const char *fmt, double a, double b) {
   checks++;
   if (!ok) {
     failures++;
@@ -46,8 +45,7 @@ typedef struct {
 enum { MOMENTUM, ENERGY };
 
 static spread measure(const char *dir, const char *name, int what, int degree, int elements,
-                      double target)
-{
+                      double target) {
   spread r = {NAN, NAN, NAN, 0};
   char path[1024], err[SC_ERRLEN] = "";
   snprintf(path, sizeof path, "%s/%s", dir, name);
@@ -64,8 +62,7 @@ static spread measure(const char *dir, const char *name, int what, int degree, i
   s->degree = degree;
   s->tolerance = 1e-13;
   int n = s->n;
-  if (!(p = scene_problem_new(s, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, err,
-                              sizeof err)) ||
+  if (!(p = scene_problem_new(s, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, err, sizeof err)) ||
       !(sv = cv_solver_new(NULL)) || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK ||
       cv_solve(sv, p) != CVAR_OK) {
     printf("FAIL solve %s p=%d E=%d: %s\n", name, degree, elements, err);
@@ -74,8 +71,7 @@ static spread measure(const char *dir, const char *name, int what, int degree, i
   }
   int nq = cv_solver_get_num_qpoints(sv), ne = cv_solver_get_num_elements(sv);
   buf = malloc((size_t)(2 + 3 * n) * nq * sizeof *buf);
-  if (!buf)
-    goto done;
+  if (!buf) goto done;
   double *x = buf, *w = x + nq, *y = w + nq, *dy = y + (size_t)n * nq, *q = dy + (size_t)n * nq;
   cv_solver_get_qpoints(sv, x, w, y, dy);
   if (what == MOMENTUM)
@@ -108,8 +104,7 @@ done:
   return r;
 }
 
-int main(int argc, char **argv)
-{
+int main(int argc, char **argv) {
   if (argc < 2) {
     fprintf(stderr, "usage: test_conservation DATA_DIR\n");
     return 2;
@@ -160,13 +155,13 @@ int main(int argc, char **argv)
         if (E > 10) {
           double order = log2(prev / e.point);
           snprintf(what, sizeof what, "%s p=%d E=%d energy drift order", escenes[sc], deg, E);
-          truth(what, order > deg - 0.3 && order < deg + 0.7, "observed %.3g, expected %.3g",
-                order, deg);
+          truth(what, order > deg - 0.3 && order < deg + 0.7, "observed %.3g, expected %.3g", order,
+                deg);
           /* Element means of H: order 2p on the oscillator while above round-off. */
           if (sc == 0 && e.mean > 1e-12) {
             order = log2(prevm / e.mean);
-            snprintf(what, sizeof what, "%s p=%d E=%d element-mean drift order", escenes[sc],
-                     deg, E);
+            snprintf(what, sizeof what, "%s p=%d E=%d element-mean drift order", escenes[sc], deg,
+                     E);
             truth(what, order > 2 * deg - 0.3, "observed %.3g, expected %.3g", order, 2 * deg);
           }
         }

@@ -26,8 +26,7 @@
 
 static int failures, checks;
 
-static void near(const char *what, double actual, double expected, double tol)
-{
+static void near(const char *what, double actual, double expected, double tol) {
   checks++;
   if (!(fabs(actual - expected) <= tol)) {
     failures++;
@@ -36,8 +35,7 @@ static void near(const char *what, double actual, double expected, double tol)
   }
 }
 
-static void truth(const char *what, int ok, const char *detail)
-{
+static void truth(const char *what, int ok, const char *detail) {
   checks++;
   if (!ok) {
     failures++;
@@ -49,32 +47,27 @@ static double urand(double lo, double hi) { return lo + (hi - lo) * (rand() / (d
 
 /* Re-parsing printed text: names are resolved against eq->names (name plus primes). */
 static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *err,
-                     size_t errlen)
-{
+                     size_t errlen) {
   const mech_equations *eq = user;
   char full[128];
   snprintf(full, sizeof full, "%s%.*s", name, primes, "''");
   for (int k = 0; k < eq->nslots; k++)
-    if (strcmp(eq->names[k], full) == 0)
-      return ex_slot(d, k);
+    if (strcmp(eq->names[k], full) == 0) return ex_slot(d, k);
   snprintf(err, errlen, "unknown name '%s'", full);
   return -1;
 }
 
 /* Print e (of the scene's DAG), parse the text into `into`; -1 on failure. */
 static ex_id reparse(const scene *s, const mech_equations *eq, ex_id e, ex_dag *into, char *text,
-                     size_t len)
-{
+                     size_t len) {
   char err[256];
   ex_print(s->dag, e, (const char *const *)eq->names, text, len);
   ex_id r = ex_parse(into, text, resolve, (void *)eq, 1, err, sizeof err);
-  if (r < 0)
-    printf("  cannot re-parse '%s': %s\n", text, err);
+  if (r < 0) printf("  cannot re-parse '%s': %s\n", text, err);
   return r;
 }
 
-static scene *load(const char *dir, const char *file, int nset, const sc_set *set)
-{
+static scene *load(const char *dir, const char *file, int nset, const sc_set *set) {
   char path[1024], err[SC_ERRLEN] = "";
   snprintf(path, sizeof path, "%s/%s", dir, file);
   scene *s = scene_load_file(path, nset, set, err, sizeof err);
@@ -82,8 +75,7 @@ static scene *load(const char *dir, const char *file, int nset, const sc_set *se
   return s;
 }
 
-static scene *load_text(const char *text)
-{
+static scene *load_text(const char *text) {
   char err[SC_ERRLEN] = "";
   scene *s = scene_load_buffer(text, strlen(text), "t.scene", 0, NULL, err, sizeof err);
   truth("in-memory scene", s != NULL, err);
@@ -92,13 +84,11 @@ static scene *load_text(const char *text)
 
 /* Pendulum L = m l^2 th'^2/2 + m g l cos th: E = m l^2 th'' + m g l sin th,
  * p = m l^2 th', H = m l^2 th'^2/2 - m g l cos th. */
-static void pendulum(const char *dir, double m, double l, double g, int nset, const sc_set *set)
-{
+static void pendulum(const char *dir, double m, double l, double g, int nset, const sc_set *set) {
   scene *s = load(dir, "pendulum_angle.scene", nset, set);
   mech_equations eq;
   char err[SC_ERRLEN] = "", tE[512], tp[512], tH[512], what[128];
-  if (!s)
-    return;
+  if (!s) return;
   if (scene_equations_new(s, &eq, err, sizeof err) != CVAR_OK) {
     truth("pendulum equations", 0, err);
     scene_free(s);
@@ -112,8 +102,8 @@ static void pendulum(const char *dir, double m, double l, double g, int nset, co
   truth("pendulum expressions re-parse", E >= 0 && P >= 0 && H >= 0, tE);
   truth("pendulum: not cyclic, autonomous", !eq.cyclic[0] && eq.autonomous, "flags");
   /* The simplified form: no 0*, *1, +0 left, and the y'' coefficient printed first. */
-  truth("pendulum E has no zero terms", !strstr(tE, "0*") && !strstr(tE, "*1") &&
-        !strstr(tE, "+ 0"), tE);
+  truth("pendulum E has no zero terms",
+        !strstr(tE, "0*") && !strstr(tE, "*1") && !strstr(tE, "+ 0"), tE);
   for (int k = 0; k < 200 && E >= 0 && P >= 0 && H >= 0; k++) {
     double v[4] = {urand(-10, 10), urand(-7, 7), urand(-5, 5), urand(-50, 50)};
     double e, p, h; /* slots: 0 = t, 1 = th, 2 = th', 3 = th'' */
@@ -137,8 +127,7 @@ static void pendulum(const char *dir, double m, double l, double g, int nset, co
 }
 
 /* Double pendulum (equal m, l): hand-derived equations, a constant multiple allowed. */
-static void double_pendulum_equations(const char *dir)
-{
+static void double_pendulum_equations(const char *dir) {
   scene *s = load(dir, "double_pendulum.scene", 0, NULL);
   mech_equations eq;
   char err[SC_ERRLEN] = "", t[2][512], tH[512], what[128];
@@ -150,22 +139,20 @@ static void double_pendulum_equations(const char *dir)
   }
   ex_dag *d = ex_dag_new();
   ex_id E[2], H = reparse(s, &eq, eq.hamiltonian, d, tH, sizeof tH);
-  for (int i = 0; i < 2; i++)
-    E[i] = reparse(s, &eq, eq.el[i], d, t[i], sizeof t[i]);
+  for (int i = 0; i < 2; i++) E[i] = reparse(s, &eq, eq.el[i], d, t[i], sizeof t[i]);
   printf("double pendulum:\n  E_a = %s\n  E_b = %s\n  H = %s\n", t[0], t[1], tH);
   truth("double pendulum re-parse", E[0] >= 0 && E[1] >= 0 && H >= 0, "");
   /* slots: 0 t, 1 a, 2 b, 3 a', 4 b', 5 a'', 6 b'' */
   for (int k = 0; k < 200 && E[0] >= 0 && E[1] >= 0 && H >= 0; k++) {
     double v[7];
     v[0] = 0;
-    for (int j = 1; j < 7; j++)
-      v[j] = urand(-4, 4);
+    for (int j = 1; j < 7; j++) v[j] = urand(-4, 4);
     double a = v[1], b = v[2], da = v[3], db = v[4], dda = v[5], ddb = v[6], c = cos(a - b),
            sn = sin(a - b), ml2 = m * l * l;
     double ha = ml2 * (2 * dda + c * ddb + db * db * sn) + 2 * m * g * l * sin(a);
     double hb = ml2 * (c * dda + ddb - da * da * sn) + m * g * l * sin(b);
-    double hh = ml2 * (2 * da * da + db * db + 2 * da * db * c) / 2 -
-                m * g * l * (2 * cos(a) + cos(b));
+    double hh =
+        ml2 * (2 * da * da + db * db + 2 * da * db * c) / 2 - m * g * l * (2 * cos(a) + cos(b));
     double ea, eb, eh;
     ex_eval(d, E[0], v, &ea);
     ex_eval(d, E[1], v, &eb);
@@ -184,8 +171,7 @@ static void double_pendulum_equations(const char *dir)
 }
 
 /* Cyclic and autonomous flags of the reference scenes. */
-static void flags(const char *dir)
-{
+static void flags(const char *dir) {
   static const struct {
     const char *file;
     int autonomous;
@@ -215,13 +201,11 @@ static void flags(const char *dir)
 
 /* Double pendulum modes: w2 = (g/l)(2 -+ sqrt 2); K v = w2 M v, v^T M v = 1. */
 static void double_pendulum_modes(const char *dir, double l, double g, int nset,
-                                  const sc_set *set)
-{
+                                  const sc_set *set) {
   scene *s = load(dir, "double_pendulum.scene", nset, set);
   mech_modes md;
   char err[SC_ERRLEN] = "", what[128];
-  if (!s)
-    return;
+  if (!s) return;
   cv_status rc = scene_modes_new(s, &md, err, sizeof err);
   truth("double pendulum modes", rc == CVAR_OK, err);
   if (rc == CVAR_OK) {
@@ -254,20 +238,17 @@ static void double_pendulum_modes(const char *dir, double l, double g, int nset,
   scene_free(s);
 }
 
-static const char *top_text =
-    "[scene]\ntitle = top\nvariable = t\ninterval = 0, 1\nunknowns = th\n"
-    "integrand = m*l^2*th'^2/2 + m*g*l*cos(th)\n"
-    "[parameters]\nm = 2\nl = 0.5\ng = 9.81\nth0 = 3\n"
-    "[boundary]\nth = 0, 0\n[guess]\nth = th0\n";
+static const char *top_text = "[scene]\ntitle = top\nvariable = t\ninterval = 0, 1\nunknowns = th\n"
+                              "integrand = m*l^2*th'^2/2 + m*g*l*cos(th)\n"
+                              "[parameters]\nm = 2\nl = 0.5\ng = 9.81\nth0 = 3\n"
+                              "[boundary]\nth = 0, 0\n[guess]\nth = th0\n";
 
 /* The pendulum about th = pi (Newton from th = 3): unstable, growth rate sqrt(g/l). */
-static void inverted_pendulum(void)
-{
+static void inverted_pendulum(void) {
   scene *s = load_text(top_text);
   mech_modes md;
   char err[SC_ERRLEN] = "";
-  if (!s)
-    return;
+  if (!s) return;
   cv_status rc = scene_modes_new(s, &md, err, sizeof err);
   truth("inverted pendulum modes", rc == CVAR_OK, err);
   if (rc == CVAR_OK) {
@@ -284,8 +265,7 @@ static void inverted_pendulum(void)
 }
 
 /* Cases with a known outcome: neutral modes, no equilibrium, singular M, refusals. */
-static void special_cases(void)
-{
+static void special_cases(void) {
   static const struct {
     const char *what, *text;
     cv_status rc;
@@ -332,12 +312,10 @@ static void special_cases(void)
     scene *s = load_text(cases[c].text);
     mech_modes md;
     char err[SC_ERRLEN] = "";
-    if (!s)
-      continue;
+    if (!s) continue;
     cv_status rc = scene_modes_new(s, &md, err, sizeof err);
     truth(cases[c].what, rc == cases[c].rc, err[0] ? err : "(no message)");
-    if (cases[c].msg)
-      truth(cases[c].what, strstr(err, cases[c].msg) != NULL, err);
+    if (cases[c].msg) truth(cases[c].what, strstr(err, cases[c].msg) != NULL, err);
     if (rc == CVAR_OK && strstr(cases[c].what, "Cartesian pendulum")) {
       /* hanging at (0, -1): lambda = -g/(2l) = -1/2, one mode on the circle, omega2 = g/l,
        * shape along x with unit mass norm */
@@ -354,8 +332,8 @@ static void special_cases(void)
       near("spring: lower omega2", md.omega2[0], 0, 1e-12);
       near("spring: upper omega2", md.omega2[1], 6, 1e-12);
       near("spring: neutral shape a = b", md.shape[0] - md.shape[1], 0, 1e-12);
-      near("spring: equilibrium keeps the guess's centre", md.equilibrium[0] + md.equilibrium[1],
-           1, 1e-12);
+      near("spring: equilibrium keeps the guess's centre", md.equilibrium[0] + md.equilibrium[1], 1,
+           1e-12);
       near("spring: equilibrium a = b", md.equilibrium[0] - md.equilibrium[1], 0, 1e-12);
     }
     mech_modes_free(&md);
@@ -363,8 +341,7 @@ static void special_cases(void)
   }
 }
 
-int main(int argc, char **argv)
-{
+int main(int argc, char **argv) {
   if (argc < 2) {
     fprintf(stderr, "usage: test_mechanics DATA_DIR\n");
     return 2;

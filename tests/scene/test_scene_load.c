@@ -20,8 +20,7 @@
 
 static int failures, checks;
 
-static void near(const char *what, double actual, double expected, double tol)
-{
+static void near(const char *what, double actual, double expected, double tol) {
   checks++;
   if (!(fabs(actual - expected) <= tol)) {
     failures++;
@@ -30,8 +29,7 @@ static void near(const char *what, double actual, double expected, double tol)
   }
 }
 
-static void truth(const char *what, int ok, const char *expected, const char *actual)
-{
+static void truth(const char *what, int ok, const char *expected, const char *actual) {
   checks++;
   if (!ok) {
     failures++;
@@ -39,37 +37,32 @@ static void truth(const char *what, int ok, const char *expected, const char *ac
   }
 }
 
-static scene *load(const char *text, int nset, const sc_set *set, char *err)
-{
+static scene *load(const char *text, int nset, const sc_set *set, char *err) {
   return scene_load_buffer(text, strlen(text), "t.scene", nset, set, err, SC_ERRLEN);
 }
 
 /* Load must fail with a message starting with `prefix` and containing `part`. */
 static void must_fail(const char *what, const char *text, size_t len, const char *prefix,
-                      const char *part)
-{
+                      const char *part) {
   char err[SC_ERRLEN];
   scene *s = scene_load_buffer(text, len, "t.scene", 0, NULL, err, sizeof err);
-  truth(what, !s && strncmp(err, prefix, strlen(prefix)) == 0 && strstr(err, part) != NULL,
-        prefix, s ? "(loaded)" : err);
+  truth(what, !s && strncmp(err, prefix, strlen(prefix)) == 0 && strstr(err, part) != NULL, prefix,
+        s ? "(loaded)" : err);
   scene_free(s);
 }
 
 /* H = sum_i y'_i dF/dy'_i - F of s's compiled problem at one point (NaN on failure). */
-static double energy_at(const scene *s, double x, const double *y, const double *dy)
-{
+static double energy_at(const scene *s, double x, const double *y, const double *dy) {
   char err[SC_ERRLEN];
   double H = NAN;
   cv_problem *p = scene_problem_new(s, CVAR_NEED_F | CVAR_NEED_GRAD, err, sizeof err);
-  if (!p || cv_problem_eval_energy(p, 1, &x, y, dy, &H, NULL) != CVAR_OK)
-    H = NAN;
+  if (!p || cv_problem_eval_energy(p, 1, &x, y, dy, &H, NULL) != CVAR_OK) H = NAN;
   cv_problem_free(p);
   return H;
 }
 
 /* Evaluate report r of s at one point (x, y[], dy[]). */
-static double report_at(scene *s, int r, double x, const double *y, const double *dy)
-{
+static double report_at(scene *s, int r, double x, const double *y, const double *dy) {
   double *out = calloc((size_t)s->nreports, sizeof *out), v;
   if (scene_eval_reports(s, 1, &x, y, dy, out) < 0)
     v = NAN;
@@ -80,33 +73,31 @@ static double report_at(scene *s, int r, double x, const double *y, const double
 }
 
 static const char *CATENARY =
-  "# Catenary\n"
-  "[scene]\n"
-  "title     = Catenary between two rings\n"
-  "variable  = x                       # independent variable name (default x)\n"
-  "interval  = -1, 1                   ; a, b with a < b\n"
-  "unknowns  = y\n"
-  "integrand = y * sqrt(1 + y'^2)\n"
-  "[parameters]\n"
-  "c = 2\n"
-  "d = 2*c\n"
-  "[definitions]\n"
-  "ends = c*cosh(1/c)\n"
-  "[boundary]\n"
-  "y = ends, ends\n"
-  "[exact]\n"
-  "y = c*cosh(x/c)\n"
-  "action = 4.350402387287603\n";
+    "# Catenary\n"
+    "[scene]\n"
+    "title     = Catenary between two rings\n"
+    "variable  = x                       # independent variable name (default x)\n"
+    "interval  = -1, 1                   ; a, b with a < b\n"
+    "unknowns  = y\n"
+    "integrand = y * sqrt(1 + y'^2)\n"
+    "[parameters]\n"
+    "c = 2\n"
+    "d = 2*c\n"
+    "[definitions]\n"
+    "ends = c*cosh(1/c)\n"
+    "[boundary]\n"
+    "y = ends, ends\n"
+    "[exact]\n"
+    "y = c*cosh(x/c)\n"
+    "action = 4.350402387287603\n";
 
-static void test_catenary(void)
-{
+static void test_catenary(void) {
   char err[SC_ERRLEN];
   scene *s = load(CATENARY, 0, NULL, err);
   truth("catenary loads", s != NULL, "a scene", err);
-  if (!s)
-    return;
-  truth("title", strcmp(s->title, "Catenary between two rings") == 0,
-        "Catenary between two rings", s->title);
+  if (!s) return;
+  truth("title", strcmp(s->title, "Catenary between two rings") == 0, "Catenary between two rings",
+        s->title);
   truth("variable", strcmp(s->variable, "x") == 0, "x", s->variable);
   near("a", s->a, -1, 0);
   near("b", s->b, 1, 0);
@@ -148,8 +139,8 @@ static void test_catenary(void)
     truth("two --set load", 0, "a scene", err);
   sc_set bad = {"e", "1"};
   s = load(CATENARY, 1, &bad, err);
-  truth("--set of a non-parameter fails without a line", !s &&
-        strncmp(err, "t.scene: --set e=1: 'e' is not a parameter", 42) == 0,
+  truth("--set of a non-parameter fails without a line",
+        !s && strncmp(err, "t.scene: --set e=1: 'e' is not a parameter", 42) == 0,
         "t.scene: --set e=1: 'e' is not a parameter...", err);
   scene_free(s);
   sc_set nonconst = {"c", "x"};
@@ -161,36 +152,33 @@ static void test_catenary(void)
 
 /* Continuations, comments of both kinds, CRLF, a byte order mark, definitions in order,
  * free ends, lists with commas inside parentheses, a 1000-character expression. */
-static void test_format(void)
-{
+static void test_format(void) {
   char err[SC_ERRLEN];
-  const char *text =
-    "\xEF\xBB\xBF[scene]\r\n"
-    "interval  = 0, atan2(1, 1)*4   # pi, with a comma inside parentheses\r\n"
-    "unknowns  = u, v\r\n"
-    "integrand = u'^2/2 +\r\n"
-    "    v'^2/2      # continued\r\n"
-    "\r\n"
-    "  ; a comment between continuation lines\r\n"
-    "    + k*u*v\r\n"
-    "[parameters]\r\n"
-    "k = 0.25\r\n"
-    "[definitions]\r\n"
-    "a = u + v\r\n"
-    "b = a*u'          # uses the earlier definition\r\n"
-    "[boundary]\r\n"
-    "u = free, 1\r\n"
-    "v = 0, free\r\n"
-    "[report]\r\n"
-    "r1 = b + x\r\n"
-    "r2 = k*u*v\r\n";
+  const char *text = "\xEF\xBB\xBF[scene]\r\n"
+                     "interval  = 0, atan2(1, 1)*4   # pi, with a comma inside parentheses\r\n"
+                     "unknowns  = u, v\r\n"
+                     "integrand = u'^2/2 +\r\n"
+                     "    v'^2/2      # continued\r\n"
+                     "\r\n"
+                     "  ; a comment between continuation lines\r\n"
+                     "    + k*u*v\r\n"
+                     "[parameters]\r\n"
+                     "k = 0.25\r\n"
+                     "[definitions]\r\n"
+                     "a = u + v\r\n"
+                     "b = a*u'          # uses the earlier definition\r\n"
+                     "[boundary]\r\n"
+                     "u = free, 1\r\n"
+                     "v = 0, free\r\n"
+                     "[report]\r\n"
+                     "r1 = b + x\r\n"
+                     "r2 = k*u*v\r\n";
   scene *s = load(text, 0, NULL, err);
   truth("format scene loads", s != NULL, "a scene", err);
-  if (!s)
-    return;
+  if (!s) return;
   near("b = atan2(1, 1)*4", s->b, M_PI, 4 * DBL_EPSILON * M_PI);
-  truth("unknown names", s->n == 2 && !strcmp(s->unknowns[0], "u") &&
-        !strcmp(s->unknowns[1], "v"), "u, v", "other");
+  truth("unknown names", s->n == 2 && !strcmp(s->unknowns[0], "u") && !strcmp(s->unknowns[1], "v"),
+        "u, v", "other");
   truth("u free at a", s->bc[0].free_end[0] && !s->bc[0].free_end[1], "free, fixed", "?");
   truth("v free at b", !s->bc[1].free_end[0] && s->bc[1].free_end[1], "fixed, free", "?");
   near("u(b) = 1", s->bc[0].value[1], 1, 0);
@@ -217,8 +205,7 @@ static void test_format(void)
     hsum += 1.0 / k;
   }
   size_t line_len = len;
-  len += (size_t)snprintf(big + len, cap - len,
-                          "\n[boundary]\ny = 0, 1\n[report]\nsame = ");
+  len += (size_t)snprintf(big + len, cap - len, "\n[boundary]\ny = 0, 1\n[report]\nsame = ");
   for (int k = 1; k <= 150; k++)
     len += (size_t)snprintf(big + len, cap - len, "%sy'^2/%d", k > 1 ? " + " : "", k);
   len += (size_t)snprintf(big + len, cap - len, "\n");
@@ -234,15 +221,14 @@ static void test_format(void)
   char *p = strstr(big, "y'^2/150");
   p[0] = 'q';
   s = load(big, 0, NULL, err);
-  truth("error on a long line: line 4, column > 1000", !s && !strncmp(err, "t.scene:4: ", 11)
-        && strstr(err, "column 1") && strstr(err, "'q'"), "t.scene:4: integrand, column 1xxx",
-        err);
+  truth("error on a long line: line 4, column > 1000",
+        !s && !strncmp(err, "t.scene:4: ", 11) && strstr(err, "column 1") && strstr(err, "'q'"),
+        "t.scene:4: integrand, column 1xxx", err);
   scene_free(s);
   free(big);
 }
 
-static void test_errors(void)
-{
+static void test_errors(void) {
   const char *H = "[scene]\ninterval = 0, 1\nunknowns = y\nintegrand = y'^2\n";
   char buf[1024];
   must_fail("NUL byte", "[scene]\ninterval = 0, 1\n\0x = 1\n", 25, "t.scene:3: ", "NUL");
@@ -254,16 +240,16 @@ static void test_errors(void)
   snprintf(buf, sizeof buf, "%s[boundary]\ny = 0, 1\n[constraints]\ng = 2*x\n", H);
   must_fail("constraint without unknowns", buf, strlen(buf), "t.scene:8: ", "no unknown");
   snprintf(buf, sizeof buf, "%s[boundary]\ny = 0, 1\n[constraints]\ng = y*(y - 1)\n", H);
-  must_fail("a pointwise constraint on the only unknown", buf, strlen(buf), "t.scene:8: ",
-            "no degree of freedom");
+  must_fail("a pointwise constraint on the only unknown", buf, strlen(buf),
+            "t.scene:8: ", "no degree of freedom");
   snprintf(buf, sizeof buf, "%s[boundary]\ny = 0, 1\n[mesh]\nbreakpoints = 0.5, 0.5\n", H);
   must_fail("breakpoint twice", buf, strlen(buf), "t.scene:8: ", "twice");
   snprintf(buf, sizeof buf, "%s[boundary]\ny = 0, 1\n[mesh]\ngrading_at = middle\n", H);
   must_fail("grading_at", buf, strlen(buf), "t.scene:8: ", "a, b or both");
   snprintf(buf, sizeof buf, "%s[boundary]\ny = 0, 1\n  continued = 1\n", H);
   /* joined: "0, 1 continued = 1", so the error is at line 7, column 3 */
-  must_fail("an indented line continues the value", buf, strlen(buf), "t.scene:7: ",
-            "column 3: unexpected");
+  must_fail("an indented line continues the value", buf, strlen(buf),
+            "t.scene:7: ", "column 3: unexpected");
   snprintf(buf, sizeof buf, "%s[boundary]\ny = 0, 1\n[%*s]\n", H, 300, "x");
   must_fail("a very long section name", buf, strlen(buf), "t.scene:7: ", "unknown section");
   snprintf(buf, sizeof buf, "%s[boundary]\n%0*d = 0, 1\n", H, 150, 7);
@@ -272,27 +258,25 @@ static void test_errors(void)
   must_fail("error on a continuation line", buf, strlen(buf), "t.scene:9: ", "'w'");
 }
 
-static void test_good_extras(void)
-{
+static void test_good_extras(void) {
   char err[SC_ERRLEN];
   const char *text =
-    "[scene]\ninterval = 0, 2\nunknowns = y\nintegrand = if(x < 1, 1, 2)*y'^2\n"
-    "[boundary]\ny = 0, 1\n[guess]\ny = x^2/4\n"
-    "[constraints]\n[integrals]\nL = sqrt(1 + y'^2), 3\n"
-    "[mesh]\nelements = 7\ndegree = 8\nbreakpoints = 1.5, 1\ngrading = 2\ngrading_at = both\n"
-    "[solver]\nmethod = lbfgs\ntolerance = 1e-8\nmax_iterations = 12\n";
+      "[scene]\ninterval = 0, 2\nunknowns = y\nintegrand = if(x < 1, 1, 2)*y'^2\n"
+      "[boundary]\ny = 0, 1\n[guess]\ny = x^2/4\n"
+      "[constraints]\n[integrals]\nL = sqrt(1 + y'^2), 3\n"
+      "[mesh]\nelements = 7\ndegree = 8\nbreakpoints = 1.5, 1\ngrading = 2\ngrading_at = both\n"
+      "[solver]\nmethod = lbfgs\ntolerance = 1e-8\nmax_iterations = 12\n";
   scene *s = load(text, 0, NULL, err);
   truth("extras load", s != NULL, "a scene", err);
-  if (!s)
-    return;
+  if (!s) return;
   near("elements", s->elements, 7, 0);
   near("degree", s->degree, 8, 0);
   near("breakpoints sorted", s->nbreak == 2 ? s->breakpoints[0] : -1, 1, 0);
   near("grading", s->grading, 2, 0);
   near("grading_at both", s->graded_end, CVAR_GRADE_BOTH, 0);
   near("method lbfgs", s->method, CVAR_METHOD_LBFGS, 0);
-  near("lbfgs needs F and the gradient", scene_method_need(s->method),
-       CVAR_NEED_F | CVAR_NEED_GRAD, 0);
+  near("lbfgs needs F and the gradient", scene_method_need(s->method), CVAR_NEED_F | CVAR_NEED_GRAD,
+       0);
   near("tolerance", s->tolerance, 1e-8, 0);
   near("max_iterations", s->max_iterations, 12, 0);
   near("integral c", s->nints == 1 ? s->ints[0].value : -1, 3, 0);
@@ -304,8 +288,7 @@ static void test_good_extras(void)
   scene_free(s);
 }
 
-int main(void)
-{
+int main(void) {
   test_catenary();
   test_format();
   test_errors();

@@ -17,8 +17,7 @@
 
 static int failures, checks;
 
-static void truth(const char *what, int ok, const char *detail)
-{
+static void truth(const char *what, int ok, const char *detail) {
   checks++;
   if (!ok) {
     failures++;
@@ -27,42 +26,39 @@ static void truth(const char *what, int ok, const char *detail)
 }
 
 /* Every section the loader knows, so that each of its allocations is on the path. */
-static const char text[] =
-  "[scene]\n"
-  "title     = Pendulum, Cartesian, every section\n"
-  "variable  = t\n"
-  "interval  = 0, 0.5\n"
-  "unknowns  = x, y\n"
-  "integrand = m*(x'^2 + y'^2)/2 - m*g*y +\n"
-  "            0*v2\n"
-  "[parameters]\n"
-  "m = 1\n"
-  "l = 1\n"
-  "g = 9.81\n"
-  "[definitions]\n"
-  "v2 = x'^2 + y'^2\n"
-  "[boundary]\n"
-  "x = 0, l*sin(1)\n"
-  "y = -l, -l*cos(1)\n"
-  "[guess]\n"
-  "x = l*sin(2*t)\n"
-  "y = -l*cos(2*t)\n"
-  "[constraints]\n"
-  "rod = x^2 + y^2 - l^2\n"
-  "[report]\n"
-  "speed2 = v2\n"
-  "[mesh]\n"
-  "elements = 6\n"
-  "degree = 3\n"
-  "breakpoints = 0.25\n";
+static const char text[] = "[scene]\n"
+                           "title     = Pendulum, Cartesian, every section\n"
+                           "variable  = t\n"
+                           "interval  = 0, 0.5\n"
+                           "unknowns  = x, y\n"
+                           "integrand = m*(x'^2 + y'^2)/2 - m*g*y +\n"
+                           "            0*v2\n"
+                           "[parameters]\n"
+                           "m = 1\n"
+                           "l = 1\n"
+                           "g = 9.81\n"
+                           "[definitions]\n"
+                           "v2 = x'^2 + y'^2\n"
+                           "[boundary]\n"
+                           "x = 0, l*sin(1)\n"
+                           "y = -l, -l*cos(1)\n"
+                           "[guess]\n"
+                           "x = l*sin(2*t)\n"
+                           "y = -l*cos(2*t)\n"
+                           "[constraints]\n"
+                           "rod = x^2 + y^2 - l^2\n"
+                           "[report]\n"
+                           "speed2 = v2\n"
+                           "[mesh]\n"
+                           "elements = 6\n"
+                           "degree = 3\n"
+                           "breakpoints = 0.25\n";
 
-static scene *load(char *err)
-{
+static scene *load(char *err) {
   return scene_load_buffer(text, strlen(text), "t.scene", 0, NULL, err, SC_ERRLEN);
 }
 
-int main(void)
-{
+int main(void) {
   char err[SC_ERRLEN], what[64];
   int k, ok = 0;
 
@@ -73,8 +69,10 @@ int main(void)
     scene *s = load(err);
     cv_debug_fail_alloc_after(-1);
     snprintf(what, sizeof what, "load, allocation %d fails", k);
-    if (s) ok = 1;
-    else truth(what, err[0] != '\0', "NULL without a message");
+    if (s)
+      ok = 1;
+    else
+      truth(what, err[0] != '\0', "NULL without a message");
     scene_free(s);
   }
   truth("load succeeds once allocations do", ok, "never loaded");
@@ -94,19 +92,22 @@ int main(void)
     double x[2] = {0.1, 0.3}, y[4] = {0.5, 0.6, -0.8, -0.7}, dy[4] = {1, 2, 3, 4}, H[2], p[4];
     err[0] = '\0';
     cv_debug_fail_alloc_after(k);
-    cv_problem *pb = scene_problem_new(s, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, err,
-                                       sizeof err);
+    cv_problem *pb =
+        scene_problem_new(s, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, err, sizeof err);
     cv_status st = pb ? scene_solver_configure(s, sv, err, sizeof err) : CVAR_ENOMEM;
     if (pb && st == CVAR_OK) st = cv_solve(sv, pb);
     cv_status ev = st == CVAR_OK ? cv_problem_eval_energy(pb, 2, x, y, dy, H, p) : CVAR_ENOMEM;
     cv_debug_fail_alloc_after(-1);
     snprintf(what, sizeof what, "problem/solve/energy, allocation %d fails", k);
-    if (!pb) truth(what, err[0] != '\0', "NULL problem without a message");
+    if (!pb)
+      truth(what, err[0] != '\0', "NULL problem without a message");
     else if (st != CVAR_OK)
       truth(what, st == CVAR_ENOMEM || st == CVAR_EDEPENDENCY || st == CVAR_ECALLBACK,
             cv_status_name(st));
-    else if (ev == CVAR_OK) ok = 1;
-    else truth(what, ev == CVAR_ENOMEM, cv_status_name(ev));
+    else if (ev == CVAR_OK)
+      ok = 1;
+    else
+      truth(what, ev == CVAR_ENOMEM, cv_status_name(ev));
     cv_problem_free(pb);
     cv_solver_free(sv);
     scene_free(s);
@@ -120,8 +121,7 @@ int main(void)
     for (k = 0; k < 100000 && !ok; k++) {
       scene *s = load(err);
       truth("load without injection", s != NULL, err);
-      if (!s)
-        break;
+      if (!s) break;
       struct cv_scene sc = {s};
       cv_status why = CVAR_OK;
       err[0] = '\0';
@@ -130,10 +130,14 @@ int main(void)
                            : (void *)cv_modes_new(&sc, &why, err, sizeof err);
       cv_debug_fail_alloc_after(-1);
       snprintf(what, sizeof what, "%s, allocation %d fails", which ? "modes" : "equations", k);
-      if (h) ok = 1;
-      else truth(what, err[0] != '\0' && why == CVAR_ENOMEM, cv_status_name(why));
-      if (which == 0) cv_equations_free(h);
-      else cv_modes_free(h);
+      if (h)
+        ok = 1;
+      else
+        truth(what, err[0] != '\0' && why == CVAR_ENOMEM, cv_status_name(why));
+      if (which == 0)
+        cv_equations_free(h);
+      else
+        cv_modes_free(h);
       scene_free(s);
     }
     truth("mechanics succeeds once allocations do", ok, which ? "modes" : "equations");

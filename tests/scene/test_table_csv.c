@@ -29,8 +29,8 @@ int main(void) {
     for (int j = 0; j < NY; j++) {
       s ^= s << 13, s ^= s >> 7, s ^= s << 17;
       /* magnitudes from 1e-30 to 1e30, random significands */
-      double x = ((double)(s >> 11) / 9007199254740992.0 + 0.1) *
-                 pow(10.0, (double)((int)(s % 61) - 30));
+      double x =
+          ((double)(s >> 11) / 9007199254740992.0 + 0.1) * pow(10.0, (double)((int)(s % 61) - 30));
       if (s & 1) x = -x;
       char buf[64];
       snprintf(buf, sizeof buf, fmts[(i * NY + j) % 7], x);
