@@ -12,7 +12,7 @@ mkdir -p "$out/corpus"
 cc=${CLANG:-clang}
 # The library sources exactly as meson lists them (a file not in meson.build is not built).
 srcs=""
-for d in core expr scene; do
+for d in core expr mech scene; do
   for f in $(sed -n "s/^ *'\([A-Za-z0-9_]*\.c\)',\{0,1\}.*/\1/p" "$root/src/$d/meson.build"); do
     srcs="$srcs $root/src/$d/$f"
   done
@@ -22,7 +22,7 @@ done
   -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
   -I"$root/include" -I"$root/src" -I/usr/include/suitesparse \
   "$root/tests/fuzz/fuzz_scene.c" $srcs \
-  -linih -lcholmod -lnlopt -llapack -lm -o "$out/fuzz_scene"
+  -linih -ljansson -lcholmod -lnlopt -llapack -lm -pthread -o "$out/fuzz_scene"
 cp "$root"/tests/scene/data/*.scene "$root"/tests/scene/bad/*.scene "$out/corpus/" 2>/dev/null || true
 cd "$out"
 rc=0
