@@ -184,7 +184,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       s->err_est = est;
       if (est <= tol) {
         cv_set_msg(s->msg, sizeof s->msg,
-                   "converged on %d elements (%d nodes) after %d round%s, %ld Newton "
+                   "accuracy reached on %d elements (%d nodes) after %d round%s, %ld Newton "
                    "iterations in all (and %ld on the reference meshes); estimated max nodal "
                    "error %.2g <= %.2g",
                    E, s->disc.nodes, s->rounds, s->rounds == 1 ? "" : "s", iters, iters_ref, est,
