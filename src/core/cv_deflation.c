@@ -78,9 +78,7 @@ static void path_take(cv_path *q, cv_solver *s) {
 
 static void path_give(cv_solver *s, cv_path *q) {
   cv_solver_drop_factor(s);
-  cv_disc_free(&s->disc);
-  cv_free(s->y);
-  cv_free(s->mult);
+  cv_solver_drop_results(s);
   s->disc = q->disc;
   s->y = q->y;
   s->mult = q->mult;

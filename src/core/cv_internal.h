@@ -284,6 +284,8 @@ struct cv_solver {
 cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
 /* Release the solver's factor of its mesh (before the mesh changes). */
 void cv_solver_drop_factor(cv_solver *s);
+/* Release the last solve's mesh, nodal values and multipliers (not the factor). */
+void cv_solver_drop_results(cv_solver *s);
 /* The start of a solve (cv_start.c): cv_start_setup discretises the current mesh spec,
  * allocates the results and fills s->y with the starting values and flags singular ends;
  * cv_start_values fills Y with the given start / guess, or (line = 1) the straight line. */

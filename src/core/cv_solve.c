@@ -17,11 +17,7 @@ double cv_now(void) {
 
 /* Reset the results of the previous solve. */
 static void results_reset(cv_solver *s) {
-  cv_free(s->y);
-  cv_free(s->mult);
-  s->y = s->mult = NULL;
-  cv_disc_free(&s->disc); /* the factor stays: cv_newton_run checks it against the mesh */
-  s->have = 0;
+  cv_solver_drop_results(s);
   s->iterations = 0;
   s->morse = -1;
   s->degenerate = 0;

@@ -34,6 +34,14 @@ void cv_solver_drop_factor(cv_solver *s) {
   s->gof = NULL;
 }
 
+void cv_solver_drop_results(cv_solver *s) {
+  cv_free(s->y);
+  cv_free(s->mult);
+  s->y = s->mult = NULL;
+  cv_disc_free(&s->disc); /* the factor stays: cv_newton_run checks it against the mesh */
+  s->have = 0;
+}
+
 void cv_solver_free(cv_solver *s) {
   if (!s) return;
   cv_solver_drop_factor(s);
@@ -41,9 +49,7 @@ void cv_solver_free(cv_solver *s) {
   cv_free(s->mesh.degrees);
   cv_free(s->mesh.breaks);
   cv_free(s->start);
-  cv_free(s->y);
-  cv_free(s->mult);
-  cv_disc_free(&s->disc);
+  cv_solver_drop_results(s);
   cv_pathset_free(s->paths);
   cv_free(s);
 }

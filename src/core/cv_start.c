@@ -124,11 +124,7 @@ static void detect_singular_ends(const cv_problem *p, cv_disc *d, const double *
 /* Discretisation, starting values and singular-end detection for the current mesh spec. */
 cv_status cv_start_setup(cv_solver *s, const cv_problem *p) {
   cv_status st;
-  cv_free(s->y);
-  cv_free(s->mult);
-  s->y = s->mult = NULL;
-  cv_disc_free(&s->disc); /* the factor stays: cv_newton_run checks it against the mesh */
-  s->have = 0;
+  cv_solver_drop_results(s);
   st = cv_disc_init(&s->disc, p, s, s->msg, sizeof s->msg);
   if (st) {
     if (st == CVAR_ENOMEM) cv_set_msg(s->msg, sizeof s->msg, "out of memory building the mesh");
