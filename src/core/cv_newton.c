@@ -107,6 +107,34 @@ static double residual(const cv_disc *d, const double *g, double *norm) {
   return 0.5 * s;
 }
 
+/* The round-off floor of the scaled residual (theory N-3a): storing the unknowns x in
+ * doubles moves each by up to eps |x_j|, which moves g_f by up to eps sum_j |K_fj| |x_j|;
+ * scaled as in residual(), floor = eps max_f (1/m_f) sum_j |K_fj| |x_j|. K is the matrix in
+ * Ax (upper triangle, column c holds rows c + 1 - length .. c; the last factored one,
+ * assembled at the iterate before the last step or at the last iterate), acc scratch of
+ * nfree. The rounding inside each integrand term is not counted: the floor is a lower
+ * estimate, so the ratio residual / floor errs on the side of "above the floor". */
+static double residual_floor(const newton_ws *w, const double *Ax, const double *Y, const double *M,
+                             double *acc) {
+  const cv_disc *d = w->d;
+  int nf = d->nfree;
+  for (int f = 0; f < nf; f++) acc[f] = 0.0;
+  for (int c = 0; c < nf; c++) {
+    int k0 = w->colptr[c], len = w->colptr[c + 1] - k0, r0 = c + 1 - len;
+    double xc = fabs(w->gof[c] >= 0 ? Y[w->gof[c]] : M[-1 - w->gof[c]]), sum = 0.0;
+    for (int k = 0; k < len - 1; k++) {
+      int r = r0 + k;
+      double a = fabs(Ax[k0 + k]);
+      acc[r] += a * xc;
+      sum += a * fabs(w->gof[r] >= 0 ? Y[w->gof[r]] : M[-1 - w->gof[r]]);
+    }
+    acc[c] += sum + fabs(Ax[k0 + len - 1]) * xc;
+  }
+  double fl = 0.0;
+  for (int f = 0; f < nf; f++) fl = fmax(fl, acc[f] * d->imass[f]);
+  return DBL_EPSILON * fl;
+}
+
 static const char *where_failed(cv_status st) {
   return st == CVAR_ECALLBACK ? "the integrand callback asked to abort"
                               : "the integrand (or a partial) is not finite";
@@ -416,12 +444,14 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   double S = 0.0, scale = 0.0;
   int stale = 0;           /* see the first residual below */
   double *Yc = Y, *Mc = M; /* the current iterate (see the swap below) */
+  double *Ax = NULL;       /* the matrix, in the factor's storage */
 
   s->iterations = 0;
   s->morse = -1;
   s->degenerate = 0;
-  s->gnorm = NAN;
+  s->gnorm = s->gfloor = NAN;
   s->action = NAN;
+  int have_K = 0; /* Ax holds an assembled matrix (for the residual's floor) */
   st = run_init(s, p, d, &w, &kkt, Y, M, nmult, &ncon);
   if (st) goto cleanup;
   int constrained = ncon > 0;
@@ -429,7 +459,8 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   for (long i = 0; i < d->ndof; i++)
     if (fabs(Y[i]) > scale) scale = fabs(Y[i]);
   if (scale == 0.0) scale = 1.0;
-  double atol = s->atol * scale, *Ax = cv_ldlt_values(w.L);
+  double atol = s->atol * scale;
+  Ax = cv_ldlt_values(w.L);
 
   /* Phase timers for bench/ (t_assemble, t_factor): on a system of a few unknowns the
    * clock reads were an eighth of the solve, so small systems are not split. */
@@ -446,6 +477,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     goto cleanup;
   }
   s->action = S;
+  have_K = 1;
   double phi = residual(d, w.g, &s->gnorm);
   /* After a step accepted on S alone the merit phi and the reported residual of the new
    * iterate are left to the next pass over g (the step norm below), not computed in a pass
@@ -548,6 +580,10 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   }
 cleanup:
   if (stale) residual(d, w.g, &s->gnorm);
+  if (have_K && Ax && nf > 0 && w.delta && isfinite(s->gnorm)) {
+    double fl = residual_floor(&w, Ax, Yc, Mc, w.delta);
+    s->gfloor = isfinite(fl) && fl > 0.0 ? fl : NAN;
+  }
   if (w.Yt && Yc != Y) { /* the latest iterate lives in our buffer: hand it back */
     memcpy(Y, Yc, (size_t)d->ndof * sizeof *Y);
     w.Yt = Yc;
