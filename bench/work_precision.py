@@ -165,8 +165,8 @@ def run_bvp(np, solve_bvp, pr, tol, budget):
                         max_nodes=1000000)
         t = time.perf_counter() - t0
         best, spent = min(best, t), spent + t
-        if sol.status != 0:
-            return None
+        if sol.status != 0:  # 1: max_nodes exceeded, 2: singular Jacobian, 3: tol not met
+            return sol.status
     err = float(np.max(np.abs(sol.y[:n] - pr["exact"](sol.x))))
     return err, best, sol.x.size
 
@@ -209,6 +209,10 @@ def main():
             bvp_tol[name] = {}
             for tol in tols:
                 r = run_bvp(np, solve_bvp, P[name], tol, budget)
+                if isinstance(r, int):
+                    print("  %-16s tol %.0e  failed (status %d)" % (name, tol, r))
+                    bvp_tol[name]["%.1e" % tol] = "failed (status %d)" % r
+                    continue
                 bvp_tol[name]["%.1e" % tol] = r
                 if r:
                     pts.append([r[0], r[1]])
@@ -273,16 +277,18 @@ def main():
             first = True
             for T, err, t, nodes, status in cv["tol"][name]:
                 b = bvp_tol[name].get("%.1e" % T)
+                why = b if isinstance(b, str) else "failed"
+                b = None if isinstance(b, str) else b
                 ratio = "%.0f" % (b[1] / t) if b else "-"
                 print("%-16s %8.1e | %-10s %9.2e %6d %-9s | %-10s %9s %6s | %7s" % (
                     name if first else "", T, "%.2e" % t, err, nodes, status,
-                    "%.2e" % b[1] if b else "failed", "%.2e" % b[0] if b else "-",
+                    "%.2e" % b[1] if b else why, "%.2e" % b[0] if b else "-",
                     "%d" % b[2] if b else "-", ratio))
                 if abs(math.log10(T) - round(math.log10(T))) < 1e-6:  # whole decades
                     md.append("| %s | %.0e | %.1e | %.1e%s | %d | %s | %s | %s | %s |" % (
                         name if first else "", T, t, err,
                         "" if status == "converged" else " (%s)" % status, nodes,
-                        "%.1e" % b[1] if b else "failed", "%.1e" % b[0] if b else "–",
+                        "%.1e" % b[1] if b else why, "%.1e" % b[0] if b else "–",
                         "%d" % b[2] if b else "–", ratio + "×" if b else "–"))
                     first = False
     if args.markdown:
