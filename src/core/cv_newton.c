@@ -112,8 +112,8 @@ static double residual(const cv_disc *d, const double *g, double *norm) {
  * scaled as in residual(), floor = eps max_f (1/m_f) sum_j |K_fj| |x_j|. K is the matrix in
  * Ax (upper triangle, column c holds rows c + 1 - length .. c; the last factored one,
  * assembled at the iterate before the last step or at the last iterate), acc scratch of
- * nfree. The rounding inside each integrand term is not counted: the floor is a lower
- * estimate, so the ratio residual / floor errs on the side of "above the floor". */
+ * nfree. The other part of the floor, the rounding of the terms summed into g_f, costs an
+ * evaluation of the integrand and is added on demand by cv_solver_residual_floor. */
 static double residual_floor(const newton_ws *w, const double *Ax, const double *Y, const double *M,
                              double *acc) {
   const cv_disc *d = w->d;
@@ -584,7 +584,7 @@ cleanup:
   if (stale) residual(d, w.g, &s->gnorm);
   if (have_K && Ax && nf > 0 && w.delta && isfinite(s->gnorm)) {
     double fl = residual_floor(&w, Ax, Yc, Mc, w.delta);
-    s->gfloor = isfinite(fl) && fl > 0.0 ? fl : NAN;
+    s->gfloor = isfinite(fl) ? fl : NAN; /* 0 when every unknown is 0 */
   }
   if (w.Yt && Yc != Y) { /* the latest iterate lives in our buffer: hand it back */
     memcpy(Y, Yc, (size_t)d->ndof * sizeof *Y);
