@@ -111,22 +111,25 @@ static double residual(const cv_disc *d, const double *g, double *norm) {
  * doubles moves each by up to eps |x_j|, which moves g_f by up to eps sum_j |K_fj| |x_j|;
  * scaled as in residual(), floor = eps max_f (1/m_f) sum_j |K_fj| |x_j|. K is the matrix in
  * Ax (upper triangle, column c holds rows c + 1 - length .. c; the last factored one,
- * assembled at the iterate before the last step or at the last iterate), acc scratch of
- * nfree. The other part of the floor, the rounding of the terms summed into g_f, costs an
+ * assembled at the iterate before the last step or at the last iterate); acc and xa are
+ * scratch of nfree. The other part of the floor, the rounding of the terms summed into g_f, costs an
  * evaluation of the integrand and is added on demand by cv_solver_residual_floor. */
 static double residual_floor(const newton_ws *w, const double *Ax, const double *Y, const double *M,
-                             double *acc) {
+                             double *acc, double *xa) {
   const cv_disc *d = w->d;
   int nf = d->nfree;
-  for (int f = 0; f < nf; f++) acc[f] = 0.0;
+  for (int f = 0; f < nf; f++) {
+    int gi = w->gof[f];
+    xa[f] = fabs(gi >= 0 ? Y[gi] : M[-1 - gi]);
+    acc[f] = 0.0;
+  }
   for (int c = 0; c < nf; c++) {
     int k0 = w->colptr[c], len = w->colptr[c + 1] - k0, r0 = c + 1 - len;
-    double xc = fabs(w->gof[c] >= 0 ? Y[w->gof[c]] : M[-1 - w->gof[c]]), sum = 0.0;
+    double xc = xa[c], sum = 0.0;
     for (int k = 0; k < len - 1; k++) {
-      int r = r0 + k;
       double a = fabs(Ax[k0 + k]);
-      acc[r] += a * xc;
-      sum += a * fabs(w->gof[r] >= 0 ? Y[w->gof[r]] : M[-1 - w->gof[r]]);
+      acc[r0 + k] += a * xc;
+      sum += a * xa[r0 + k];
     }
     acc[c] += sum + fabs(Ax[k0 + len - 1]) * xc;
   }
@@ -582,9 +585,9 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   }
 cleanup:
   if (stale) residual(d, w.g, &s->gnorm);
-  if (have_K && Ax && nf > 0 && w.delta && isfinite(s->gnorm)) {
-    double fl = residual_floor(&w, Ax, Yc, Mc, w.delta);
-    s->gfloor = isfinite(fl) ? fl : NAN; /* 0 when every unknown is 0 */
+  if (have_K && Ax && nf > 0 && w.delta && w.gt && isfinite(s->gnorm)) {
+    double fl = residual_floor(&w, Ax, Yc, Mc, w.delta, w.gt); /* both free here */
+    s->gfloor = isfinite(fl) ? fl : NAN;                       /* 0 when every unknown is 0 */
   }
   if (w.Yt && Yc != Y) { /* the latest iterate lives in our buffer: hand it back */
     memcpy(Y, Yc, (size_t)d->ndof * sizeof *Y);
