@@ -478,8 +478,7 @@ CVAR_API double cv_solver_get_gradient_norm(const cv_solver *s);
  * evaluation of the integrand's gradient at the quadrature points. CVAR_ESTATE (and NaN)
  * when the last solve was not a Newton solve that took a step (NLopt engines, no free
  * unknowns). Terms of constraints are not counted (a lower estimate of the floor then). */
-CVAR_API cv_status cv_solver_residual_floor(const cv_solver *s, const cv_problem *p,
-                                            double *floor);
+CVAR_API cv_status cv_solver_residual_floor(const cv_solver *s, const cv_problem *p, double *floor);
 /** Newton (or minimiser) iterations of the last solve. */
 CVAR_API int cv_solver_get_num_iterations(const cv_solver *s);
 /** Wall-clock seconds of the last cv_solve. */

@@ -27,14 +27,43 @@ static void results_reset(cv_solver *s) {
   s->note[0] = '\0';
 }
 
+/* The smallest end element automatic grading makes is 10^-CV_GRADE_MIN_DIGITS of the
+ * interval: next to a singular end the Hessian's entries there are differences of nearly
+ * equal large terms (theory M-2), and on smaller elements its inertia, the Morse index,
+ * was measured wrong (brachistochrone, 1000 elements of degree 8 at k = 4: h = 1e-12). */
+#define CV_GRADE_MIN_DIGITS 10.0
+
+/* Negative directions of the Hessian on a mesh whose elements at a singular end are
+ * smaller than automatic grading makes them (CV_GRADE_MIN_DIGITS): there the Hessian is a
+ * difference of nearly equal large terms, and both a count too high (a minimum called a
+ * saddle) and one that changes with the quadrature were measured. The count stays what the
+ * discrete Hessian says; the message says it may be the mesh's. */
+static void caution_tiny_end_elements(cv_solver *s) {
+  const cv_disc *d = &s->disc;
+  double L = d->b - d->a, h = INFINITY;
+  if (d->E < 1 || !(L > 0)) return;
+  if (d->sing_a) h = fmin(h, d->xe[1] - d->xe[0]);
+  if (d->sing_b) h = fmin(h, d->xe[d->E] - d->xe[d->E - 1]);
+  if (!(h < L * pow(10.0, -CV_GRADE_MIN_DIGITS))) return;
+  size_t ln = strlen(s->note);
+  cv_set_msg(s->note + ln, sizeof s->note - ln,
+             "the element at the singular end is %.1e of the interval, below the 1e-%g "
+             "down to which the Morse index was checked: its negative directions may belong "
+             "to the mesh, not the path (compare a milder grading); ",
+             h / L, CV_GRADE_MIN_DIGITS);
+}
+
 /* An integrand singular at an end (Q-2) on a plain uniform mesh: grade the mesh towards
- * that end, x_i = a + (b - a)(i/E)^k with k = min(4, 2 + p/2) (theory M-2). */
+ * that end, x_i = a + (b - a)(i/E)^k with k = min(4, 2 + p/2), lowered so that the end
+ * element keeps at least 1e-10 of the interval, E^-k >= 1e-10 (theory M-2). */
 static cv_status grade_singular_ends(cv_solver *s, const cv_problem *p) {
   if (!(s->disc.sing_a || s->disc.sing_b) || s->mesh.kind != CV_MESH_UNIFORM || s->start)
     return CVAR_OK;
   cv_meshspec keep = s->mesh;
   int both = s->disc.sing_a && s->disc.sing_b, at_a = s->disc.sing_a;
   double k = fmin(4.0, 2.0 + 0.5 * s->degree);
+  int E = both ? (s->mesh.elements + 1) / 2 : s->mesh.elements; /* elements per side */
+  if (E > 1) k = fmax(1.0, fmin(k, floor(100.0 * CV_GRADE_MIN_DIGITS / log10(E)) / 100.0));
   s->mesh.kind = CV_MESH_GRADED;
   s->mesh.grading = k;
   s->mesh.grade_end = both ? CVAR_GRADE_BOTH : at_a ? CVAR_GRADE_A : CVAR_GRADE_B;
@@ -251,6 +280,7 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
                fmax(rel[0], rel[1]), first);
     s->near_sing[0] = s->near_sing[1] = 0;
   }
+  if (st == CVAR_OK && s->morse > 0) caution_tiny_end_elements(s);
   prefix_note(s);
   s->status = st;
   return st;
