@@ -23,6 +23,12 @@ cv_status cv_solver_set_tol(cv_solver *s, double tol, int max_nodes) {
   return CVAR_OK;
 }
 
+cv_status cv_solver_set_time_limit(cv_solver *s, double seconds) {
+  if (!s || !(seconds >= 0) || !isfinite(seconds)) return CVAR_EINVAL;
+  s->time_limit = seconds;
+  return CVAR_OK;
+}
+
 cv_status cv_solver_set_adapt(cv_solver *s, double tol, int max_elements) {
   if (!s || !(tol >= 0) || !isfinite(tol) || max_elements < 1) return CVAR_EINVAL;
   s->adapt_tol = tol;
@@ -64,7 +70,7 @@ static double value_scale(const cv_solver *s) {
  * on. best: smallest estimate so far; floor_: the estimate's round-off part (HP-2);
  * stalled: rounds since the best last halved. */
 static int stop_rule(cv_solver *s, double est, double best, double floor_, int stalled,
-                     int next_size) {
+                     int next_size, double elapsed) {
   double tol = s->adapt_tol;
   const char *what = s->hp ? "nodes" : "elements";
   if ((best <= floor_ && tol < floor_) ||
@@ -82,6 +88,23 @@ static int stop_rule(cv_solver *s, double est, double best, double floor_, int s
                "the error estimate stopped decreasing at %.2g > %.2g (%d rounds without "
                "halving it, %d elements, %d nodes)",
                best, tol, stalled, s->disc.E, s->disc.nodes);
+    return 1;
+  }
+  if (s->time_limit > 0 && elapsed >= s->time_limit) {
+    char reached[96];
+    if (isfinite(est))
+      cv_set_msg(reached, sizeof reached, "the estimated max nodal error reached is %.2g > %.2g",
+                 est, tol);
+    else if (isfinite(best))
+      cv_set_msg(reached, sizeof reached,
+                 "the last round gave no error bound (HP-3), the best estimate was %.2g", best);
+    else
+      cv_set_msg(reached, sizeof reached, "no round has given an error bound yet (HP-3)");
+    cv_set_msg(s->msg, sizeof s->msg,
+               "the time limit of %.3g s was reached after %d round%s (%.3g s, %d elements, %d "
+               "nodes); %s; allow more time or ask for a larger tolerance",
+               s->time_limit, s->rounds, s->rounds == 1 ? "" : "s", elapsed, s->disc.E,
+               s->disc.nodes, reached);
     return 1;
   }
   if (next_size > s->adapt_max) {
@@ -121,7 +144,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   double *t = NULL, *eta = NULL, *sigma = NULL, *where = NULL;
   int *deg = NULL, E = 0, stalled = 0, warm = 0, misses = 0;
   long iters = 0, iters_ref = 0; /* Newton iterations of all rounds; of the enriched solves */
-  double tol = s->adapt_tol, best = INFINITY;
+  double tol = s->adapt_tol, best = INFINITY, t0 = cv_now();
   cv_meshspec spec0 = s->mesh;
   int degree0 = s->degree;
   if (!f) return CVAR_ENOMEM;
@@ -217,7 +240,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
      * above tol (HP-4); --adapt, those above tol / 4 (AD-1), and always the largest */
     double thresh = s->hp ? 0.25 * emax : fmin(0.25 * tol, emax);
     if (stop_rule(s, est, best, floor_, stalled,
-                  next_size(&s->disc, eta, sigma, thresh, tol, s->hp))) {
+                  next_size(&s->disc, eta, sigma, thresh, tol, s->hp), cv_now() - t0)) {
       st = CVAR_EMAXITER;
       goto cleanup;
     }
