@@ -185,7 +185,9 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     double est, floor_ = 0.0;
     int done = 0;
     char why[400];
-    st = cv_estimate_enriched(s, p, f, &est, NULL, &floor_, eta, sigma, where, why, sizeof why);
+    st = cv_estimate_enriched(s, p, f, &est, NULL, &floor_, why, sizeof why);
+    /* the indicators only when another round may follow */
+    if (!st && est > tol) st = cv_estimate_indicators(s, f, eta, sigma, where);
     iters_ref += f->iterations;
     if (st == CVAR_ENOMEM) goto cleanup;
     if (st) {

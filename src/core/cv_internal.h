@@ -305,10 +305,13 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
 cv_status cv_warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from);
 /* HP-2, HP-3: the estimate of s's max nodal error from a warm-started solve into f on the
  * enriched mesh (est_vertex: at the element boundaries; floor_out: its round-off part; both
- * may be NULL); with eta, sigma, where (E each, all or none) the indicators of HP-4. */
+ * may be NULL). */
 cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solver *f, double *est,
-                               double *est_vertex, double *floor_out, double *eta, double *sigma,
-                               double *where, char *msg, size_t len);
+                               double *est_vertex, double *floor_out, char *msg, size_t len);
+/* HP-4: the indicators eta, sigma, where (E entries each) of s's elements from f, the
+ * enriched solve of a successful cv_estimate_enriched. */
+cv_status cv_estimate_indicators(const cv_solver *s, const cv_solver *f, double *eta,
+                                 double *sigma, double *where);
 /* HP-4, HP-5: the next mesh (on [0, 1], *t with *Enew + 1 entries, *deg with *Enew) from
  * d with the elements cv_hp_marked refined (hp = 0: bisected at their degree); target:
  * the tolerance, for the degree a smooth element is raised to. */
