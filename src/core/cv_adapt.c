@@ -59,6 +59,40 @@ static cv_status start_mesh(cv_solver *s, const cv_problem *p, int *E, double **
   return CVAR_OK;
 }
 
+/* HP-1: a plain uniform start of one degree p < 8 on a problem with no singular end is
+ * replaced by the same number of nodes at degree 8, at least 2 elements: a smooth solution
+ * is resolved to 1e-12 by a few degree-8 elements, and starting there saves the rounds that
+ * raise the degrees one prediction at a time (2 rounds -> 1 on the smooth reference
+ * problems). Next to a singular end the degree must stay low (HP-5), so such a start is
+ * kept. The singular ends are those the start's discretisation finds (cv_start_setup). */
+static cv_status start_at_degree8(cv_solver *s, const cv_problem *p, const cv_meshspec *spec0,
+                                  int *E, double **t, int **deg) {
+  if (!s->hp || spec0->kind != CV_MESH_UNIFORM || spec0->nbreak > 0 || spec0->degrees ||
+      (*deg)[0] >= CV_MAX_DEGREE)
+    return CVAR_OK;
+  for (int e = 1; e < *E; e++)
+    if ((*deg)[e] != (*deg)[0]) return CVAR_OK;
+  cv_status st = cv_solver_set_mesh_hp(s, *E, *t, *deg);
+  if (!st) st = cv_start_setup(s, p);
+  if (st) return st == CVAR_ENOMEM ? st : CVAR_OK; /* the first round says what is wrong */
+  if (s->disc.sing_a || s->disc.sing_b) return CVAR_OK;
+  int E8 = (*E * (*deg)[0] + CV_MAX_DEGREE - 1) / CV_MAX_DEGREE;
+  if (E8 < 2) E8 = 2;
+  double *t8 = cv_malloc((size_t)(E8 + 1) * sizeof *t8);
+  int *d8 = cv_malloc((size_t)E8 * sizeof *d8);
+  if (!t8 || !d8) {
+    cv_free(t8);
+    cv_free(d8);
+    return CVAR_ENOMEM;
+  }
+  for (int e = 0; e <= E8; e++) t8[e] = (double)e / E8;
+  for (int e = 0; e < E8; e++) d8[e] = CV_MAX_DEGREE;
+  cv_free(*t);
+  cv_free(*deg);
+  *t = t8, *deg = d8, *E = E8;
+  return CVAR_OK;
+}
+
 /* Largest nodal value of the solution (at least 1): the scale of its round-off floor. */
 static double value_scale(const cv_solver *s) {
   double m = 1.0;
@@ -136,6 +170,38 @@ static int next_size(const cv_disc *d, const double *eta, const double *sigma, d
   return size > 2000000000L ? 2000000000 : (int)size;
 }
 
+/* HP-7: after the first solve, when every element has degree >= 4 and decays smoothly
+ * (sigma >= 1) and the predicted next coefficients are far above tol (> 100 tol, so the
+ * enriched solve could not have confirmed tol), refine by those predictions (HP-4 with
+ * eta = the tail) without the estimate: the enriched solve of a mesh known to be too
+ * coarse is skipped. 1 when it refined (E, t, deg replaced), 0 when not, -1 out of memory. */
+static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where, double tol,
+                        int *E, double **t, int **deg) {
+  const cv_disc *d = &s->disc;
+  double tmax = 0.0;
+  cv_estimate_pilot(s, tail, sigma);
+  for (long e = 0; e < d->E; e++) {
+    if (cv_disc_edeg(d, e) < 4 || !(sigma[e] >= 1.0) || !isfinite(tail[e])) return 0;
+    tmax = fmax(tmax, tail[e]);
+    where[e] = 0.0;
+  }
+  if (!(tmax > 100.0 * tol)) return 0;
+  int En = 0, *dn = NULL;
+  double *tn = NULL;
+  if (cv_hp_refine(d, tail, sigma, where, 0.25 * tmax, tol, 1, &En, &tn, &dn)) return -1;
+  long nodes = 1;
+  for (int e = 0; e < En; e++) nodes += dn[e];
+  if (nodes > s->adapt_max) { /* the cap: leave it to the estimated rounds to say */
+    cv_free(tn);
+    cv_free(dn);
+    return 0;
+  }
+  cv_free(*t);
+  cv_free(*deg);
+  *t = tn, *deg = dn, *E = En;
+  return 1;
+}
+
 /* Rounds (HP-1): solve on the current mesh warm-started from the last enriched solution,
  * estimate, refine. Ends with s holding the last round's solution and s->err_est. */
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
@@ -156,6 +222,11 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   s->mesh.t = NULL; /* spec0 keeps the caller's mesh; restored at the end */
   s->mesh.degrees = NULL;
   s->mesh.nbreak = 0; /* breakpoints are already boundaries, and stay so */
+  st = start_at_degree8(s, p, &spec0, &E, &t, &deg);
+  if (st) {
+    cv_set_msg(s->msg, sizeof s->msg, "out of memory");
+    goto cleanup;
+  }
   for (s->rounds = 1;; s->rounds++) {
     st = cv_solver_set_mesh_hp(s, E, t, deg);
     if (!st && warm) st = cv_warm_start(s, p, warm == 1 ? f : s);
@@ -181,6 +252,17 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     if (!eta || !sigma || !where) {
       st = CVAR_ENOMEM;
       goto cleanup;
+    }
+    if (s->hp && s->rounds == 1) { /* HP-7: the first solve's own coefficients */
+      int r = pilot_refine(s, eta, sigma, where, tol, &E, &t, &deg);
+      if (r < 0) {
+        st = CVAR_ENOMEM;
+        goto cleanup;
+      }
+      if (r > 0) {
+        warm = 2;
+        continue;
+      }
     }
     double est, floor_ = 0.0;
     int done = 0;

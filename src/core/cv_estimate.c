@@ -46,6 +46,8 @@ typedef struct {
   double ip[NG][CV_MAX_DEGREE + 1];    /* degree-p interpolant at the Gauss points */
   double leg[CV_MAX_DEGREE + 1][CV_MAX_DEGREE + 1]; /* Legendre coefficients from GLL_P values */
   double warm[NF][CV_MAX_DEGREE + 1];  /* the element's degree-p values at the enriched nodes */
+  double self[CV_MAX_DEGREE + 1][CV_MAX_DEGREE + 1]; /* Legendre coefficients from GLL_p values */
+  double xi[CV_MAX_DEGREE + 1], bw[CV_MAX_DEGREE + 1]; /* GLL_p nodes, barycentric weights */
   int nwarm;                           /* enriched nodes (both halves when split) */
 } est_table;
 
@@ -93,6 +95,17 @@ static void table_compute(est_table *T, int p) {
     legendre_all(P, xiP[l], L);
     for (int k = 0; k <= P; k++) T->leg[k][l] = wP[l] * L[k] * (k < P ? 0.5 * (2 * k + 1) : 0.5 * P);
   }
+  for (int l = 0; l <= p; l++) {
+    legendre_all(p, xi[l], L);
+    for (int k = 0; k <= p; k++) T->self[k][l] = wl[l] * L[k] * (k < p ? 0.5 * (2 * k + 1) : 0.5 * p);
+  }
+  for (int l = 0; l <= p; l++) {
+    double w = 1.0;
+    for (int m = 0; m <= p; m++)
+      if (m != l) w *= xi[l] - xi[m];
+    T->xi[l] = xi[l];
+    T->bw[l] = 1.0 / w;
+  }
   T->nwarm = T->split ? 2 * (P + 1) : P + 1;
   for (int m = 0; m <= P; m++) {
     if (T->split) {
@@ -138,8 +151,8 @@ static double apply_row(const double *row, int off, int P, const double *F, int 
 }
 
 /* Start solver s (its mesh set, about to be solved) from the solution held by `from`,
- * interpolated at s's nodes. */
-cv_status cv_warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from) {
+ * interpolated at s's nodes, through a discretisation of s's mesh and cv_solver_eval. */
+static cv_status warm_start_generic(cv_solver *s, const cv_problem *p, const cv_solver *from) {
   cv_disc d;
   char msg[160];
   cv_status st = cv_disc_init(&d, p, s, msg, sizeof msg);
@@ -161,6 +174,62 @@ cv_status cv_warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from
   cv_free(ys);
   cv_free(y);
   cv_disc_free(&d);
+  return st;
+}
+
+/* The degree-p Lagrange basis at GLL_p through the second barycentric formula (p + 1
+ * divisions instead of p (p + 1)): phi_l = (w_l / (s - x_l)) / sum_k (w_k / (s - x_k)). */
+static void bary_basis(const est_table *T, int p, double s, double *phi) {
+  double sum = 0.0;
+  for (int l = 0; l <= p; l++) {
+    double ds = s - T->xi[l];
+    if (ds == 0.0) { /* at a node */
+      for (int k = 0; k <= p; k++) phi[k] = k == l;
+      return;
+    }
+    phi[l] = T->bw[l] / ds;
+    sum += phi[l];
+  }
+  for (int l = 0; l <= p; l++) phi[l] /= sum;
+}
+
+/* Start solver s (its mesh set, about to be solved) from the solution held by `from`,
+ * interpolated at s's nodes. An hp mesh of the rounds (t on [0, 1] and degrees, no
+ * breakpoints) is read directly and its nodes, in increasing order, met by one sweep over
+ * `from`'s elements; other meshes are discretised first. */
+cv_status cv_warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from) {
+  const cv_meshspec *m = &s->mesh;
+  const cv_disc *fd = &from->disc;
+  if (!(m->kind == CV_MESH_USER && m->t && m->degrees && m->nbreak == 0) || !from->have)
+    return warm_start_generic(s, p, from);
+  int n = p->n, E = m->elements;
+  long N = 1;
+  for (int e = 0; e < E; e++) N += m->degrees[e];
+  double *y = cv_malloc((size_t)N * n * sizeof *y), a = p->a, L = p->b - p->a;
+  if (!y) return CVAR_ENOMEM;
+  long j = 0, lo = 0;
+  for (int e = 0; e < E; e++) {
+    int pe = m->degrees[e];
+    const est_table *Te = table_get(pe);
+    double x0 = a + L * m->t[e], h = a + L * m->t[e + 1] - x0;
+    for (int l = 0; l < pe + (e == E - 1); l++, j++) {
+      double x = l == pe ? a + L : x0 + 0.5 * (Te->xi[l] + 1.0) * h;
+      while (lo < fd->E - 1 && fd->xe[lo + 1] <= x) lo++;
+      int q = cv_disc_edeg(fd, lo);
+      const est_table *Tq = table_get(q);
+      double phi[CV_MAX_DEGREE + 1], hq = fd->xe[lo + 1] - fd->xe[lo];
+      double tau = fmin(1.0, fmax(-1.0, 2.0 * (x - fd->xe[lo]) / hq - 1.0));
+      bary_basis(Tq, q, tau, phi);
+      const double *Y = from->y + (size_t)cv_disc_enode(fd, lo) * n;
+      for (int i = 0; i < n; i++) {
+        double v = 0.0;
+        for (int k = 0; k <= q; k++) v += phi[k] * Y[(size_t)k * n + i];
+        y[(size_t)j * n + i] = v;
+      }
+    }
+  }
+  cv_status st = cv_solver_set_start(s, (int)(N * n), y);
+  cv_free(y);
   return st;
 }
 
@@ -196,6 +265,45 @@ static cv_status enriched_mesh(const cv_disc *d, int *Ef, double **t, int **deg)
  * slope of log |a_k|, k = 1..P, floored at round-off; the largest over components is not
  * used: the smallest rate, the least smooth component, decides), and where[e] the
  * reference coordinate in [-1, 1] at which the surplus is largest. */
+/* Minus the least-squares slope of ln|a_k| against k for k = 1..P, the coefficients
+ * floored at 1e-15 of the largest (HP-4). */
+static double decay_rate(const double *a, int P) {
+  double amax = 0.0;
+  for (int k = 0; k <= P; k++) amax = fmax(amax, fabs(a[k]));
+  double floor_ = 1e-15 * (amax > 0 ? amax : 1.0), sk = 0, sl = 0, skk = 0, skl = 0;
+  int m = 0;
+  for (int k = 1; k <= P; k++, m++) {
+    double lk = log(fmax(fabs(a[k]), floor_));
+    sk += k, sl += lk, skk += (double)k * k, skl += k * lk;
+  }
+  return -(m * skl - sk * sl) / (m * skk - sk * sk);
+}
+
+cv_status cv_estimate_pilot(const cv_solver *s, double *tail, double *sigma) {
+  const cv_disc *d = &s->disc;
+  int n = d->n;
+  for (long e = 0; e < d->E; e++) {
+    int pe = cv_disc_edeg(d, e);
+    const est_table *T = table_get(pe);
+    const double *Y = s->y + (size_t)cv_disc_enode(d, e) * n;
+    double tl = 0.0, sg = INFINITY;
+    for (int i = 0; i < n; i++) {
+      double a[CV_MAX_DEGREE + 1];
+      for (int k = 0; k <= pe; k++) {
+        a[k] = 0.0;
+        for (int l = 0; l <= pe; l++) a[k] += T->self[k][l] * Y[(size_t)l * n + i];
+      }
+      double rate = decay_rate(a, pe);
+      sg = fmin(sg, rate);
+      double next = fabs(a[pe]) * exp(-fmax(rate, 0.0)); /* a_{p+1}, extrapolated */
+      if (!(next <= tl)) tl = next;                        /* NaN propagates */
+    }
+    tail[e] = tl;
+    sigma[e] = sg;
+  }
+  return CVAR_OK;
+}
+
 cv_status cv_estimate_indicators(const cv_solver *s, const cv_solver *f, double *eta,
                                  double *sigma, double *where) {
   const cv_disc *d = &s->disc;
@@ -227,21 +335,12 @@ cv_status cv_estimate_indicators(const cv_solver *s, const cv_solver *f, double 
         double dlt = fabs(apply_row(T->gauss[l], T->gauss_off[l], P, F, n, i) - ip);
         if (!(dlt <= eta_e)) eta_e = dlt, at = tg[l]; /* NaN propagates */
       }
-      double amax = 0.0;
       for (int k = 0; k <= P; k++) {
         a[k] = 0.0;
         for (int l = 0; l <= P; l++) a[k] += T->leg[k][l] * ys[i * (P + 1) + l];
-        amax = fmax(amax, fabs(a[k]));
       }
-      /* slope of log|a_k| against k for k = 1..P, coefficients floored at round-off */
-      double floor_ = 1e-15 * (amax > 0 ? amax : 1.0), sk = 0, sl = 0, skk = 0, skl = 0;
-      int m = 0;
-      for (int k = 1; k <= P; k++, m++) {
-        double lk = log(fmax(fabs(a[k]), floor_));
-        sk += k, sl += lk, skk += (double)k * k, skl += k * lk;
-      }
-      double slope = (m * skl - sk * sl) / (m * skk - sk * sk);
-      if (-slope < sig_e) sig_e = -slope;
+      double rate = decay_rate(a, P);
+      if (rate < sig_e) sig_e = rate;
     }
     eta[e] = eta_e;
     sigma[e] = sig_e;

@@ -49,11 +49,23 @@ static int degree_suffices(int p, double eta, double sigma, double target) {
   return !(k > CV_MAX_DEGREE - p + 1);
 }
 
+/* HP-4: the number of equal degree-8 pieces for a smooth element that degree 8 alone would
+ * leave above a tenth of the target: raising p to 8 gains e^(-sigma (8 - p)), and m pieces
+ * another m^-(8+1) (the asymptotic h-rate at degree 8), so
+ * m = ceil((eta e^(-sigma (8 - p)) / (target / 10))^(1/9)), 2..MAX_PIECES. */
+#define MAX_PIECES 16
+static int smooth_pieces(int p, double eta, double sigma, double target) {
+  double r = eta * exp(-sigma * (CV_MAX_DEGREE - p)) / (0.1 * target);
+  double m = ceil(pow(r, 1.0 / (CV_MAX_DEGREE + 1)));
+  return !(m >= 2) ? 2 : m > MAX_PIECES ? MAX_PIECES : (int)m;
+}
+
 cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
                        const double *where, double thresh, double target, int hp, int *Enew,
                        double **t, int **deg) {
   int E = d->E, F = 0;
-  for (int e = 0; e < E; e++) F += cv_hp_marked(eta[e], sigma[e], thresh, target, hp) ? 2 : 1;
+  for (int e = 0; e < E; e++)
+    F += cv_hp_marked(eta[e], sigma[e], thresh, target, hp) ? MAX_PIECES : 1; /* at most */
   *t = cv_malloc((size_t)(F + 1) * sizeof **t);
   *deg = cv_malloc((size_t)F * sizeof **deg);
   if (!*t || !*deg) {
@@ -100,16 +112,30 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
       continue;
     }
     if (sigma[e] >= SMOOTH_RATE && pe < CV_MAX_DEGREE) {    /* smooth: raise p (HP-4) */
-      if (!degree_suffices(pe, eta[e], sigma[e], target)) { /* and halve, in one round */
-        (*deg)[k++] = CV_MAX_DEGREE;
-        (*t)[k] = tm;
-        (*deg)[k++] = CV_MAX_DEGREE;
+      if (!degree_suffices(pe, eta[e], sigma[e], target)) { /* and split, in one round */
+        int m = smooth_pieces(pe, eta[e], sigma[e], target);
+        for (int j = 0; j < m; j++) {
+          double tj = split_at(x0, x1, x0 + (x1 - x0) * j / m, a, L);
+          if (j > 0 && tj < 0) continue; /* round-off: fewer pieces */
+          if (j > 0) (*t)[k] = tj;
+          (*deg)[k++] = CV_MAX_DEGREE;
+        }
         continue;
       }
       (*deg)[k++] = predicted_degree(pe, eta[e], sigma[e], target);
       continue;
     }
-    (*deg)[k++] = pe; /* not smooth, or degree 8 already: halve */
+    if (sigma[e] >= SMOOTH_RATE) { /* smooth at degree 8: m pieces (HP-4) */
+      int m = smooth_pieces(pe, eta[e], sigma[e], target);
+      for (int j = 0; j < m; j++) {
+        double tj = split_at(x0, x1, x0 + (x1 - x0) * j / m, a, L);
+        if (j > 0 && tj < 0) continue;
+        if (j > 0) (*t)[k] = tj;
+        (*deg)[k++] = pe;
+      }
+      continue;
+    }
+    (*deg)[k++] = pe; /* not smooth: halve */
     (*t)[k] = tm;
     (*deg)[k++] = pe;
   }

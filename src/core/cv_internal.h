@@ -312,6 +312,10 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
  * enriched solve of a successful cv_estimate_enriched. */
 cv_status cv_estimate_indicators(const cv_solver *s, const cv_solver *f, double *eta,
                                  double *sigma, double *where);
+/* HP-7: from s's own solution, no solve: per element the decay rate sigma of its Legendre
+ * coefficients and the next coefficient it predicts, tail = |a_p| e^(-sigma) (the largest
+ * over the unknowns); a prediction to refine by, never an estimate. */
+cv_status cv_estimate_pilot(const cv_solver *s, double *tail, double *sigma);
 /* HP-4, HP-5: the next mesh (on [0, 1], *t with *Enew + 1 entries, *deg with *Enew) from
  * d with the elements cv_hp_marked refined (hp = 0: bisected at their degree); target:
  * the tolerance, for the degree a smooth element is raised to. */
