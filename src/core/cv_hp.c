@@ -49,6 +49,22 @@ static int degree_suffices(int p, double eta, double sigma, double target) {
   return !(k > CV_MAX_DEGREE - p + 1);
 }
 
+/* HP-5: where piece j of m of [x0, x1] starts: equal pieces, or, with a singular end that
+ * the element does not touch, pieces whose distances from that end grow geometrically,
+ * u_j = d0 (d1 / d0)^(j/m) from it (halving: the geometric mean of the element's distances
+ * d0, d1). Each piece then has the same ratio of distance to length, so the same rate of
+ * convergence in p, instead of the piece nearer the end lagging behind. */
+static double piece_start(const cv_disc *d, double x0, double x1, int j, int m) {
+  double a = d->xe[0], b = d->xe[d->E];
+  if ((d->sing_a || d->sing_b) && x0 > a && x1 < b) {
+    int at_a = d->sing_a && (!d->sing_b || x0 - a <= b - x1);
+    double d0 = at_a ? x0 - a : b - x1, d1 = at_a ? x1 - a : b - x0;
+    double u = d0 * pow(d1 / d0, (double)j / m);
+    return at_a ? a + u : b - u;
+  }
+  return x0 + (x1 - x0) * j / m;
+}
+
 /* HP-4: the number of equal degree-8 pieces for a smooth element that degree 8 alone would
  * leave above a tenth of the target: raising p to 8 gains e^(-sigma (8 - p)), and m pieces
  * another m^-(8+1) (the asymptotic h-rate at degree 8), so
@@ -115,7 +131,7 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
       if (!degree_suffices(pe, eta[e], sigma[e], target)) { /* and split, in one round */
         int m = smooth_pieces(pe, eta[e], sigma[e], target);
         for (int j = 0; j < m; j++) {
-          double tj = split_at(x0, x1, x0 + (x1 - x0) * j / m, a, L);
+          double tj = split_at(x0, x1, piece_start(d, x0, x1, j, m), a, L);
           if (j > 0 && tj < 0) continue; /* round-off: fewer pieces */
           if (j > 0) (*t)[k] = tj;
           (*deg)[k++] = CV_MAX_DEGREE;
@@ -125,18 +141,19 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
       (*deg)[k++] = predicted_degree(pe, eta[e], sigma[e], target);
       continue;
     }
-    if (sigma[e] >= SMOOTH_RATE) { /* smooth at degree 8: m pieces (HP-4) */
+    if (sigma[e] >= SMOOTH_RATE) { /* smooth at degree 8: m pieces (HP-4, HP-5) */
       int m = smooth_pieces(pe, eta[e], sigma[e], target);
       for (int j = 0; j < m; j++) {
-        double tj = split_at(x0, x1, x0 + (x1 - x0) * j / m, a, L);
+        double tj = split_at(x0, x1, piece_start(d, x0, x1, j, m), a, L);
         if (j > 0 && tj < 0) continue;
         if (j > 0) (*t)[k] = tj;
         (*deg)[k++] = pe;
       }
       continue;
     }
-    (*deg)[k++] = pe; /* not smooth: halve */
-    (*t)[k] = tm;
+    double tsplit = split_at(x0, x1, piece_start(d, x0, x1, 1, 2), a, L);
+    (*deg)[k++] = pe; /* not smooth: halve (HP-5: geometrically with a singular end) */
+    (*t)[k] = tsplit >= 0 ? tsplit : tm;
     (*deg)[k++] = pe;
   }
   (*t)[0] = 0.0;
