@@ -70,15 +70,51 @@ static double piece_start(const cv_disc *d, double x0, double x1, int j, int m) 
  * another m^-(8+1) (the asymptotic h-rate at degree 8), so
  * m = ceil((eta e^(-sigma (8 - p)) / (target / 10))^(1/9)), 2..MAX_PIECES. */
 #define MAX_PIECES 16
+#define MAX_LAYERS 12 /* geometric layers added towards a singular end in one round */
 static int smooth_pieces(int p, double eta, double sigma, double target) {
   double r = eta * exp(-sigma * (CV_MAX_DEGREE - p)) / (0.1 * target);
   double m = ceil(pow(r, 1.0 / (CV_MAX_DEGREE + 1)));
   return !(m >= 2) ? 2 : m > MAX_PIECES ? MAX_PIECES : (int)m;
 }
 
+/* HP-8: the degree q of one element replacing elements e and e + 1 (0: no merge): both
+ * unmarked, smooth and of degree p, neither touching a singular end. On the union, r_i =
+ * (h_e + h_e+1) / h_i times element i, the Legendre rate falls to sigma_i - ln r_i (the
+ * ellipse of analyticity shrinks by r_i), so the surplus at degree q is predicted as
+ * eta_i e^(-sigma_i (q - p)) r_i^(q+1); q is the least degree from p to min(8, 2p - 1) (fewer
+ * nodes than the two) at which both predictions are below a tenth of the target. A
+ * start finer than the tolerance needs (a scene's own [mesh]) is so coarsened, round by
+ * round, where the solution is smooth, in the first MERGE_ROUNDS rounds only (hp = 2): later
+ * merges could undo the refinements of a solution that is only piecewise smooth (a
+ * tabulated spline) and the rounds would go round in circles. */
+#define MERGE_AIM 0.1 /* merged surplus predicted at most this x target (HP-8) */
+static int merged_degree(const cv_disc *d, const double *eta, const double *sigma,
+                         double thresh, double target, long e) {
+  int p = cv_disc_edeg(d, e);
+  if (cv_disc_edeg(d, e + 1) != p || (e == 0 && d->sing_a) || (e + 2 == d->E && d->sing_b))
+    return 0;
+  double h0 = d->xe[e + 1] - d->xe[e], h1 = d->xe[e + 2] - d->xe[e + 1];
+  for (int i = 0; i < 2; i++) {
+    double r = (h0 + h1) / (i ? h1 : h0);
+    if (cv_hp_marked(eta[e + i], sigma[e + i], thresh, target, 1) ||
+        !(sigma[e + i] - log(r) >= SMOOTH_RATE))
+      return 0;
+  }
+  int qmax = 2 * p - 1 < CV_MAX_DEGREE ? 2 * p - 1 : CV_MAX_DEGREE;
+  for (int q = p; q <= qmax; q++) {
+    int ok = 1;
+    for (int i = 0; i < 2 && ok; i++) {
+      double r = (h0 + h1) / (i ? h1 : h0);
+      ok = eta[e + i] * exp(-sigma[e + i] * (q - p)) * pow(r, q + 1) <= MERGE_AIM * target;
+    }
+    if (ok) return q;
+  }
+  return 0;
+}
+
 cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
-                       const double *where, double thresh, double target, int hp, int *Enew,
-                       double **t, int **deg) {
+                       const double *where, double thresh, double target, int hp,
+                       const int *layers, int *Enew, double **t, int **deg) {
   int E = d->E, F = 0;
   for (int e = 0; e < E; e++)
     F += cv_hp_marked(eta[e], sigma[e], thresh, target, hp) ? MAX_PIECES : 1; /* at most */
@@ -97,6 +133,12 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
     int pe = cv_disc_edeg(d, e);
     double x0 = d->xe[e], x1 = d->xe[e + 1];
     (*t)[k] = (x0 - a) / L;
+    int q = hp == 2 && e + 1 < E ? merged_degree(d, eta, sigma, thresh, target, e) : 0;
+    if (q) { /* HP-8 */
+      (*deg)[k++] = q;
+      e++;
+      continue;
+    }
     double tm = split_at(x0, x1, 0.5 * (x0 + x1), a, L);
     double tl = split_at(x0, x1, x0 + GEOM_RATIO * (x1 - x0), a, L);
     double tr = split_at(x0, x1, x1 - GEOM_RATIO * (x1 - x0), a, L);
@@ -115,15 +157,28 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
                     (!(e == E - 1 && d->sing_b) && where[e] < -0.5 && sigma[e] < SMOOTH_RATE);
     int sing_right = (e == E - 1 && d->sing_b) ||
                      (!(e == 0 && d->sing_a) && where[e] > 0.5 && sigma[e] < SMOOTH_RATE);
-    if (sing_left && !sing_right) { /* small element at x0 keeps p, the rest p + 1 (HP-5) */
+    /* HP-5: layers towards a singular end the element touches (1 elsewhere) */
+    int nl = layers && e == 0 && d->sing_a     ? layers[0]
+             : layers && e == E - 1 && d->sing_b ? layers[1]
+                                                  : 1;
+    nl = nl < 1 ? 1 : nl > MAX_LAYERS ? MAX_LAYERS : nl;
+    if (sing_left && !sing_right) { /* small element at x0 keeps p, the next p + 1, ... */
       (*deg)[k++] = pe;
-      (*t)[k] = tl;
-      (*deg)[k++] = clamp_deg(pe + 1);
+      for (int j = nl; j >= 1; j--) {
+        double tj = split_at(x0, x1, x0 + pow(GEOM_RATIO, j) * (x1 - x0), a, L);
+        if (tj < 0 || tj <= (*t)[k - 1]) continue; /* round-off: fewer layers */
+        (*t)[k] = tj;
+        (*deg)[k++] = clamp_deg(pe + 1 + nl - j);
+      }
       continue;
     }
     if (sing_right && !sing_left) {
-      (*deg)[k++] = clamp_deg(pe + 1);
-      (*t)[k] = tr;
+      for (int j = 1; j <= nl; j++) {
+        double tj = split_at(x0, x1, x1 - pow(GEOM_RATIO, j) * (x1 - x0), a, L);
+        if (tj < 0 || tj <= (*t)[k]) continue;
+        (*deg)[k++] = clamp_deg(pe + 1 + nl - j);
+        (*t)[k] = tj;
+      }
       (*deg)[k++] = pe;
       continue;
     }
