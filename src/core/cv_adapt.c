@@ -195,7 +195,7 @@ static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where
   if (!(tmax > PILOT_MISS * tol)) return 0;
   int En = 0, *dn = NULL;
   double *tn = NULL;
-  if (cv_hp_refine(d, tail, sigma, where, 0.25 * tmax, PILOT_AIM * tol, 1, NULL, &En, &tn, &dn))
+  if (cv_hp_refine(d, tail, sigma, where, 0.25 * tmax, PILOT_AIM * tol, 1, &En, &tn, &dn))
     return -1;
   long nodes = 1;
   for (int e = 0; e < En; e++) nodes += dn[e];
@@ -208,35 +208,6 @@ static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where
   cv_free(*deg);
   *t = tn, *deg = dn, *E = En;
   return 1;
-}
-
-/* HP-5: what the last round saw of the element touching each singular end: its surplus,
- * length and degree. */
-typedef struct {
-  double eta, h;
-  int p, valid;
-} end_memory;
-
-/* HP-5: how many geometric layers to add at each singular end this round. The surplus of the
- * element touching a singular end falls like h^alpha as it shrinks at a fixed degree (alpha =
- * 2/3 for y ~ x^(2/3)); two rounds give alpha = ln(eta / eta') / ln(h / h'), and then the
- * layers that bring it to a tenth of tol, k = ceil(ln(eta / (tol / 10)) / (alpha ln(1 /
- * 0.15))), are added at once (1..12) instead of one per round. Without two such rounds, 1. */
-static void end_layers(const cv_disc *d, const double *eta, double tol, end_memory *m,
-                       int layers[2]) {
-  for (int end = 0; end < 2; end++) {
-    layers[end] = 1;
-    if (!(end ? d->sing_b : d->sing_a)) continue;
-    long e = end ? d->E - 1 : 0;
-    double h = d->xe[e + 1] - d->xe[e], et = eta[e];
-    int p = cv_disc_edeg(d, e);
-    if (m[end].valid && p == m[end].p && h < m[end].h && et > 0 && et < m[end].eta) {
-      double alpha = log(et / m[end].eta) / log(h / m[end].h);
-      double k = ceil(log(et / (0.1 * tol)) / (alpha * log(1.0 / 0.15)));
-      if (alpha > 0.05 && k > 1) layers[end] = k > 12 ? 12 : (int)k;
-    }
-    m[end].eta = et, m[end].h = h, m[end].p = p, m[end].valid = 1;
-  }
 }
 
 static int cmp_desc(const void *a, const void *b) {
@@ -270,7 +241,6 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   cv_solver *f = cv_solver_new(&st);
   double *t = NULL, *eta = NULL, *sigma = NULL, *where = NULL;
   int *deg = NULL, E = 0, stalled = 0, warm = 0, misses = 0;
-  end_memory ends[2] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
   long iters = 0, iters_ref = 0; /* Newton iterations of all rounds; of the enriched solves */
   double tol = s->adapt_tol, best = INFINITY, t0 = cv_now();
   cv_meshspec spec0 = s->mesh;
@@ -396,11 +366,8 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     }
     cv_free(t);
     cv_free(deg);
-    int layers[2];
-    end_layers(&s->disc, eta, tol, ends, layers);
     int mode = s->hp ? (s->rounds <= MERGE_ROUNDS ? 2 : 1) : 0;
-    st = cv_hp_refine(&s->disc, eta, sigma, where, thresh, tol, mode, s->hp ? layers : NULL, &E,
-                      &t, &deg);
+    st = cv_hp_refine(&s->disc, eta, sigma, where, thresh, tol, mode, &E, &t, &deg);
     if (st) goto cleanup;
   }
 cleanup:

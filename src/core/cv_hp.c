@@ -70,7 +70,6 @@ static double piece_start(const cv_disc *d, double x0, double x1, int j, int m) 
  * another m^-(8+1) (the asymptotic h-rate at degree 8), so
  * m = ceil((eta e^(-sigma (8 - p)) / (target / 10))^(1/9)), 2..MAX_PIECES. */
 #define MAX_PIECES 16
-#define MAX_LAYERS 12 /* geometric layers added towards a singular end in one round */
 static int smooth_pieces(int p, double eta, double sigma, double target) {
   double r = eta * exp(-sigma * (CV_MAX_DEGREE - p)) / (0.1 * target);
   double m = ceil(pow(r, 1.0 / (CV_MAX_DEGREE + 1)));
@@ -113,8 +112,8 @@ static int merged_degree(const cv_disc *d, const double *eta, const double *sigm
 }
 
 cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
-                       const double *where, double thresh, double target, int hp,
-                       const int *layers, int *Enew, double **t, int **deg) {
+                       const double *where, double thresh, double target, int hp, int *Enew,
+                       double **t, int **deg) {
   int E = d->E, F = 0;
   for (int e = 0; e < E; e++)
     F += cv_hp_marked(eta[e], sigma[e], thresh, target, hp) ? MAX_PIECES : 1; /* at most */
@@ -157,28 +156,15 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
                     (!(e == E - 1 && d->sing_b) && where[e] < -0.5 && sigma[e] < SMOOTH_RATE);
     int sing_right = (e == E - 1 && d->sing_b) ||
                      (!(e == 0 && d->sing_a) && where[e] > 0.5 && sigma[e] < SMOOTH_RATE);
-    /* HP-5: layers towards a singular end the element touches (1 elsewhere) */
-    int nl = layers && e == 0 && d->sing_a     ? layers[0]
-             : layers && e == E - 1 && d->sing_b ? layers[1]
-                                                  : 1;
-    nl = nl < 1 ? 1 : nl > MAX_LAYERS ? MAX_LAYERS : nl;
-    if (sing_left && !sing_right) { /* small element at x0 keeps p, the next p + 1, ... */
+    if (sing_left && !sing_right) { /* small element at x0 keeps p, the rest p + 1 (HP-5) */
       (*deg)[k++] = pe;
-      for (int j = nl; j >= 1; j--) {
-        double tj = split_at(x0, x1, x0 + pow(GEOM_RATIO, j) * (x1 - x0), a, L);
-        if (tj < 0 || tj <= (*t)[k - 1]) continue; /* round-off: fewer layers */
-        (*t)[k] = tj;
-        (*deg)[k++] = clamp_deg(pe + 1 + nl - j);
-      }
+      (*t)[k] = tl;
+      (*deg)[k++] = clamp_deg(pe + 1);
       continue;
     }
     if (sing_right && !sing_left) {
-      for (int j = 1; j <= nl; j++) {
-        double tj = split_at(x0, x1, x1 - pow(GEOM_RATIO, j) * (x1 - x0), a, L);
-        if (tj < 0 || tj <= (*t)[k]) continue;
-        (*deg)[k++] = clamp_deg(pe + 1 + nl - j);
-        (*t)[k] = tj;
-      }
+      (*deg)[k++] = clamp_deg(pe + 1);
+      (*t)[k] = tr;
       (*deg)[k++] = pe;
       continue;
     }

@@ -321,12 +321,11 @@ cv_status cv_estimate_pilot(const cv_solver *s, double *tail, double *sigma);
 /* HP-4, HP-5: the next mesh (on [0, 1], *t with *Enew + 1 entries, *deg with *Enew) from
  * d with the elements cv_hp_marked refined (hp = 0: bisected at their degree; hp = 2: hp
  * and smooth neighbours may be merged, HP-8); target:
- * the tolerance, for the degree a smooth element is raised to; layers (NULL: 1, 1): the
- * geometric layers to add in the element touching a singular end a, b. */
+ * the tolerance, for the degree a smooth element is raised to. */
 int cv_hp_marked(double eta, double sigma, double thresh, double target, int hp);
 cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
-                       const double *where, double thresh, double target, int hp,
-                       const int *layers, int *Enew, double **t, int **deg);
+                       const double *where, double thresh, double target, int hp, int *Enew,
+                       double **t, int **deg);
 double cv_now(void);
 
 cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y);
