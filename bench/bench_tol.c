@@ -3,7 +3,9 @@
  * fastest of repeats filling 50 ms), nodes, rounds, the estimate and the true error, and, in
  * the same run, the time of one solve on the best hand-picked mesh of docs/performance.md
  * for that accuracy (the baseline), with the ratio; then the brachistochrone's action error
- * against sqrt(nodes) as the tolerance falls (HP-5: exp(-b sqrt(N))).
+ * against sqrt(nodes) as the tolerance falls (HP-5: exp(-b sqrt(N))). The brachistochrone
+ * runs twice: from --tol's own start, and from the example scene's [mesh] (100 graded
+ * elements of degree 4) as the start.
  * Usage: bench_tol [scene_dir (default: the tests' copy of the reference problems)]
  * SPDX-License-Identifier: MIT */
 #include <math.h>
@@ -14,6 +16,9 @@
 #include "calcvar.h"
 #include "scene/scene.h"
 
+#ifndef CV_EXAMPLES_DIR
+#define CV_EXAMPLES_DIR "examples/scenes"
+#endif
 #ifndef CV_SCENE_DIR
 #define CV_SCENE_DIR "tests/scene/data"
 #endif
@@ -22,17 +27,19 @@ typedef struct {
   const char *scene, *set; /* set: one name=value override or NULL */
   double tol;
   int elements, degree; /* the hand-picked baseline mesh (0: none) */
+  int own_mesh;         /* 1: the scene in examples/scenes, its own [mesh] as the start */
 } bench_case;
 
 static const bench_case cases[] = {
-    {"brachistochrone.scene", NULL, 1e-10, 0, 0},
-    {"boundary_layer.scene", "eps=1e-8", 1e-9, 0, 0},
-    {"boundary_layer.scene", "eps=1e-8", 2e-8, 0, 0},
-    {"catenary.scene", NULL, 1e-12, 2, 8},
-    {"fisheye_ray.scene", NULL, 1e-12, 3, 8},
-    {"harmonic_saddle.scene", NULL, 1e-12, 5, 8},
-    {"boundary_layer.scene", NULL, 1e-12, 98, 8},
-    {"sphere_geodesic.scene", NULL, 1e-12, 5, 8},
+    {"brachistochrone.scene", NULL, 1e-10, 0, 0, 0},
+    {"brachistochrone.scene", NULL, 1e-10, 0, 0, 1},
+    {"boundary_layer.scene", "eps=1e-8", 1e-9, 0, 0, 0},
+    {"boundary_layer.scene", "eps=1e-8", 2e-8, 0, 0, 0},
+    {"catenary.scene", NULL, 1e-12, 2, 8, 0},
+    {"fisheye_ray.scene", NULL, 1e-12, 3, 8, 0},
+    {"harmonic_saddle.scene", NULL, 1e-12, 5, 8, 0},
+    {"boundary_layer.scene", NULL, 1e-12, 98, 8, 0},
+    {"sphere_geodesic.scene", NULL, 1e-12, 5, 8, 0},
 };
 
 typedef struct {
@@ -43,15 +50,16 @@ typedef struct {
 
 /* One timed solve of scene s (tol > 0: --tol from the CLI's start; else the given mesh),
  * the fastest of repeats filling 50 ms; errors against [exact] from the last one. */
-static int run(scene *s, const cv_problem *p, double tol, int elements, int degree,
+static int run(scene *s, const cv_problem *p, double tol, int elements, int degree, int own,
                bench_result *r) {
+  int E0 = s->elements, P0 = s->degree; /* the scene's own mesh */
   double best = INFINITY, total = 0.0;
   char err[SC_ERRLEN];
   for (int rep = 0; rep < 200 && (rep < 3 || total < 0.05); rep++) {
     cv_solver *sv = cv_solver_new(NULL);
     s->tol = tol;
-    s->elements = tol > 0 ? SCENE_TOL_START_ELEMENTS : elements;
-    s->degree = tol > 0 ? SCENE_TOL_START_DEGREE : degree;
+    s->elements = own ? E0 : tol > 0 ? SCENE_TOL_START_ELEMENTS : elements;
+    s->degree = own ? P0 : tol > 0 ? SCENE_TOL_START_DEGREE : degree;
     if (!sv || scene_solver_configure(s, sv, err, sizeof err) != CVAR_OK) {
       fprintf(stderr, "%s\n", err);
       cv_solver_free(sv);
@@ -100,7 +108,7 @@ int main(int argc, char **argv) {
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     const bench_case *bc = &cases[c];
     char path[1024], err[SC_ERRLEN], nm[64] = "", val[64] = "";
-    snprintf(path, sizeof path, "%s/%s", dir, bc->scene);
+    snprintf(path, sizeof path, "%s/%s", bc->own_mesh ? CV_EXAMPLES_DIR : dir, bc->scene);
     sc_set set = {nm, val};
     if (bc->set) {
       const char *eq = strchr(bc->set, '=');
@@ -116,8 +124,8 @@ int main(int argc, char **argv) {
     }
     bench_result a, b = {0};
     b.t = b.err = NAN;
-    if (run(s, p, bc->tol, 0, 0, &a) < 0 ||
-        (bc->elements && run(s, p, 0, bc->elements, bc->degree, &b) < 0)) {
+    if (run(s, p, bc->tol, 0, 0, bc->own_mesh, &a) < 0 ||
+        (bc->elements && run(s, p, 0, bc->elements, bc->degree, 0, &b) < 0)) {
       cv_problem_free(p);
       scene_free(s);
       return 1;
@@ -125,7 +133,7 @@ int main(int argc, char **argv) {
     char hand[16] = "-";
     if (bc->elements) snprintf(hand, sizeof hand, "%dx p%d", bc->elements, bc->degree);
     printf("%-22s %-9s %7.0e %-9s %6d %6d %9.2e %9.2e %9.2e %9.2e | %-10s %9.2e %9.2e %6.1f\n",
-           bc->scene, bc->set ? bc->set : "-", bc->tol,
+           bc->scene, bc->own_mesh ? "own mesh" : bc->set ? bc->set : "-", bc->tol,
            a.st == CVAR_OK ? "converged" : cv_status_name(a.st) + 5, a.nodes, a.rounds, a.est,
            a.err, a.errA, a.t, hand, b.t, b.err, bc->elements ? a.t / b.t : NAN);
     cv_problem_free(p);
@@ -148,7 +156,7 @@ int main(int argc, char **argv) {
   int m = 0;
   for (double T = 1e-3; T >= 0.99e-12; T /= 10) {
     bench_result a;
-    if (run(s, p, T, 0, 0, &a) < 0) break;
+    if (run(s, p, T, 0, 0, 0, &a) < 0) break;
     double r = sqrt((double)a.nodes), e = fmax(a.errA, 1e-16);
     printf("%8.0e %6d %10.2f %10.2e\n", T, a.nodes, r, a.errA);
     if (a.errA > 1e-14) { /* above round-off */

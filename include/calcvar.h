@@ -405,6 +405,13 @@ CVAR_API cv_status cv_solver_set_adapt(cv_solver *s, double tol, int max_element
  * mesh is the one set by the other setters. Cannot be combined with cv_solver_set_adapt
  * (the last one set wins). */
 CVAR_API cv_status cv_solver_set_tol(cv_solver *s, double tol, int max_nodes);
+/** A cap on the wall-clock time of the rounds of cv_solver_set_tol or cv_solver_set_adapt
+ * (theory HP-6): when a round ends after `seconds` (> 0) since cv_solve began without the
+ * estimate reaching tol, the rounds stop with CVAR_EMAXITER and a sentence naming the cap and
+ * the estimate reached; the results are those of the last round. The round under way is
+ * finished (and estimated), so a run may exceed the cap by one round. 0 turns it off
+ * (default). Plain solves on a fixed mesh are not capped. */
+CVAR_API cv_status cv_solver_set_time_limit(cv_solver *s, double seconds);
 /** Estimated max nodal error of the last adaptive or --tol solve (NaN otherwise). */
 CVAR_API double cv_solver_get_error_estimate(const cv_solver *s);
 /** A-posteriori estimate of the max nodal error of the last (converged) solve on its own

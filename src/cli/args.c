@@ -76,7 +76,7 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o) {
         "--elements", "--degree", "--method", "--tolerance", "--max-iterations",
         "--set",      "--adapt",  "--tol",    "--continue",  "--json",
         "--csv",      "--plot",   "--max",    "--work",      "--max-elements",
-        NULL};
+        "--time-limit", NULL};
     int known = flag;
     for (int k = 0; valued[k]; k++) known |= strcmp(name, valued[k]) == 0;
     if (!known) return bad(cmd, "unknown option '%s' (see calcvar --help)", name);
@@ -136,6 +136,9 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o) {
     } else if (strcmp(name, "--adapt") == 0) {
       if (parse_pos_double(v, &o->adapt) < 0)
         return bad(cmd, "--adapt needs a target error > 0, got '%s'", v);
+    } else if (strcmp(name, "--time-limit") == 0) {
+      if (parse_pos_double(v, &o->time_limit) < 0 || o->time_limit > 1e9)
+        return bad(cmd, "--time-limit needs a number of seconds > 0 (at most 1e9), got '%s'", v);
     } else if (strcmp(name, "--tol") == 0) {
       if (parse_pos_double(v, &o->tol) < 0)
         return bad(cmd, "--tol needs a target max nodal error > 0, got '%s'", v);
@@ -215,6 +218,14 @@ int cli_apply_accuracy(const cli_opts *o, scene *s) {
   }
   if (o->adapt > 0) s->adapt = o->adapt;
   double tol = o->tol > 0 ? o->tol : s->tol;
+  if (o->time_limit > 0) {
+    if (!(tol > 0 || s->adapt > 0)) {
+      fprintf(stderr, "calcvar: --time-limit caps the rounds of automatic accuracy only (--tol "
+                      "T, --adapt TOL, or [mesh] tol / adapt in the scene)\n");
+      return EXIT_BADINPUT;
+    }
+    s->time_limit = o->time_limit;
+  }
   if (tol > 0) { /* automatic accuracy: the scene's or the flags' mesh is only the start */
     s->tol = tol;
     if (!o->elements && !s->elements_line && s->grading <= 0)
@@ -233,7 +244,7 @@ void cli_apply_solver_options(const cli_opts *o, scene *s) {
 int cli_only_scene_options(const char *cmd, const cli_opts *o) {
   if (o->csv || o->plot || o->adapt > 0 || o->tol > 0 || o->cont || o->elements || o->degree ||
       o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all || o->max_elements ||
-      o->verbose) {
+      o->verbose || o->time_limit > 0) {
     fprintf(stderr, "calcvar %s: only --set, --json and --quiet apply to %s\n", cmd, cmd);
     return EXIT_BADINPUT;
   }

@@ -248,6 +248,7 @@ int cli_converge(int argc, char **argv) {
                         : o.tol > 0      ? "--tol"
                         : o.cont         ? "--continue"
                         : o.max_elements ? "--max-elements"
+                        : o.time_limit > 0 ? "--time-limit"
                                          : NULL;
   if (notmine) {
     rc = bad("%s is an option of solve, not of converge", notmine);

@@ -269,6 +269,7 @@ struct cv_solver {
   double t_assemble, t_factor; /* seconds in assembly / LDL^T (bench/; from 512 unknowns) */
   double adapt_tol, err_est;   /* adaptive refinement (cv_adapt.c) */
   int adapt_max, rounds;
+  double time_limit;        /* seconds for the rounds (HP-6); 0: none */
   int hp;                   /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
   int continuation, csteps; /* automatic continuation (cv_continuation.c) */
   char note[320];           /* what the solver decided on its own, prefixed to msg */
@@ -306,12 +307,20 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
 cv_status cv_warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from);
 /* HP-2, HP-3: the estimate of s's max nodal error from a warm-started solve into f on the
  * enriched mesh (est_vertex: at the element boundaries; floor_out: its round-off part; both
- * may be NULL); with eta, sigma, where (E each, all or none) the indicators of HP-4. */
+ * may be NULL). */
 cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solver *f, double *est,
-                               double *est_vertex, double *floor_out, double *eta, double *sigma,
-                               double *where, char *msg, size_t len);
+                               double *est_vertex, double *floor_out, char *msg, size_t len);
+/* HP-4: the indicators eta, sigma, where (E entries each) of s's elements from f, the
+ * enriched solve of a successful cv_estimate_enriched. */
+cv_status cv_estimate_indicators(const cv_solver *s, const cv_solver *f, double *eta,
+                                 double *sigma, double *where);
+/* HP-7: from s's own solution, no solve: per element the decay rate sigma of its Legendre
+ * coefficients and the next coefficient it predicts, tail = |a_p| e^(-sigma) (the largest
+ * over the unknowns); a prediction to refine by, never an estimate. */
+cv_status cv_estimate_pilot(const cv_solver *s, double *tail, double *sigma);
 /* HP-4, HP-5: the next mesh (on [0, 1], *t with *Enew + 1 entries, *deg with *Enew) from
- * d with the elements cv_hp_marked refined (hp = 0: bisected at their degree); target:
+ * d with the elements cv_hp_marked refined (hp = 0: bisected at their degree; hp = 2: hp
+ * and smooth neighbours may be merged, HP-8); target:
  * the tolerance, for the degree a smooth element is raised to. */
 int cv_hp_marked(double eta, double sigma, double thresh, double target, int hp);
 cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,

@@ -139,6 +139,10 @@ cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_
     what = "tol"; /* [mesh] tol or --tol: automatic accuracy, capped at 1e6 nodes */
     st = cv_solver_set_tol(sv, s->tol, SCENE_TOL_MAX_NODES);
   }
+  if (st == CVAR_OK && s->time_limit > 0) {
+    what = "time limit"; /* --time-limit: a cap on the rounds' wall-clock time (HP-6) */
+    st = cv_solver_set_time_limit(sv, s->time_limit);
+  }
   if (st == CVAR_OK) {
     what = "method";
     st = cv_solver_set_method(sv, s->method);

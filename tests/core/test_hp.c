@@ -177,7 +177,53 @@ static void tol_rounds(void) {
   cv_problem_free(q);
 }
 
+/* 5. HP-1's degree-8 start and HP-6's time cap. A uniform start of degree 2 on the catenary
+ * (no singular end) becomes the same nodes at degree 8, which reach 1e-12 in one round.
+ * A cap of 1 ns ends the oscillator's rounds after the first: max_iterations, a sentence
+ * naming the cap, the estimate reached (finite, above the target), which is said. */
+static void start_and_time_cap(void) {
+  cv_problem *p = catenary(), *q = oscillator();
+  cv_solver *s = cv_solver_new(NULL);
+  cv_solver_set_elements(s, 10);
+  cv_solver_set_degree(s, 2);
+  cv_solver_set_tol(s, 1e-12, 100000);
+  CHECK(cv_solve(s, p) == CVAR_OK, "catenary 1e-12: %s", cv_solver_last_error(s));
+  int deg[64], E = cv_solver_get_degrees(s, NULL);
+  CHECK(E > 0 && E <= 64, "elements %d", E);
+  cv_solver_get_degrees(s, deg);
+  int all8 = 1;
+  for (int e = 0; e < E && e < 64; e++) all8 &= deg[e] == 8;
+  CHECK(cv_solver_get_adapt_rounds(s) == 1 && all8 && E == 3,
+        "degree-8 start: %d rounds, %d elements", cv_solver_get_adapt_rounds(s), E);
+  double err = max_nodal_error(s, catenary_exact);
+  CHECK(err <= 1e-11 && cv_solver_get_error_estimate(s) >= 0.1 * err, "true %.3g, estimate %.3g",
+        err, cv_solver_get_error_estimate(s));
+  /* a graded start is kept (no degree-8 start, and degree 2 gives no pilot, HP-7): the
+   * first round ends with an estimate */
+  cv_solver_set_mesh_graded(s, 10, 2.0, CVAR_GRADE_A);
+  CHECK(cv_solver_set_time_limit(s, 1e-9) == CVAR_OK, "time limit 1e-9 refused");
+  CHECK(cv_solve(s, q) == CVAR_EMAXITER, "1 ns must stop the rounds");
+  const char *m = cv_solver_last_error(s);
+  double est = cv_solver_get_error_estimate(s);
+  CHECK(strstr(m, "time limit of 1e-09 s was reached after 1 round") != NULL, "message: %s", m);
+  CHECK(cv_solver_get_adapt_rounds(s) == 1, "rounds %d", cv_solver_get_adapt_rounds(s));
+  CHECK(isfinite(est) && est > 1e-12, "estimate reached %.3g", est);
+  char want[32];
+  snprintf(want, sizeof want, "reached is %.2g", est);
+  CHECK(strstr(m, want) != NULL, "message gives the estimate: %s", m);
+  CHECK(cv_solver_set_time_limit(s, -1) == CVAR_EINVAL, "negative time limit accepted");
+  CHECK(cv_solver_set_time_limit(s, NAN) == CVAR_EINVAL, "NaN time limit accepted");
+  CHECK(cv_solver_set_time_limit(s, INFINITY) == CVAR_EINVAL, "infinite time limit accepted");
+  CHECK(cv_solver_set_time_limit(NULL, 1) == CVAR_EINVAL, "NULL solver accepted");
+  CHECK(cv_solver_set_time_limit(s, 0) == CVAR_OK, "time limit 0 (off) refused");
+  CHECK(cv_solve(s, q) == CVAR_OK, "no cap: %s", cv_solver_last_error(s));
+  cv_solver_free(s);
+  cv_problem_free(p);
+  cv_problem_free(q);
+}
+
 int main(void) {
+  start_and_time_cap();
   same_as_uniform();
   mixed_degrees();
   morse_and_no_bound();

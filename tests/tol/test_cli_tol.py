@@ -15,6 +15,8 @@
 #   >= 0.1 x the true error (it never claims to be much better than it is);
 # - where [exact] gives only the action: relative action error <= 10 T;
 # - T = 1e-17: exit 1, the round-off sentence; --tol with --adapt: exit 2;
+# - --time-limit: a tiny cap ends with exit 1, the cap and the estimate in the sentence;
+#   bad values exit 2;
 # - an estimate without a bound is said so (issue 14: a reference that converged on
 #   another stationary path), and an estimate that exists is honest against an independent
 #   fine solve.
@@ -159,6 +161,34 @@ r = run(os.path.join(problems, "catenary.scene"), "--tol", "0")
 check("--tol 0 exit 2", r.returncode == 2, r.stderr)
 r = run(os.path.join(problems, "catenary.scene"), "--tol", "1e-8", "--continue", "a=1:2")
 check("--tol with --continue exit 2", r.returncode == 2, r.stderr)
+
+# The time cap (theory HP-6): a limit far below what the brachistochrone at 1e-12 needs
+# ends the rounds after the first (each round is finished and estimated): exit 1,
+# max_iterations, a sentence naming the cap and the estimate reached, which the JSON
+# carries. A generous limit changes nothing. Bad values, and the cap without rounds: exit 2.
+brach = os.path.join(problems, "brachistochrone.scene")
+r, d = solve_json(brach, "--tol", "1e-12", "--time-limit", "1e-6")
+msg = d.get("message", "")
+check("time limit exit 1", r.returncode == 1, "%d: %s" % (r.returncode, r.stderr))
+check("time limit status", d.get("status") == "max_iterations", d.get("status"))
+check("time limit sentence", "time limit of 1e-06 s was reached after 1 round" in msg, msg)
+est = d.get("error_estimate")
+check("time limit estimate reported", isinstance(est, float) and est > 1e-12, d.keys())
+if isinstance(est, float):
+    check("time limit sentence gives the estimate", ("%.2g" % est) in msg, msg)
+r, d = solve_json(os.path.join(problems, "catenary.scene"), "--tol", "1e-8",
+                  "--time-limit", "600")
+check("generous time limit exit 0", r.returncode == 0 and d.get("status") == "converged",
+      d.get("message"))
+for v in ("0", "-1", "abc", "nan", "inf"):
+    r = run(brach, "--tol", "1e-8", "--time-limit", v)
+    check("--time-limit %s exit 2" % v, r.returncode == 2 and "--time-limit" in r.stderr,
+          r.stderr)
+r = run(brach, "--time-limit", "1")
+check("--time-limit without --tol exit 2", r.returncode == 2 and "automatic accuracy" in
+      r.stderr, r.stderr)
+r = run(brach, "--adapt", "1e-12", "--degree", "2", "--time-limit", "1e-6")
+check("--adapt time limit exit 1", r.returncode == 1 and "time limit" in r.stderr, r.stderr)
 
 # A mesh too coarse to resolve the oscillation: the enriched solve finds another Morse
 # index, and the report says there is no bound instead of giving one.
