@@ -44,6 +44,9 @@ struct cv_problem {
   void *guess_user;
   int nnotes; /* failure notes of callbacks (cv_table_internal.h) */
   cv_note_source *notes;
+  cv_smooth_fn smooth; /* jumps that can be smoothed (cv_table_internal.h, theory HC-4) */
+  void *smooth_user;
+  int nsmooth;
   int ntables; /* tables added by cv_problem_add_table, each with a reference */
   char **table_name;
   cv_table **table;
@@ -269,7 +272,7 @@ struct cv_solver {
   int adapt_max, rounds;
   int hp;                   /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
   int continuation, csteps; /* automatic continuation (cv_continuation.c) */
-  char note[320];           /* what the solver decided on its own, prefixed to msg */
+  char note[480];           /* what the solver decided on its own, prefixed to msg */
   cv_progress_fn progress;  /* cv_solver_set_progress; NULL: none */
   void *progress_user;
   int near_sing[2];         /* ends found nearly singular after a solve */

@@ -107,6 +107,112 @@ static cv_status continue_from_start(cv_solver *s, const cv_problem *p, cv_statu
   return st;
 }
 
+/* One level of the smoothing homotopy: Newton from Yc on the integrand smoothed over w.
+ * On success Yc holds the solution and *A its action. */
+static cv_status smooth_level(cv_solver *s, const cv_problem *p, double w, double *Yc, double *Yt,
+                              double *A) {
+  size_t nd = (size_t)s->disc.ndof * sizeof *Yt;
+  p->smooth(p->smooth_user, w);
+  memcpy(Yt, Yc, nd);
+  cv_status st = cv_newton_run(s, p, &s->disc, Yt, s->mult, NULL);
+  if (st == CVAR_OK) {
+    memcpy(Yc, Yt, nd);
+    *A = s->action;
+  }
+  return st;
+}
+
+/* (HC-4) Jumps of the integrand in y: the discrete action jumps when a quadrature point
+ * crosses one and its gradient never sees the interface (F_y is 0 on both sides), so Newton
+ * cannot find the minimiser. Smooth the jumps over a width w (X-6), solve from the start,
+ * and halve w with warm starts while the mesh resolves the band: there the action moves
+ * like A(w) = A(0) + C w + O(w^2), each halving by half the change of the one before.
+ * The last level whose change kept that ratio (within [0.3, 0.7]) is the answer; its
+ * action differs from the sharp problem's by about its last change (first order in w). */
+static cv_status smooth_homotopy(cv_solver *s, const cv_problem *p, cv_status first) {
+  char firstmsg[sizeof s->msg];
+  memcpy(firstmsg, s->msg, sizeof firstmsg);
+  int nd = s->disc.ndof, levels = 0, total = s->iterations, ok = 0;
+  double *Yc = cv_malloc((size_t)nd * sizeof *Yc), *Yt = cv_malloc((size_t)nd * sizeof *Yt);
+  double *Yok = cv_malloc((size_t)nd * sizeof *Yok);
+  cv_status st = Yc && Yt && Yok ? cv_start_values(s, p, &s->disc, Yc, 0) : CVAR_ENOMEM;
+  double range = 0.0, w, wok = 0.0, A = NAN, Aprev = NAN, dprev = NAN, dok = NAN;
+  int morse0 = -1;
+  if (st) goto cleanup;
+  /* the first width: half the largest spread of the start's values (1 if it is flat) */
+  for (int k = 0; k < s->n; k++) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (int j = k; j < nd; j += s->n) lo = fmin(lo, Yc[j]), hi = fmax(hi, Yc[j]);
+    range = fmax(range, hi - lo);
+  }
+  w = range > 0 ? 0.5 * range : 1.0;
+  for (levels = 0; levels < 48; levels++, w *= 0.5) {
+    st = smooth_level(s, p, w, Yc, Yt, &A);
+    total += s->iterations;
+    if (st == CVAR_ECALLBACK || st == CVAR_ENOMEM || st == CVAR_EINVAL || st == CVAR_ECANCELLED)
+      goto cleanup;
+    if (st != CVAR_OK) break;
+    if (levels == 0) morse0 = s->morse;
+    if (s->morse != morse0) break; /* an unresolved band makes spurious negative curvature */
+    double dA = Aprev - A; /* the change of this halving */
+    if (levels >= 2) {
+      double r = dA / dprev;
+      if (!(r >= 0.3 && r <= 0.7)) break; /* the band is no longer resolved */
+    }
+    if (levels >= 1) {
+      wok = w, dok = dA, ok = levels >= 2;
+      memcpy(Yok, Yc, (size_t)nd * sizeof *Yok);
+    }
+    dprev = dA;
+    Aprev = A;
+  }
+  if (!ok) {
+    st = first == CVAR_OK ? CVAR_ESTALL : first;
+    cv_set_msg(s->msg, sizeof s->msg,
+               "%s; the integrand jumps in y (%d if%s on the unknowns), and smoothing the "
+               "jumps did not help: %s after %d halvings of the width",
+               firstmsg, p->nsmooth, p->nsmooth > 1 ? "s" : "",
+               levels == 0 ? "the widest smoothing was not solved"
+                           : "the action did not change in proportion to the width",
+               levels);
+    p->smooth(p->smooth_user, 0.0);
+    goto cleanup;
+  }
+  /* one step of a factor sqrt(2) further (halving is coarse: the band is resolved down
+   * to about half an element), kept when its Morse index and its change agree */
+  double slope = dok / wok; /* C of A(w) = A(0) + C w */
+  memcpy(Yc, Yok, (size_t)nd * sizeof *Yc);
+  w = wok * 0.70710678118654752;
+  st = smooth_level(s, p, w, Yc, Yt, &A);
+  total += s->iterations;
+  if (st == CVAR_OK && s->morse == morse0) {
+    double r = (Aprev - A) / (slope * (wok - w)); /* Aprev is A(wok) */
+    if (r >= 0.6 && r <= 1.4) wok = w, memcpy(Yok, Yc, (size_t)nd * sizeof *Yok);
+  }
+  /* the accepted level once more, for its own action, Morse index and message */
+  p->smooth(p->smooth_user, wok);
+  memcpy(s->y, Yok, (size_t)nd * sizeof *Yok);
+  st = cv_newton_run(s, p, &s->disc, s->y, s->mult, NULL);
+  total += s->iterations;
+  if (st == CVAR_OK) {
+    size_t ln = strlen(s->note);
+    cv_set_msg(s->note + ln, sizeof s->note - ln,
+               "the integrand jumps in y and Newton failed on the jumps (%s), so they were "
+               "smoothed over a width w, reduced to w = %.3g, the finest the mesh resolves "
+               "(theory HC-4): this is the smoothed problem's answer, its action about %.2g "
+               "from the sharp one's (first order in w; extrapolated to w = 0: %.10g); ",
+               cv_strerror(first), wok, fabs(slope * wok), s->action - slope * wok);
+  } else {
+    p->smooth(p->smooth_user, 0.0);
+  }
+cleanup:
+  s->iterations = total;
+  cv_free(Yc);
+  cv_free(Yt);
+  cv_free(Yok);
+  return st;
+}
+
 /* Prefix the solver's own decisions (s->note) to the message. */
 static void prefix_note(cv_solver *s) {
   if (!s->note[0]) return;
@@ -153,6 +259,9 @@ static cv_status solve_once(cv_solver *s, const cv_problem *p) {
     lost = st != CVAR_OK;
   }
   if (lost && unconstrained && s->continuation) st = continue_from_start(s, p, st);
+  lost = st == CVAR_ESTALL || st == CVAR_EDIVERGED || st == CVAR_ENONFINITE ||
+         st == CVAR_ESINGULAR || (st == CVAR_EMAXITER && s->maxit >= 20);
+  if (lost && p->smooth && s->continuation) st = smooth_homotopy(s, p, st);
 done:
   return st;
 }
@@ -264,6 +373,7 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   s->err_est = NAN;
   s->rounds = 0;
   for (int k = 0; p && k < p->nnotes; k++) p->notes[k].fn(p->notes[k].user, 1);
+  if (p && p->smooth) p->smooth(p->smooth_user, 0.0); /* the integrand as written (HC-4) */
   cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
   s->status = st;
   /* A failure the integrand can explain (a table's grid left): the cause first, then what
