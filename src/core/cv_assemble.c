@@ -6,7 +6,11 @@
 #include "cv_internal.h"
 
 cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc *d) {
-  size_t n = (size_t)p->n, m = CV_BATCH;
+  /* A batch holds at most CV_BATCH points and never more than the mesh has: a small mesh's
+   * buffers then share a page or two instead of one fresh page per output (the first
+   * solve in a process pays a page fault for each, docs/performance.md). */
+  long nq = cv_disc_num_qpoints(d);
+  size_t n = (size_t)p->n, m = nq < 1 ? 1 : nq < CV_BATCH ? (size_t)nq : CV_BATCH;
   memset(as, 0, sizeof *as);
   as->prob = p;
   as->disc = d;

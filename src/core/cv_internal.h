@@ -71,6 +71,9 @@ typedef struct {
 } cv_rule;
 
 void cv_gauss_legendre(int q, double *t, double *w);
+/* The same computed (Newton on the Legendre recurrence), for the table's test. */
+void cv_gauss_legendre_compute(int q, double *t, double *w);
+void cv_gauss_lobatto_compute(int p, double *xi, double *w);
 void cv_gauss_lobatto(int p, double *xi, double *w);
 /* Lagrange basis on nodes xi[0..p] at s: phi[l] and (if dphi) phi_l'(s). */
 void cv_lagrange(int p, const double *xi, double s, double *phi, double *dphi);
