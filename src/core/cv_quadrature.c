@@ -129,6 +129,26 @@ static struct {
   cv_refelem r;
 } ref_cache[CV_MAX_DEGREE + 1][CV_MAX_QUAD + 1];
 
+/* A (p, q) other than the default: computed once per process (out of line, with its
+ * temporary, so that the default's frame stays small). */
+static __attribute__((noinline)) void refelem_other(cv_refelem *r, int p, int q) {
+  if (p < 1 || p > CV_MAX_DEGREE || q < 1 || q > CV_MAX_QUAD) {
+    refelem_compute(r, p, q);
+    return;
+  }
+  if (!atomic_load_explicit(&ref_cache[p][q].ready, memory_order_acquire)) {
+    cv_refelem tmp;
+    refelem_compute(&tmp, p, q); /* outside the lock: it takes the lock itself */
+    pthread_mutex_lock(&rule_lock);
+    if (!atomic_load_explicit(&ref_cache[p][q].ready, memory_order_relaxed)) {
+      ref_cache[p][q].r = tmp;
+      atomic_store_explicit(&ref_cache[p][q].ready, 1, memory_order_release);
+    }
+    pthread_mutex_unlock(&rule_lock);
+  }
+  *r = ref_cache[p][q].r;
+}
+
 /* Offsets of degree p's default element and end rules in cv_rules_table.h. */
 static int ref_offset(int p) {
   int o = 0;
@@ -152,21 +172,7 @@ void cv_refelem_init(cv_refelem *r, int p, int q) {
     r->qs = 2 * q + 4;
     return;
   }
-  if (p < 1 || p > CV_MAX_DEGREE || q < 1 || q > CV_MAX_QUAD) {
-    refelem_compute(r, p, q);
-    return;
-  }
-  if (!atomic_load_explicit(&ref_cache[p][q].ready, memory_order_acquire)) {
-    cv_refelem tmp;
-    refelem_compute(&tmp, p, q); /* outside the lock: it takes the lock itself */
-    pthread_mutex_lock(&rule_lock);
-    if (!atomic_load_explicit(&ref_cache[p][q].ready, memory_order_relaxed)) {
-      ref_cache[p][q].r = tmp;
-      atomic_store_explicit(&ref_cache[p][q].ready, 1, memory_order_release);
-    }
-    pthread_mutex_unlock(&rule_lock);
-  }
-  *r = ref_cache[p][q].r;
+  refelem_other(r, p, q);
 }
 
 /* The singular-end rule (Q-2) on the element touching an end, in reference coordinates:
@@ -179,14 +185,8 @@ static struct {
   double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
 } end_cache[2][CV_MAX_DEGREE + 1][CV_MAX_QUAD + 1];
 
-cv_rule cv_end_rule(int p, int qs, int end) {
-  end = end != 0;
-  if (qs == 2 * (p + 1) + 4) { /* the default element's: constants */
-    int o, ot;
-    end_offsets(p, &o, &ot);
-    return end ? (cv_rule){qs, end1_t + o, end1_w + o, end1_B + ot, end1_D + ot}
-               : (cv_rule){qs, end0_t + o, end0_w + o, end0_B + ot, end0_D + ot};
-  }
+/* An end rule other than the default element's: computed once per process (out of line). */
+static __attribute__((noinline)) void end_rule_compute(int p, int qs, int end) {
   if (!atomic_load_explicit(&end_cache[end][p][qs].ready, memory_order_acquire)) {
     double t[CV_MAX_QUAD], w[CV_MAX_QUAD], xi[CV_MAX_DEGREE + 1], wl[CV_MAX_DEGREE + 1];
     cv_gauss_legendre(qs, t, w);
@@ -204,6 +204,17 @@ cv_rule cv_end_rule(int p, int qs, int end) {
     }
     pthread_mutex_unlock(&rule_lock);
   }
+}
+
+cv_rule cv_end_rule(int p, int qs, int end) {
+  end = end != 0;
+  if (qs == 2 * (p + 1) + 4) { /* the default element's: constants */
+    int o, ot;
+    end_offsets(p, &o, &ot);
+    return end ? (cv_rule){qs, end1_t + o, end1_w + o, end1_B + ot, end1_D + ot}
+               : (cv_rule){qs, end0_t + o, end0_w + o, end0_B + ot, end0_D + ot};
+  }
+  end_rule_compute(p, qs, end);
   return (cv_rule){qs, end_cache[end][p][qs].tau, end_cache[end][p][qs].om, end_cache[end][p][qs].B,
                    end_cache[end][p][qs].D};
 }

@@ -62,7 +62,7 @@ static cv_status grade_singular_ends(cv_solver *s, const cv_problem *p) {
  * where the Hessian is indefinite, docs/faq.md): one Newton run, cheaper than the
  * continuation. Returns CVAR_OK when it converged (the note says so); otherwise the
  * first attempt's results are restored and what continues is that attempt. */
-static cv_status retry_straight_line(cv_solver *s, const cv_problem *p, cv_status first) {
+static __attribute__((noinline, cold)) cv_status retry_straight_line(cv_solver *s, const cv_problem *p, cv_status first) {
   cv_status st = first;
   double *Y1 = cv_malloc((size_t)s->disc.ndof * sizeof *Y1);
   if (Y1 && !cv_start_values(s, p, &s->disc, Y1, 1)) {
@@ -93,7 +93,7 @@ static cv_status retry_straight_line(cv_solver *s, const cv_problem *p, cv_statu
 }
 
 /* Continuation from the start, computed again (theory HC-2). */
-static cv_status continue_from_start(cv_solver *s, const cv_problem *p, cv_status first) {
+static __attribute__((noinline, cold)) cv_status continue_from_start(cv_solver *s, const cv_problem *p, cv_status first) {
   cv_status st = first;
   double *Y0 = cv_malloc((size_t)s->disc.ndof * sizeof *Y0);
   char keep[sizeof s->msg];
@@ -129,7 +129,7 @@ static cv_status smooth_level(cv_solver *s, const cv_problem *p, double w, doubl
  * like A(w) = A(0) + C w + O(w^2), each halving by half the change of the one before.
  * The last level whose change kept that ratio (within [0.3, 0.7]) is the answer; its
  * action differs from the sharp problem's by about its last change (first order in w). */
-static cv_status smooth_homotopy(cv_solver *s, const cv_problem *p, cv_status first) {
+static __attribute__((noinline, cold)) cv_status smooth_homotopy(cv_solver *s, const cv_problem *p, cv_status first) {
   char firstmsg[sizeof s->msg];
   memcpy(firstmsg, s->msg, sizeof firstmsg);
   int nd = s->disc.ndof, levels = 0, total = s->iterations, ok = 0;
@@ -214,8 +214,7 @@ cleanup:
 }
 
 /* Prefix the solver's own decisions (s->note) to the message. */
-static void prefix_note(cv_solver *s) {
-  if (!s->note[0]) return;
+static __attribute__((noinline)) void prefix_note(cv_solver *s) {
   char m[sizeof s->msg];
   size_t ln = strlen(s->note), lm = strlen(s->msg);
   if (ln + lm >= sizeof m) lm = sizeof m - 1 - ln;
@@ -291,6 +290,73 @@ static int twice_agrees(const cv_solver *s, const cv_problem *p, double *dev) {
   return ok;
 }
 
+/* The graded retry (HC-3) after Newton and continuation both failed on a uniform mesh;
+ * out of line, with its message buffers, so that the frames of a plain solve stay small
+ * (the first solve in a process pays a page fault per fresh stack page). */
+static __attribute__((noinline, cold)) cv_status graded_retry(cv_solver *s, const cv_problem *p,
+                                                               cv_status st) {
+  char first[sizeof s->msg];
+  memcpy(first, s->msg, sizeof first);
+  s->near_sing[0] = s->near_sing[1] = 1;
+  cv_status st2 = solve_once(s, p);
+  s->near_sing[0] = s->near_sing[1] = 0;
+  double dev = 0.0;
+  if (st2 == CVAR_OK && !twice_agrees(s, p, &dev)) {
+    st2 = CVAR_ESTALL;
+    if (isfinite(dev))
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "a stationary path of this mesh was found, but twice the elements moved its "
+                 "action by %.1e of itself: it is an artefact of the mesh, not a solution",
+                 dev);
+    else
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "a stationary path of this mesh was found, but none on twice the elements: "
+                 "it is an artefact of the mesh, not a solution");
+  }
+  if (st2 == CVAR_OK) {
+    char keep[sizeof s->note];
+    memcpy(keep, s->note, sizeof keep);
+    cv_set_msg(s->note, sizeof s->note,
+               "on the uniform mesh Newton and continuation failed (%s), so both ends were "
+               "integrated as singular; %s",
+               cv_strerror(st), keep);
+    st = CVAR_OK;
+  } else {
+    /* both attempts failed: say what was tried, with the first attempt's detail */
+    char second[sizeof s->msg];
+    memcpy(second, s->msg, sizeof second);
+    s->note[0] = '\0';
+    cv_set_msg(s->msg, sizeof s->msg,
+               "%s; with the mesh graded towards both ends and both integrated as singular: "
+               "%s",
+               first, second);
+    st = st2;
+  }
+  return st;
+}
+
+/* A converged solve whose end element under-integrates (Q-3): once more with that end
+ * integrated as singular. Out of line, like graded_retry. */
+static __attribute__((noinline, cold)) cv_status resolve_singular_ends(cv_solver *s,
+                                                                        const cv_problem *p,
+                                                                        const int un[2],
+                                                                        const double rel[2]) {
+  cv_status st;
+  s->near_sing[0] = un[0], s->near_sing[1] = un[1];
+  st = solve_once(s, p);
+  char first[sizeof s->note];
+  memcpy(first, s->note, sizeof first);
+  cv_set_msg(s->note, sizeof s->note,
+             "the integrand is nearly singular at %s (the singular-end rule changed the "
+             "action by %.1e of itself there), so it is integrated as singular; %s",
+             un[0] && un[1] ? "both ends"
+             : un[0]        ? "the start"
+                            : "the end",
+             fmax(rel[0], rel[1]), first);
+  s->near_sing[0] = s->near_sing[1] = 0;
+  return st;
+}
+
 /* One solve on the mesh of s->mesh (no adaptation). A converged solve whose end element
  * under-integrates a nearly singular integrand (theory Q-3) is solved again with that end
  * treated as singular (Q-2 rule, and grading on a uniform mesh, M-2). */
@@ -305,64 +371,22 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
    * slope 100, which the uniform mesh does not resolve). */
   if ((st == CVAR_ESTALL || st == CVAR_EDIVERGED || st == CVAR_EMAXITER) &&
       s->method == CVAR_METHOD_NEWTON && s->mesh.kind == CV_MESH_UNIFORM && !s->start && s->have &&
-      !s->disc.sing_a && !s->disc.sing_b && s->maxit >= 20) {
-    char first[sizeof s->msg];
-    memcpy(first, s->msg, sizeof first);
-    s->near_sing[0] = s->near_sing[1] = 1;
-    cv_status st2 = solve_once(s, p);
-    s->near_sing[0] = s->near_sing[1] = 0;
-    double dev = 0.0;
-    if (st2 == CVAR_OK && !twice_agrees(s, p, &dev)) {
-      st2 = CVAR_ESTALL;
-      if (isfinite(dev))
-        cv_set_msg(s->msg, sizeof s->msg,
-                   "a stationary path of this mesh was found, but twice the elements moved its "
-                   "action by %.1e of itself: it is an artefact of the mesh, not a solution",
-                   dev);
-      else
-        cv_set_msg(s->msg, sizeof s->msg,
-                   "a stationary path of this mesh was found, but none on twice the elements: "
-                   "it is an artefact of the mesh, not a solution");
-    }
-    if (st2 == CVAR_OK) {
-      char keep[sizeof s->note];
-      memcpy(keep, s->note, sizeof keep);
-      cv_set_msg(s->note, sizeof s->note,
-                 "on the uniform mesh Newton and continuation failed (%s), so both ends were "
-                 "integrated as singular; %s",
-                 cv_strerror(st), keep);
-      st = CVAR_OK;
-    } else {
-      /* both attempts failed: say what was tried, with the first attempt's detail */
-      char second[sizeof s->msg];
-      memcpy(second, s->msg, sizeof second);
-      s->note[0] = '\0';
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "%s; with the mesh graded towards both ends and both integrated as singular: "
-                 "%s",
-                 first, second);
-      st = st2;
-    }
-  }
+      !s->disc.sing_a && !s->disc.sing_b && s->maxit >= 20)
+    st = graded_retry(s, p, st);
   for (int end = 0; end < 2 && st == CVAR_OK; end++)
     un[end] = cv_start_end_unresolved(p, &s->disc, s->y, end, s->action, &rel[end]);
-  if (un[0] || un[1]) {
-    s->near_sing[0] = un[0], s->near_sing[1] = un[1];
-    st = solve_once(s, p);
-    char first[sizeof s->note];
-    memcpy(first, s->note, sizeof first);
-    cv_set_msg(s->note, sizeof s->note,
-               "the integrand is nearly singular at %s (the singular-end rule changed the "
-               "action by %.1e of itself there), so it is integrated as singular; %s",
-               un[0] && un[1] ? "both ends"
-               : un[0]        ? "the start"
-                              : "the end",
-               fmax(rel[0], rel[1]), first);
-    s->near_sing[0] = s->near_sing[1] = 0;
-  }
-  prefix_note(s);
+  if (un[0] || un[1]) st = resolve_singular_ends(s, p, un, rel);
+  if (s->note[0]) prefix_note(s);
   s->status = st;
   return st;
+}
+
+/* The integrand's own explanation of a failure before the engine's (out of line). */
+static __attribute__((noinline, cold)) void prefix_failure_note(cv_solver *s, const char *note) {
+  char m[2 * sizeof s->msg];
+  snprintf(m, sizeof m, "%s%s%s", note, s->msg[0] ? "; " : "", s->msg);
+  memcpy(s->msg, m, sizeof s->msg - 1); /* truncated to the message buffer */
+  s->msg[sizeof s->msg - 1] = '\0';
 }
 
 cv_status cv_solve(cv_solver *s, const cv_problem *p) {
@@ -381,12 +405,7 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   const char *note = NULL;
   for (int k = 0; st != CVAR_OK && p && k < p->nnotes && !(note && note[0]); k++)
     note = p->notes[k].fn(p->notes[k].user, 0);
-  if (note && note[0]) {
-    char m[2 * sizeof s->msg];
-    snprintf(m, sizeof m, "%s%s%s", note, s->msg[0] ? "; " : "", s->msg);
-    memcpy(s->msg, m, sizeof s->msg - 1); /* truncated to the message buffer */
-    s->msg[sizeof s->msg - 1] = '\0';
-  }
+  if (note && note[0]) prefix_failure_note(s, note);
   s->time = cv_now() - t0;
   return st;
 }
