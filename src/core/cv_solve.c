@@ -225,7 +225,7 @@ static __attribute__((noinline)) void prefix_note(cv_solver *s) {
 }
 
 /* One solve on the mesh of s->mesh, with the singular ends known so far. */
-static cv_status solve_once(cv_solver *s, const cv_problem *p) {
+CV_HOT static cv_status solve_once(cv_solver *s, const cv_problem *p) {
   cv_status st;
   results_reset(s);
   if (!p || !p->F) {
@@ -389,7 +389,7 @@ static __attribute__((noinline, cold)) void prefix_failure_note(cv_solver *s, co
   s->msg[sizeof s->msg - 1] = '\0';
 }
 
-cv_status cv_solve(cv_solver *s, const cv_problem *p) {
+CV_HOT cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   if (!s) return CVAR_EINVAL;
   double t0 = cv_now();
   cv_pathset_free(s->paths); /* a plain solve forgets the paths of cv_solve_all */

@@ -159,7 +159,7 @@ cv_status cv_start_setup(cv_solver *s, const cv_problem *p) {
 
 /* The discrete integral of F over element e with rule r (reference points, weights and
  * basis tables). buf: q (2 n + 2) doubles. Returns 0 when F fails or is not finite. */
-static int element_integral(const cv_problem *p, const cv_disc *d, const double *Y, long e,
+CV_HOT static int element_integral(const cv_problem *p, const cv_disc *d, const double *Y, long e,
                             const cv_rule *r, double *buf, double *S) {
   int n = p->n, P1 = cv_disc_edeg(d, e) + 1, q = r->q;
   double x0 = d->xe[e], h = d->xe[e + 1] - x0, *x = buf, *y = x + q, *dy = y + (size_t)n * q;
@@ -189,7 +189,7 @@ static int element_integral(const cv_problem *p, const cv_disc *d, const double 
  * element e (Q-2: x = c +- u^2, qs Gauss points in u); INFINITY if F fails. *own: the
  * element's integral under its own rule. */
 /* The gap of element e between its own rule and r1 (see rule_gap). */
-static double gap_with(const cv_problem *p, const cv_disc *d, const double *Y, long e,
+CV_HOT static double gap_with(const cv_problem *p, const cv_disc *d, const double *Y, long e,
                        const cv_rule *r1, double *buf, double *own) {
   double S0, S1;
   cv_rule r0 = cv_disc_rule(d, e);
@@ -224,7 +224,7 @@ static __attribute__((noinline, cold)) double gap_inner(const cv_problem *p, con
 /* |integral under the element's own rule - under the singular-end rule at the end| over
  * element e (Q-2: x = c +- u^2, qs Gauss points in u); INFINITY if F fails. *own: the
  * element's integral under its own rule. */
-static double rule_gap(const cv_problem *p, const cv_disc *d, const double *Y, long e, int end,
+CV_HOT static double rule_gap(const cv_problem *p, const cv_disc *d, const double *Y, long e, int end,
                        double *buf, double *own) {
   if (e != (end ? d->E - 1 : 0)) return gap_inner(p, d, Y, e, end, buf, own);
   const cv_refelem *re = cv_disc_eref(d, e);
