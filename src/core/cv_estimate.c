@@ -186,6 +186,14 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
   *est = NAN;
   if (est_vertex) *est_vertex = NAN;
   if (floor_out) *floor_out = NAN;
+  if (s->smooth_w > 0) { /* HC-4: an enriched solve would miss the smoothing's own error */
+    cv_free(t), cv_free(deg);
+    cv_set_msg(msg, len,
+               "the answer is of the integrand with its jumps smoothed over w = %.3g, whose "
+               "error (first order in w) a solve with higher degrees cannot measure",
+               s->smooth_w);
+    return CVAR_ESTATE;
+  }
   f->nq = 0;
   f->rtol = s->rtol;
   f->atol = s->atol;

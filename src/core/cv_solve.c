@@ -24,6 +24,7 @@ static void results_reset(cv_solver *s) {
   s->action = s->gnorm = NAN;
   s->t_assemble = s->t_factor = 0.0;
   s->csteps = 0;
+  s->smooth_w = 0.0;
   s->note[0] = '\0';
 }
 
@@ -196,6 +197,7 @@ static __attribute__((noinline, cold)) cv_status smooth_homotopy(cv_solver *s, c
   total += s->iterations;
   if (st == CVAR_OK) {
     size_t ln = strlen(s->note);
+    s->smooth_w = wok;
     cv_set_msg(s->note + ln, sizeof s->note - ln,
                "the integrand jumps in y and Newton failed on the jumps (%s), so they were "
                "smoothed over a width w, reduced to w = %.3g, the finest the mesh resolves "

@@ -93,6 +93,12 @@ static int solve(int E, int p, double c, double A, double *ey, double *eA, doubl
         p, cv_solver_get_morse_index(s));
   CHECK(strstr(msg, "smoothed") != NULL, "E=%d p=%d: the message does not say it smoothed: %s", E,
         p, msg);
+  /* no error estimate: an enriched solve cannot see the smoothing's error (HC-4) */
+  double est = 0.0;
+  char why[400] = "";
+  cv_status se = cv_solver_estimate_error(s, pr, &est, NULL, why, sizeof why);
+  CHECK(se != CVAR_OK && strstr(why, "smoothed") != NULL,
+        "E=%d p=%d: an error estimate (%s, %g) for the smoothed answer", E, p, cv_status_name(se), est);
   int nn = cv_solver_get_num_nodes(s);
   double *x = malloc((size_t)nn * sizeof *x), *y = malloc((size_t)nn * sizeof *y);
   if (x && y && cv_solver_get_nodes(s, x) == CVAR_OK && cv_solver_get_values(s, y) == CVAR_OK) {
