@@ -2,7 +2,8 @@
  * element degree (issue 6); optional work-precision pictures with solve_bvp's points.
  * SPDX-License-Identifier: MIT
  *
- * usage: work_precision [--quick] [--json FILE] [--bvp FILE] [--svg-dir DIR] [SCENE_DIR]
+ * usage: work_precision [--quick] [--no-tol] [--json FILE] [--bvp FILE] [--svg-dir DIR]
+ *                       [SCENE_DIR]
  *
  * For catenary, fisheye_ray, harmonic_saddle, boundary_layer (eps = 1e-2) and
  * sphere_geodesic (the scenes of tests/scene/data, with their [exact]) and degrees 1, 2, 4,
@@ -17,6 +18,14 @@
  * Error: max over nodes and unknowns of |y_h - y_exact| (the contract's error.max_nodal).
  * For each target 1e-4, 1e-6, 1e-8, 1e-10, 1e-12 the table gives the least time over the
  * meshes whose error is at or below it.
+ *
+ * --tol (unless --no-tol): the same problems solved with automatic accuracy, no mesh chosen
+ * by hand — the scene configured as `calcvar solve SCENE --tol T` does (start: 4 elements of
+ * degree 4, cap 10^6 nodes) — for T = 10^-2, 10^-2.5, ..., 10^-13 (solve_bvp's tolerances in
+ * work_precision.py), each timed as above (fresh solver, fastest of repeats) with the true
+ * max nodal error of the first; an unconverged --tol (exit 1: round-off floor or a cap) is
+ * listed with its status and error but left out of the picture. The sweep stops after a
+ * solve that took over 1 s.
  *
  * --json FILE writes every measured point; --bvp FILE reads solve_bvp's points
  * ({"problem": [[error, time_s], ...]}, written by work_precision.py) and --svg-dir DIR then
@@ -43,9 +52,12 @@ static const int degrees[NDEG] = {1, 2, 4, 8};
 static const double targets[NTARGET] = {1e-4, 1e-6, 1e-8, 1e-10, 1e-12};
 
 typedef struct {
-  int elements;
+  int elements, nodes;
   double err, time;
+  double tol; /* --tol's requested T (0: a mesh chosen by hand) */
+  cv_status st;
 } point;
+enum { NTOL = 23 }; /* T = 10^(-k/2), k = 4 .. 26 */
 
 static double now(void) {
   struct timespec ts;
@@ -53,11 +65,15 @@ static double now(void) {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-/* One mesh: fastest of repeated fresh solves, and the max nodal error of the last. */
-static int measure(const scene *s, const cv_problem *p, point *pt, double budget) {
+/* One mesh (or one --tol solve): fastest of repeated fresh solves, and the max nodal error
+ * of the first. A solve that does not converge is -1, unless any_status (--tol: its status,
+ * time and error are kept when it ended with a mesh). */
+static int measure(const scene *s, const cv_problem *p, point *pt, double budget, int any_status) {
   double best = INFINITY, spent = 0;
   int reps = 0;
   pt->err = NAN;
+  pt->nodes = 0;
+  pt->st = CVAR_OK;
   char err[SC_ERRLEN];
   while (reps < 200 && (reps == 0 || spent < budget)) {
     double t0 = now();
@@ -68,12 +84,14 @@ static int measure(const scene *s, const cv_problem *p, point *pt, double budget
     }
     cv_status st = cv_solve(sv, p);
     int nn = cv_solver_get_num_nodes(sv), n = s->n;
-    double *x = NULL, *y = NULL, *ex = NULL;
-    if (st == CVAR_OK && reps == 0) { /* the error (outside the timed part) */
+    int keep = st == CVAR_OK || (any_status && nn > 0);
+    if (keep && reps == 0) { /* the error (outside the timed part) */
       double t1 = now();
-      x = malloc((size_t)nn * sizeof *x);
-      y = malloc((size_t)nn * n * sizeof *y);
-      ex = malloc((size_t)nn * n * sizeof *ex);
+      double *x = malloc((size_t)nn * sizeof *x);
+      double *y = malloc((size_t)nn * n * sizeof *y);
+      double *ex = malloc((size_t)nn * n * sizeof *ex);
+      pt->nodes = nn;
+      pt->st = st;
       if (x && y && ex && cv_solver_get_nodes(sv, x) == CVAR_OK &&
           cv_solver_get_values(sv, y) == CVAR_OK && scene_eval_exact(s, nn, x, ex) == 0) {
         double e = 0;
@@ -89,7 +107,7 @@ static int measure(const scene *s, const cv_problem *p, point *pt, double budget
     }
     cv_solver_free(sv);
     double t = now() - t0;
-    if (st != CVAR_OK) return -1;
+    if (!keep) return -1;
     best = fmin(best, t);
     spent += t;
     reps++;
@@ -115,7 +133,8 @@ static int sweep(const scene *s0, const cv_problem *p, int degree, point *pts, i
     s.elements = e;
     point *pt = &pts[np];
     pt->elements = e;
-    if (measure(&s, p, pt, quick ? 0.005 : 0.05) < 0 || !isfinite(pt->err))
+    pt->tol = 0;
+    if (measure(&s, p, pt, quick ? 0.005 : 0.05, 0) < 0 || !isfinite(pt->err))
       continue; /* e.g. too coarse for Newton from the guess */
     np++;
     /* stop at the target floor, at round-off (no gain over 3 meshes once below 1e-9:
@@ -124,6 +143,25 @@ static int sweep(const scene *s0, const cv_problem *p, int degree, point *pts, i
     stale = pt->err < 0.5 * best || best > 1e-9 ? 0 : stale + 1;
     best = fmin(best, pt->err);
     if (pt->err < 0.5e-12 || stale >= 3 || pt->time > (quick ? 0.1 : 1.0)) break;
+  }
+  return np;
+}
+
+/* --tol T for T = 10^-2 .. 10^-13 (half decades) as `calcvar solve SCENE --tol T` sets it
+ * up: no mesh given, so the start is SCENE_TOL_START_ELEMENTS of SCENE_TOL_START_DEGREE, and
+ * the cap SCENE_TOL_MAX_NODES (scene_solver_configure). */
+static int tol_sweep(const scene *s0, const cv_problem *p, point *pts, int quick) {
+  scene s = *s0;
+  int np = 0;
+  s.elements = SCENE_TOL_START_ELEMENTS;
+  s.degree = SCENE_TOL_START_DEGREE;
+  for (int k = 4; k < 4 + NTOL; k++) {
+    point *pt = &pts[np];
+    s.tol = pt->tol = pow(10.0, -0.5 * k);
+    pt->elements = 0;
+    if (measure(&s, p, pt, quick ? 0.005 : 0.05, 1) < 0 || !isfinite(pt->err)) continue;
+    np++;
+    if (pt->time > 1.0) break;
   }
   return np;
 }
@@ -176,12 +214,12 @@ static int bvp_front(json_t *arr, double *x, double *y, int max) {
 }
 
 static int draw(const char *dir, const char *name, const char *title, point pts[][MAXPTS],
-                const int *np, json_t *bvp) {
+                const int *np, const point *tp, int ntp, json_t *bvp) {
   char path[4096];
   snprintf(path, sizeof path, "%s/work_precision_%s.svg", dir, name);
-  double x[NDEG + 1][MAXPTS], y[NDEG + 1][MAXPTS];
-  char labels[NDEG + 1][32];
-  cli_plot_line lines[NDEG + 1];
+  double x[NDEG + 2][MAXPTS], y[NDEG + 2][MAXPTS];
+  char labels[NDEG + 2][40];
+  cli_plot_line lines[NDEG + 2];
   memset(lines, 0, sizeof lines);
   int nl = 0;
   for (int d = 0; d < NDEG; d++) {
@@ -191,6 +229,17 @@ static int draw(const char *dir, const char *name, const char *title, point pts[
     }
     snprintf(labels[nl], sizeof labels[nl], "calcvar p = %d", degrees[d]);
     lines[nl] = (cli_plot_line){np[d], x[d], y[d], labels[nl], d, 0, 1};
+    nl++;
+  }
+  int nt = 0; /* --tol: the converged solves, in the order of T */
+  for (int k = 0; k < ntp; k++)
+    if (tp[k].st == CVAR_OK) {
+      x[NDEG + 1][nt] = tp[k].time;
+      y[NDEG + 1][nt++] = tp[k].err;
+    }
+  if (nt > 0) {
+    snprintf(labels[nl], sizeof labels[nl], "calcvar --tol (no mesh given)");
+    lines[nl] = (cli_plot_line){nt, x[NDEG + 1], y[NDEG + 1], labels[nl], 4, 3, 1};
     nl++;
   }
   json_t *b = bvp ? json_object_get(bvp, name) : NULL;
@@ -207,11 +256,13 @@ static int draw(const char *dir, const char *name, const char *title, point pts[
                         .ylabel = "max nodal error",
                         .logx = 1,
                         .logy = 1,
+                        .legend_right = 1, /* six curves: no corner of the axes is free */
+                        .vp = {0.075, 0.68, 0.12, 0.9},
                         .nlines = nl,
                         .lines = lines};
   cli_outfile o;
   if (cli_outfile_open(&o, path, NULL) < 0) return -1;
-  if (cli_plot_write(&o, 1, &pan) < 0) {
+  if (cli_plot_write_page(&o, 1120, 560, 1, &pan) < 0) {
     cli_outfile_abandon(&o);
     return -1;
   }
@@ -221,10 +272,12 @@ static int draw(const char *dir, const char *name, const char *title, point pts[
 
 int main(int argc, char **argv) {
   const char *dir = CV_SCENE_DIR, *json_out = NULL, *bvp_in = NULL, *svg_dir = NULL;
-  int quick = 0;
+  int quick = 0, with_tol = 1;
   for (int i = 1; i < argc; i++) {
     if (strcmp(argv[i], "--quick") == 0)
       quick = 1;
+    else if (strcmp(argv[i], "--no-tol") == 0)
+      with_tol = 0;
     else if (strcmp(argv[i], "--json") == 0 && i + 1 < argc)
       json_out = argv[++i];
     else if (strcmp(argv[i], "--bvp") == 0 && i + 1 < argc)
@@ -234,12 +287,12 @@ int main(int argc, char **argv) {
     else if (argv[i][0] != '-')
       dir = argv[i];
     else {
-      fprintf(stderr, "usage: work_precision [--quick] [--json FILE] [--bvp FILE] "
+      fprintf(stderr, "usage: work_precision [--quick] [--no-tol] [--json FILE] [--bvp FILE] "
                       "[--svg-dir DIR] [SCENE_DIR]\n");
       return 2;
     }
   }
-  json_t *bvp = NULL, *all = json_object();
+  json_t *bvp = NULL, *all = json_object(), *alltol = json_object();
   if (bvp_in) {
     json_error_t je;
     if (!(bvp = json_load_file(bvp_in, 0, &je))) {
@@ -247,7 +300,7 @@ int main(int argc, char **argv) {
       return 2;
     }
   }
-  static point pts[NDEG][MAXPTS];
+  static point pts[NDEG][MAXPTS], tp[NTOL];
   printf("minimum time [s] of one solve to reach a max nodal error (elements in brackets)\n");
   printf("%-16s %7s", "problem", "error");
   for (int d = 0; d < NDEG; d++) printf("   p = %-13d", degrees[d]);
@@ -301,12 +354,29 @@ int main(int argc, char **argv) {
       else
         printf("   -\n");
     }
-    if (svg_dir && draw(svg_dir, problems[k], s->title, pts, np, bvp) < 0)
+    int ntp = with_tol ? tol_sweep(s, p, tp, quick) : 0;
+    if (with_tol) {
+      json_t *a = json_array();
+      printf("%-16s --tol T: status, nodes, max nodal error, time [s]\n", "");
+      for (int q = 0; q < ntp; q++) {
+        const char *stn = cli_status_string(tp[q].st); /* as the report's "status" */
+        printf("%-16s %9.1e  %-16s %7d  %9.2e  %9.2e\n", "", tp[q].tol, stn, tp[q].nodes, tp[q].err,
+               tp[q].time);
+        json_array_append_new(
+            a, json_pack("[f,f,f,i,s]", tp[q].tol, tp[q].err, tp[q].time, tp[q].nodes, stn));
+      }
+      json_object_set_new(alltol, problems[k], a);
+    }
+    if (svg_dir && draw(svg_dir, problems[k], s->title, pts, np, tp, ntp, bvp) < 0)
       fprintf(stderr, "work_precision: the picture for %s could not be written\n", problems[k]);
     cv_problem_free(p);
     scene_free(s);
     fflush(stdout);
   }
+  if (with_tol)
+    json_object_set_new(all, "tol", alltol);
+  else
+    json_decref(alltol);
   if (json_out && json_dump_file(all, json_out, JSON_INDENT(1) | JSON_REAL_PRECISION(6)) < 0)
     fprintf(stderr, "work_precision: cannot write %s\n", json_out);
   json_decref(all);

@@ -3,10 +3,12 @@
 # nodal error of 1e-4 .. 1e-12 on five problems, in the same run, and the time ratio.
 # SPDX-License-Identifier: MIT
 #
-# usage: bench/work_precision.py [--build DIR] [--quick] [--figures DIR]
-#   --build DIR    meson build directory holding bench/work_precision (default: build)
-#   --quick        fewer repetitions (noisier figures, a few seconds)
-#   --figures DIR  also draw DIR/work_precision_PROBLEM.svg (calcvar per degree + solve_bvp)
+# usage: bench/work_precision.py [--build DIR] [--quick] [--figures DIR] [--markdown FILE]
+#   --build DIR      meson build directory holding bench/work_precision (default: build)
+#   --quick          fewer repetitions (noisier figures, a few seconds)
+#   --figures DIR    also draw DIR/work_precision_PROBLEM.svg (calcvar per degree, calcvar
+#                    --tol, solve_bvp)
+#   --markdown FILE  also write the two comparison tables as Markdown (for the docs)
 #
 # solve_bvp (Debian python3-scipy) solves each problem's Euler-Lagrange equations as a
 # first-order system with analytic Jacobians (fun_jac, bc_jac), from the same straight-line
@@ -15,6 +17,13 @@
 # the same measure as calcvar's error.max_nodal; its time is the fastest of repeated calls
 # (at least 50 ms of calls), as for calcvar. Without scipy the comparison is skipped with
 # a message and only calcvar's table is printed. Not part of meson test.
+#
+# Second comparison, at the same requested tolerance: calcvar --tol T (automatic accuracy,
+# no mesh given; bench/work_precision.c times it the same way, fresh solver per solve,
+# fastest of repeats) against solve_bvp(tol=T), for each T, with each one's time and true
+# max nodal error. The two tolerances do not mean the same thing: calcvar's T bounds its
+# estimate of the max nodal error of y; solve_bvp's tol bounds the relative residuals of
+# its collocation equations (and of the BVP's ODE between nodes), not the error.
 import argparse
 import json
 import math
@@ -127,7 +136,8 @@ def problems(np):
 
 
 def run_bvp(np, solve_bvp, pr, tol, budget):
-    """(max nodal error, fastest time) of solve_bvp at one tolerance; None if it fails."""
+    """(max nodal error, fastest time, mesh points) of solve_bvp at one tolerance; None if it
+    fails."""
     n, a, b = pr["n"], pr["a"], pr["b"]
     ends = pr["ends"]
 
@@ -155,8 +165,8 @@ def run_bvp(np, solve_bvp, pr, tol, budget):
                         max_nodes=1000000)
         t = time.perf_counter() - t0
         best, spent = min(best, t), spent + t
-        if sol.status != 0:
-            return None
+        if sol.status != 0:  # 1: max_nodes exceeded, 2: singular Jacobian, 3: tol not met
+            return sol.status
     err = float(np.max(np.abs(sol.y[:n] - pr["exact"](sol.x))))
     return err, best, sol.x.size
 
@@ -171,6 +181,7 @@ def main():
     ap.add_argument("--build", default="build")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--figures")
+    ap.add_argument("--markdown")
     args = ap.parse_args()
     exe = os.path.join(args.build, "bench", "work_precision")
     if not os.path.exists(exe):
@@ -185,7 +196,7 @@ def main():
         print("scipy is not installed (Debian: apt-get install python3-scipy): the solve_bvp "
               "comparison is skipped; calcvar alone follows.\n")
 
-    bvp = {}
+    bvp, bvp_tol = {}, {}
     if np is not None:
         import warnings
         warnings.simplefilter("ignore")  # solve_bvp warns when tol < 100 eps
@@ -195,8 +206,14 @@ def main():
         print("scipy %s solve_bvp: (tol, max nodal error, time, mesh points)" % scipy.__version__)
         for name in PROBLEMS:
             pts = []
+            bvp_tol[name] = {}
             for tol in tols:
                 r = run_bvp(np, solve_bvp, P[name], tol, budget)
+                if isinstance(r, int):
+                    print("  %-16s tol %.0e  failed (status %d)" % (name, tol, r))
+                    bvp_tol[name]["%.1e" % tol] = "failed (status %d)" % r
+                    continue
+                bvp_tol[name]["%.1e" % tol] = r
                 if r:
                     pts.append([r[0], r[1]])
                     print("  %-16s tol %.0e  error %.2e  %.2e s  %d points" %
@@ -223,6 +240,28 @@ def main():
             cv = json.load(f)
     if not bvp:
         return
+    md = []
+    # docs/performance.md's table: per degree the least time (elements), the best in bold
+    md.append("| problem | error | p = 1 | p = 2 | p = 4 | p = 8 | solve_bvp | ratio (best "
+              "calcvar) |")
+    md.append("|---|---|---|---|---|---|---|---|")
+    for name in PROBLEMS:
+        for k, target in enumerate(TARGETS):
+            cells, best = [], None
+            for deg in ("1", "2", "4", "8"):
+                ok = [(t, E) for E, e, t in cv[name].get(deg, []) if e <= target]
+                c = min(ok) if ok else None
+                cells.append(c)
+                if c and (best is None or c[0] < best[0]):
+                    best = c
+            row = ["%.1e (%d)" % c if c else "–" for c in cells]
+            row = ["**%s** (%d)" % ("%.1e" % c[0], c[1]) if c and c == best else r
+                   for c, r in zip(cells, row)]
+            tb = time_to(bvp[name], target)
+            md.append("| %s | %.0e | %s | %s | %s |" % (
+                name if k == 0 else "", target, " | ".join(row),
+                "%.1e" % tb if tb else "not reached",
+                "%.0f×" % (tb / best[0]) if tb and best else "–"))
     print("\ncalcvar (best degree) against solve_bvp: least time to reach the error")
     print("%-16s %7s  %-18s %-10s %8s" % ("problem", "error", "calcvar [s] (p, N)",
                                         "solve_bvp", "ratio"))
@@ -235,10 +274,42 @@ def main():
                         best = (t, deg, E)
             tb = time_to(bvp[name], target)
             cell = "%.2e (%s,%d)" % best if best else "-"
+            ratio = "%.0fx" % (tb / best[0]) if best and tb else "-"
             print("%-16s %7.0e  %-18s %-10s %8s" % (name if k == 0 else "", target, cell,
                                                    "%.2e" % tb if tb else "not reached",
-                                                   "%.0fx" % (tb / best[0]) if best and tb
-                                                   else "-"))
+                                                   ratio))
+    if "tol" in cv:
+        print("\nthe same requested tolerance T: calcvar --tol T (no mesh given) against "
+              "solve_bvp(tol=T)")
+        print("%-16s %8s | %-10s %9s %6s %-9s | %-10s %9s %6s | %7s" % (
+            "problem", "T", "calcvar", "error", "nodes", "status", "solve_bvp", "error",
+            "points", "t ratio"))
+        md.append("")
+        md.append("| problem | T | calcvar --tol [s] | its max nodal error | nodes | "
+                  "solve_bvp(tol=T) [s] | its max nodal error | points | time ratio |")
+        md.append("|---|---|---|---|---|---|---|---|---|")
+        for name in PROBLEMS:
+            first = True
+            for T, err, t, nodes, status in cv["tol"][name]:
+                b = bvp_tol[name].get("%.1e" % T)
+                why = b if isinstance(b, str) else "failed"
+                b = None if isinstance(b, str) else b
+                ratio = "%.0f" % (b[1] / t) if b else "-"
+                print("%-16s %8.1e | %-10s %9.2e %6d %-9s | %-10s %9s %6s | %7s" % (
+                    name if first else "", T, "%.2e" % t, err, nodes, status,
+                    "%.2e" % b[1] if b else why, "%.2e" % b[0] if b else "-",
+                    "%d" % b[2] if b else "-", ratio))
+                if abs(math.log10(T) - round(math.log10(T))) < 1e-6:  # whole decades
+                    md.append("| %s | %.0e | %.1e | %.1e%s | %d | %s | %s | %s | %s |" % (
+                        name if first else "", T, t, err,
+                        "" if status == "converged" else " (%s)" % status, nodes,
+                        "%.1e" % b[1] if b else why, "%.1e" % b[0] if b else "–",
+                        "%d" % b[2] if b else "–", ratio + "×" if b else "–"))
+                    first = False
+    if args.markdown:
+        with open(args.markdown, "w") as f:
+            f.write("\n".join(md) + "\n")
+        print("wrote %s" % args.markdown)
 
 
 if __name__ == "__main__":

@@ -470,6 +470,16 @@ CVAR_API double cv_solver_get_action(const cv_solver *s);
 /** Max-norm of the discrete Euler-Lagrange residual scaled by the lumped nodal weights
  * (theory (N-3)); mesh independent. */
 CVAR_API double cv_solver_get_gradient_norm(const cv_solver *s);
+/** Round-off floor of that residual at the last Newton iterate (theory (N-3a)): machine
+ * epsilon times (1/m_f) (sum_j |K_fj| |x_j| + the sum of the magnitudes of the terms summed
+ * into the gradient g_f), maximised over the free unknowns f, with K the Hessian (or KKT
+ * matrix) and x the unknowns: how far round-off alone can move the residual. A residual
+ * of up to a few times this is at round-off. p must be the problem solved; costs one
+ * evaluation of the integrand's gradient at the quadrature points. CVAR_ESTATE (and NaN)
+ * when the last solve was not a Newton solve that took a step (NLopt engines, no free
+ * unknowns). Terms of constraints are not counted (a lower estimate of the floor then). */
+CVAR_API cv_status cv_solver_residual_floor(const cv_solver *s, const cv_problem *p,
+                                            double *floor);
 /** Newton (or minimiser) iterations of the last solve. */
 CVAR_API int cv_solver_get_num_iterations(const cv_solver *s);
 /** Wall-clock seconds of the last cv_solve. */

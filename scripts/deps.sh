@@ -17,3 +17,6 @@ $SUDO apt-get install -y -qq --no-install-recommends \
 # doxygen, groff: the API reference and the man page (tests 'docs'); OpenMPI: calcvar batch
 # under mpirun (test batch_mpi); strace: --continue opens its scene once (test cli_batch);
 # g++ and GeographicLib: bench/bench_geodesic only.
+# Not installed here (benchmarks only, no test needs it): python3-scipy, for the solve_bvp
+# comparison of bench/work_precision.py (apt-get install python3-scipy; run it with
+# /usr/bin/python3, docs/performance.md). bench/tol_convergence.py needs only matplotlib.

@@ -104,6 +104,7 @@ typedef struct {
   int equal;        /* one unit is as long on both axes (a path) */
   int xdown, ydown; /* the axis increases leftward / downward */
   int no_legend;    /* the axis labels say it all (one curve) */
+  int legend_right; /* the legend right of the axes, not inside (leave room for it in vp) */
   double vp[4];     /* x0, x1, y0, y1 of the axes on the page (0..1); all 0: stacked */
   int nlines;
   const cli_plot_line *lines;

@@ -210,8 +210,10 @@ static void draw_panel(const cli_plot_panel *p) {
       sym[l] = MARK;
     }
     PLFLT w, h;
-    pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX,
-             corner | PL_POSITION_INSIDE | PL_POSITION_VIEWPORT, 0.02, 0.02, 0.05, 0, 1, 1, 0, 0, n,
+    PLINT pos = p->legend_right ? PL_POSITION_RIGHT | PL_POSITION_OUTSIDE | PL_POSITION_VIEWPORT
+                                : corner | PL_POSITION_INSIDE | PL_POSITION_VIEWPORT;
+    pllegend(&w, &h, PL_LEGEND_BACKGROUND | PL_LEGEND_BOUNDING_BOX, pos,
+             p->legend_right ? 0.015 : 0.02, p->legend_right ? 0.0 : 0.02, 0.05, 0, 1, 1, 0, 0, n,
              opt, 0.7 * chr_factor, 0.8 * chr_factor, 1.6, 0.0, tc, text, NULL, NULL, NULL, NULL,
              lc, ls, lw, sc, ss, sn, sym);
   }

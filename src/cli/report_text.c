@@ -23,6 +23,18 @@ void cli_report_text(FILE *f, const cli_report *r) {
   if (r->has_gradient_norm) {
     fprintf(f, "  residual    %.3g (max-norm of the scaled Euler-Lagrange residual)\n",
             r->gradient_norm);
+    /* relative to its round-off floor (theory N-3a): a few times the floor is round-off */
+    if (r->has_residual_floor) {
+      double q = r->gradient_norm / r->residual_floor;
+      /* above it after a converged solve: the step test (N-4), whose absolute part can be
+       * large next to tiny values (a singular end), stopped Newton first */
+      fprintf(f, "  floor       %.3g: the residual is %.2g times this round-off floor (%s)\n",
+              r->residual_floor, q,
+              q <= 100           ? "at round-off"
+              : r->st == CVAR_OK ? "above round-off: the step test stopped Newton first; a "
+                                   "smaller tolerance takes it further"
+                                 : "above round-off");
+    }
     /* Newton's convergence test is on the step, not on this number, which on fine meshes
      * sits at a round-off floor that grows with the number of elements (docs/faq.md). */
     if (r->method == CVAR_METHOD_NEWTON && r->st == CVAR_OK)

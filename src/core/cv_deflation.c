@@ -36,7 +36,7 @@
 typedef struct {
   cv_disc disc;
   double *y, *mult;
-  double action, gnorm, err_est, time;
+  double action, gnorm, gfloor, err_est, time;
   int iterations, morse, degenerate, rounds, csteps;
   char msg[640];
 } cv_path;
@@ -67,7 +67,8 @@ static void path_take(cv_path *q, cv_solver *s) {
   q->disc = s->disc;
   q->y = s->y;
   q->mult = s->mult;
-  q->action = s->action, q->gnorm = s->gnorm, q->err_est = s->err_est, q->time = s->time;
+  q->action = s->action, q->gnorm = s->gnorm, q->gfloor = s->gfloor, q->err_est = s->err_est,
+  q->time = s->time;
   q->iterations = s->iterations, q->morse = s->morse, q->degenerate = s->degenerate;
   q->rounds = s->rounds, q->csteps = s->csteps;
   memcpy(q->msg, s->msg, sizeof q->msg);
@@ -82,7 +83,8 @@ static void path_give(cv_solver *s, cv_path *q) {
   s->disc = q->disc;
   s->y = q->y;
   s->mult = q->mult;
-  s->action = q->action, s->gnorm = q->gnorm, s->err_est = q->err_est, s->time = q->time;
+  s->action = q->action, s->gnorm = q->gnorm, s->gfloor = q->gfloor, s->err_est = q->err_est,
+  s->time = q->time;
   s->iterations = q->iterations, s->morse = q->morse, s->degenerate = q->degenerate;
   s->rounds = q->rounds, s->csteps = q->csteps;
   memcpy(s->msg, q->msg, sizeof s->msg);

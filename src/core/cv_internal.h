@@ -273,6 +273,8 @@ struct cv_solver {
   double *y;    /* nodes*n */
   double *mult; /* nodes*nc multiplier field, then ni integral multipliers */
   double action, gnorm, time;
+  double gfloor; /* the unknowns' part of gnorm's round-off floor (theory N-3a; cv_newton.c;
+                  * cv_floor.c adds the terms' part), NaN if unknown */
   int iterations, morse, degenerate;
   double t_assemble, t_factor; /* seconds in assembly / LDL^T (bench/; from 512 unknowns) */
   double adapt_tol, err_est;   /* adaptive refinement (cv_adapt.c) */

@@ -107,6 +107,37 @@ static double residual(const cv_disc *d, const double *g, double *norm) {
   return 0.5 * s;
 }
 
+/* The round-off floor of the scaled residual (theory N-3a): storing the unknowns x in
+ * doubles moves each by up to eps |x_j|, which moves g_f by up to eps sum_j |K_fj| |x_j|;
+ * scaled as in residual(), floor = eps max_f (1/m_f) sum_j |K_fj| |x_j|. K is the matrix in
+ * Ax (upper triangle, column c holds rows c + 1 - length .. c; the last factored one,
+ * assembled at the iterate before the last step or at the last iterate); acc and xa are
+ * scratch of nfree. The other part of the floor, the rounding of the terms summed into g_f, costs an
+ * evaluation of the integrand and is added on demand by cv_solver_residual_floor. */
+static double residual_floor(const newton_ws *w, const double *Ax, const double *Y, const double *M,
+                             double *acc, double *xa) {
+  const cv_disc *d = w->d;
+  int nf = d->nfree;
+  for (int f = 0; f < nf; f++) {
+    int gi = w->gof[f];
+    xa[f] = fabs(gi >= 0 ? Y[gi] : M[-1 - gi]);
+    acc[f] = 0.0;
+  }
+  for (int c = 0; c < nf; c++) {
+    int k0 = w->colptr[c], len = w->colptr[c + 1] - k0, r0 = c + 1 - len;
+    double xc = xa[c], sum = 0.0;
+    for (int k = 0; k < len - 1; k++) {
+      double a = fabs(Ax[k0 + k]);
+      acc[r0 + k] += a * xc;
+      sum += a * xa[r0 + k];
+    }
+    acc[c] += sum + fabs(Ax[k0 + len - 1]) * xc;
+  }
+  double fl = 0.0;
+  for (int f = 0; f < nf; f++) fl = fmax(fl, acc[f] * d->imass[f]);
+  return DBL_EPSILON * fl;
+}
+
 static const char *where_failed(cv_status st) {
   return st == CVAR_ECALLBACK ? "the integrand callback asked to abort"
                               : "the integrand (or a partial) is not finite";
@@ -322,9 +353,11 @@ static cv_status factor_hessian(cv_solver *s, newton_ws *w, double *Ax, int ncon
                           "iteration %d): the constraints may be dependent or the action flat "
                           "along them"
                         : "the Hessian is singular (pivot ratio %.1e at iteration %d): the "
-                          "action is flat along some direction, as for an integrand invariant "
-                          "under reparametrisation such as arc length sqrt(x'^2 + y'^2); use "
-                          "the energy form x'^2 + y'^2 instead",
+                          "action is flat along some direction. Either the integrand is "
+                          "invariant under reparametrisation, as arc length sqrt(x'^2 + y'^2) "
+                          "is (use the energy form x'^2 + y'^2 instead), or one end is a "
+                          "conjugate point of the other (then there is no stationary path "
+                          "between these ends, or a whole family of them)",
                dmin, s->iterations);
   } else if (st) {
     cv_set_msg(s->msg, sizeof s->msg, "%s", detail);
@@ -416,12 +449,14 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   double S = 0.0, scale = 0.0;
   int stale = 0;           /* see the first residual below */
   double *Yc = Y, *Mc = M; /* the current iterate (see the swap below) */
+  double *Ax = NULL;       /* the matrix, in the factor's storage */
 
   s->iterations = 0;
   s->morse = -1;
   s->degenerate = 0;
-  s->gnorm = NAN;
+  s->gnorm = s->gfloor = NAN;
   s->action = NAN;
+  int have_K = 0; /* Ax holds an assembled matrix (for the residual's floor) */
   st = run_init(s, p, d, &w, &kkt, Y, M, nmult, &ncon);
   if (st) goto cleanup;
   int constrained = ncon > 0;
@@ -429,7 +464,8 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   for (long i = 0; i < d->ndof; i++)
     if (fabs(Y[i]) > scale) scale = fabs(Y[i]);
   if (scale == 0.0) scale = 1.0;
-  double atol = s->atol * scale, *Ax = cv_ldlt_values(w.L);
+  double atol = s->atol * scale;
+  Ax = cv_ldlt_values(w.L);
 
   /* Phase timers for bench/ (t_assemble, t_factor): on a system of a few unknowns the
    * clock reads were an eighth of the solve, so small systems are not split. */
@@ -446,6 +482,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     goto cleanup;
   }
   s->action = S;
+  have_K = 1;
   double phi = residual(d, w.g, &s->gnorm);
   /* After a step accepted on S alone the merit phi and the reported residual of the new
    * iterate are left to the next pass over g (the step norm below), not computed in a pass
@@ -548,6 +585,10 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   }
 cleanup:
   if (stale) residual(d, w.g, &s->gnorm);
+  if (have_K && Ax && nf > 0 && w.delta && w.gt && isfinite(s->gnorm)) {
+    double fl = residual_floor(&w, Ax, Yc, Mc, w.delta, w.gt); /* both free here */
+    s->gfloor = isfinite(fl) ? fl : NAN;                       /* 0 when every unknown is 0 */
+  }
   if (w.Yt && Yc != Y) { /* the latest iterate lives in our buffer: hand it back */
     memcpy(Y, Yc, (size_t)d->ndof * sizeof *Y);
     w.Yt = Yc;

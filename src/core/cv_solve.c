@@ -21,7 +21,7 @@ static void results_reset(cv_solver *s) {
   s->iterations = 0;
   s->morse = -1;
   s->degenerate = 0;
-  s->action = s->gnorm = NAN;
+  s->action = s->gnorm = s->gfloor = NAN;
   s->t_assemble = s->t_factor = 0.0;
   s->csteps = 0;
   s->smooth_w = 0.0;
@@ -69,7 +69,7 @@ static __attribute__((noinline, cold)) cv_status retry_straight_line(cv_solver *
   if (Y1 && !cv_start_values(s, p, &s->disc, Y1, 1)) {
     char keep[sizeof s->msg];
     int it = s->iterations, morse = s->morse, deg = s->degenerate;
-    double act = s->action, gn = s->gnorm, *Yfail = s->y;
+    double act = s->action, gn = s->gnorm, gf = s->gfloor, *Yfail = s->y;
     memcpy(keep, s->msg, sizeof keep);
     s->y = Y1;
     if (cv_newton_run(s, p, &s->disc, s->y, s->mult, NULL) == CVAR_OK) {
@@ -84,7 +84,7 @@ static __attribute__((noinline, cold)) cv_status retry_straight_line(cv_solver *
       cv_free(s->y);
       s->y = Yfail;
       s->iterations = it, s->morse = morse, s->degenerate = deg;
-      s->action = act, s->gnorm = gn;
+      s->action = act, s->gnorm = gn, s->gfloor = gf;
       memcpy(s->msg, keep, sizeof keep);
     }
   } else {
@@ -331,7 +331,7 @@ static __attribute__((noinline, cold)) cv_status graded_retry(cv_solver *s, cons
     cv_set_msg(s->msg, sizeof s->msg,
                "%s; with the mesh graded towards both ends and both integrated as singular: "
                "%s",
-               first, second);
+               first, strcmp(first, second) ? second : "the same again");
     st = st2;
   }
   return st;

@@ -20,7 +20,7 @@ cv_solver *cv_solver_new(cv_status *why) {
   s->continuation = 1;
   s->search_work = 2.0;
   s->adapt_max = 1000000;
-  s->err_est = NAN;
+  s->err_est = s->gfloor = NAN;
   s->status = CVAR_ESTATE;
   s->morse = -1;
   cv_set_msg(s->msg, sizeof s->msg, "no solve yet");

@@ -212,6 +212,9 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
   r->has_action = isfinite(r->action);
   r->gradient_norm = cv_solver_get_gradient_norm(sv);
   r->has_gradient_norm = isfinite(r->gradient_norm);
+  r->has_residual_floor = m == CVAR_METHOD_NEWTON && r->has_gradient_norm &&
+                          cv_solver_residual_floor(sv, p, &r->residual_floor) == CVAR_OK &&
+                          r->residual_floor > 0;
   r->time_s = cv_solver_get_time(sv);
   r->has_time = isfinite(r->time_s);
 

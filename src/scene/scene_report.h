@@ -32,6 +32,8 @@ typedef struct {
   int has_degrees;
   int has_action, has_gradient_norm, has_time;
   double action, gradient_norm, time_s;
+  int has_residual_floor; /* Newton: the residual's round-off floor (theory N-3a) */
+  double residual_floor;
   int iterations;
   int has_morse;
   int morse;

@@ -50,6 +50,10 @@ json_t *cli_report_json_object(const cli_report *r) {
   json_object_set_new(o, "unknowns", a);
   if (r->has_action) set_real(o, "action", r->action);
   if (r->has_gradient_norm) set_real(o, "gradient_norm", r->gradient_norm);
+  if (r->has_residual_floor) { /* additions (theory N-3a): the floor and the ratio to it */
+    set_real(o, "residual_floor", r->residual_floor);
+    set_real(o, "residual_over_floor", r->gradient_norm / r->residual_floor);
+  }
   json_object_set_new(o, "iterations", json_integer(r->iterations));
   if (r->has_time) set_real(o, "time_s", r->time_s);
   if (r->has_morse) {

@@ -24,7 +24,8 @@ failures = 0
 checks = 0
 
 BASE = {"schema", "title", "status", "message", "method", "elements", "degree", "nodes", "unknowns",
-        "action", "gradient_norm", "iterations", "time_s", "morse_index", "stationary_kind"}
+        "action", "gradient_norm", "residual_floor", "residual_over_floor", "iterations",
+        "time_s", "morse_index", "stationary_kind"}
 
 
 def check(what, ok, expected, actual, tol=None):
