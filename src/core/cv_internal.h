@@ -282,7 +282,7 @@ struct cv_solver {
   int hp;                   /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
   int continuation, csteps; /* automatic continuation (cv_continuation.c) */
   double smooth_w;          /* > 0: the answer is of the integrand smoothed over this width (HC-4) */
-  char note[480];           /* what the solver decided on its own, prefixed to msg */
+  char note[640];           /* what the solver decided on its own, prefixed to msg */
   cv_progress_fn progress;  /* cv_solver_set_progress; NULL: none */
   void *progress_user;
   int near_sing[2];         /* ends found nearly singular after a solve */
