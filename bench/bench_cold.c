@@ -4,12 +4,17 @@
  * would), then times N warm solves in its own process, each with a fresh solver, and
  * prints medians and their ratio: both measured in the same run.
  *   bench_cold [N]    (default 41)
+ *   bench_cold --child K        one cold solve of problem K (0 fish-eye, 1 catenary)
+ *   bench_cold --child-warm K   one solve of K, then the timed one: the same process
+ *                               with one warm solve more, for `perf stat` and callgrind
+ *                               (the difference of the two is the first solve's extra)
  * Timings on a shared machine are noisy: compare the ratio, not absolute figures.
  * SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -64,6 +69,12 @@ static int catenary_F(int m, const double *x, const double *y, const double *dy,
   return 0;
 }
 
+static long minor_faults(void) {
+  struct rusage ru;
+  return getrusage(RUSAGE_SELF, &ru) == 0 ? ru.ru_minflt : 0;
+}
+static long faults; /* minor page faults in the last timed solve */
+
 /* One timed solve of problem `which` with a fresh solver; returns seconds (NAN on failure). */
 static double timed_solve(int which) {
   cv_problem *p = which == 0 ? cv_problem_new(1, 0, 1, NULL) : cv_problem_new(1, -1, 1, NULL);
@@ -77,9 +88,11 @@ static double timed_solve(int which) {
   cv_solver *s = cv_solver_new(NULL);
   cv_solver_set_elements(s, which == 0 ? 2 : 3);
   cv_solver_set_degree(s, 4);
+  long f0 = minor_faults();
   double t0 = now();
   cv_status st = cv_solve(s, p);
   double t = now() - t0;
+  faults = minor_faults() - f0;
   cv_solver_free(s);
   cv_problem_free(p);
   return st == CVAR_OK ? t : NAN;
@@ -92,7 +105,14 @@ static int cmp(const void *a, const void *b) {
 
 int main(int argc, char **argv) {
   if (argc == 3 && strcmp(argv[1], "--child") == 0) {
-    printf("%.9e\n", timed_solve(atoi(argv[2])));
+    double t = timed_solve(atoi(argv[2]));
+    printf("%.9e %ld page faults\n", t, faults);
+    return 0;
+  }
+  if (argc == 3 && strcmp(argv[1], "--child-warm") == 0) {
+    timed_solve(atoi(argv[2]));
+    double t = timed_solve(atoi(argv[2]));
+    printf("%.9e %ld page faults\n", t, faults);
     return 0;
   }
   int N = argc > 1 ? atoi(argv[1]) : 41;

@@ -133,9 +133,12 @@ int main(int argc, char **argv) {
     char hand[16] = "-";
     if (bc->elements) snprintf(hand, sizeof hand, "%dx p%d", bc->elements, bc->degree);
     printf("%-22s %-9s %7.0e %-9s %6d %6d %9.2e %9.2e %9.2e %9.2e | %-10s %9.2e %9.2e %6.1f\n",
-           bc->scene, bc->own_mesh ? "own mesh" : bc->set ? bc->set : "-", bc->tol,
-           a.st == CVAR_OK ? "converged" : cv_status_name(a.st) + 5, a.nodes, a.rounds, a.est,
-           a.err, a.errA, a.t, hand, b.t, b.err, bc->elements ? a.t / b.t : NAN);
+           bc->scene,
+           bc->own_mesh ? "own mesh"
+           : bc->set    ? bc->set
+                        : "-",
+           bc->tol, a.st == CVAR_OK ? "converged" : cv_status_name(a.st) + 5, a.nodes, a.rounds,
+           a.est, a.err, a.errA, a.t, hand, b.t, b.err, bc->elements ? a.t / b.t : NAN);
     cv_problem_free(p);
     scene_free(s);
   }

@@ -20,10 +20,10 @@ typedef struct {
   int method; /* cv_method or -1 */
   double tolerance;
   double adapt;
-  double tol;       /* --tol: automatic accuracy (hp) */
-  int max_elements; /* --max-elements: the adaptive cap (0: 2e6) */
+  double tol;        /* --tol: automatic accuracy (hp) */
+  int max_elements;  /* --max-elements: the adaptive cap (0: 2e6) */
   double time_limit; /* --time-limit S: a cap on the seconds of --tol / --adapt rounds */
-  const char *cont; /* --continue name=from:to */
+  const char *cont;  /* --continue name=from:to */
   int nset;
   sc_set *set;
   const char *json, *csv, *plot;

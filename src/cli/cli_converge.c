@@ -242,14 +242,14 @@ int cli_converge(int argc, char **argv) {
     goto done;
   }
   cli_progress_setup(o.verbose);
-  const char *notmine = o.csv            ? "--csv"
-                        : o.plot         ? "--plot"
-                        : o.adapt > 0    ? "--adapt"
-                        : o.tol > 0      ? "--tol"
-                        : o.cont         ? "--continue"
-                        : o.max_elements ? "--max-elements"
+  const char *notmine = o.csv              ? "--csv"
+                        : o.plot           ? "--plot"
+                        : o.adapt > 0      ? "--adapt"
+                        : o.tol > 0        ? "--tol"
+                        : o.cont           ? "--continue"
+                        : o.max_elements   ? "--max-elements"
                         : o.time_limit > 0 ? "--time-limit"
-                                         : NULL;
+                                           : NULL;
   if (notmine) {
     rc = bad("%s is an option of solve, not of converge", notmine);
     goto done;

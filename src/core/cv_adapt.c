@@ -176,8 +176,8 @@ static int next_size(const cv_disc *d, const double *eta, const double *sigma, d
  * against 1.2e-12, 5.1e-13 against 1.3e-13), and aims its predictions at tol rather than
  * HP-4's tol / 10 for the same reason (PILOT_AIM x tol as HP-4's target). */
 #define MERGE_ROUNDS 3 /* HP-8: merges in the first rounds only */
-#define PILOT_MISS 1.0
-#define PILOT_AIM  10.0
+#define PILOT_MISS   1.0
+#define PILOT_AIM    10.0
 /* HP-7: after the first solve, when every element has degree >= 4 and decays smoothly
  * (sigma >= 1) and the largest predicted next coefficient is above tol, refine by those
  * predictions (HP-4 with eta = the tail) without the estimate: the enriched solve of a mesh

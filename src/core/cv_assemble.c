@@ -6,7 +6,11 @@
 #include "cv_internal.h"
 
 cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc *d) {
-  size_t n = (size_t)p->n, m = CV_BATCH;
+  /* A batch holds at most CV_BATCH points and never more than the mesh has: a small mesh's
+   * buffers then share a page or two instead of one fresh page per output (the first
+   * solve in a process pays a page fault for each, docs/performance.md). */
+  long nq = cv_disc_num_qpoints(d);
+  size_t n = (size_t)p->n, m = nq < 1 ? 1 : nq < CV_BATCH ? (size_t)nq : CV_BATCH;
   memset(as, 0, sizeof *as);
   as->prob = p;
   as->disc = d;
@@ -196,19 +200,39 @@ static inline __attribute__((always_inline)) double batch_scalar(
   return S;
 }
 
-static double batch_scalar_dispatch(const cv_disc *d, const cv_rule *r, int e0, int ne, int p,
-                                    const cv_partials *o, double *g, const int *colptr, double *Ax,
-                                    double hscale, double *bad) {
+/* One function per degree (and per constant or any number of points), each contiguous in
+ * the code: a solve runs one of them, so it touches the pages of one kernel and not of all
+ * sixteen (the first solve in a process pays a page fault per fresh page, docs/performance.md). */
+#define KERNEL(name, c, Q)                                                                         \
+  static __attribute__((noinline)) double name(const cv_disc *d, const cv_rule *r, int e0, int ne, \
+                                               const cv_partials *o, double *g, const int *colptr, \
+                                               double *Ax, double hscale, double *bad) {           \
+    return batch_scalar(c, Q, d, r, e0, ne, o, g, colptr, Ax, hscale, bad);                        \
+  }
+KERNEL(kernel_2, 2, 2)
+KERNEL(kernel_3, 3, 3) KERNEL(kernel_4, 4, 4) KERNEL(kernel_5, 5, 5) KERNEL(kernel_2q, 2, 0)
+    KERNEL(kernel_3q, 3, 0) KERNEL(kernel_4q, 4, 0) KERNEL(kernel_5q, 5, 0) KERNEL(kernel_6q, 6, 0)
+        KERNEL(kernel_7q, 7, 0) KERNEL(kernel_8q, 8, 0) KERNEL(kernel_9q, 9, 0)
+#undef KERNEL
+
+            static double batch_scalar_dispatch(const cv_disc *d, const cv_rule *r, int e0, int ne,
+                                                int p, const cv_partials *o, double *g,
+                                                const int *colptr, double *Ax, double hscale,
+                                                double *bad) {
   /* constant points only up to degree 4: beyond, the fully unrolled kernel spills (p = 8
    * measured 1.5x slower than with the loop over points kept) */
   int P1 = p + 1, same = r->q == P1 && P1 <= 5;
   switch (P1) {
-#define CASE(c)                                                                                    \
-  case c:                                                                                          \
-    return same ? batch_scalar(c, c, d, r, e0, ne, o, g, colptr, Ax, hscale, bad)                  \
-                : batch_scalar(c, 0, d, r, e0, ne, o, g, colptr, Ax, hscale, bad);
-    CASE(2) CASE(3) CASE(4) CASE(5) CASE(6) CASE(7) CASE(8) CASE(9)
-#undef CASE
+#define ARGS d, r, e0, ne, o, g, colptr, Ax, hscale, bad
+  case 2: return same ? kernel_2(ARGS) : kernel_2q(ARGS);
+  case 3: return same ? kernel_3(ARGS) : kernel_3q(ARGS);
+  case 4: return same ? kernel_4(ARGS) : kernel_4q(ARGS);
+  case 5: return same ? kernel_5(ARGS) : kernel_5q(ARGS);
+  case 6: return kernel_6q(ARGS);
+  case 7: return kernel_7q(ARGS);
+  case 8: return kernel_8q(ARGS);
+  case 9: return kernel_9q(ARGS);
+#undef ARGS
   }
   return NAN; /* unreachable: 1 <= p <= 8 */
 }

@@ -43,12 +43,12 @@ typedef struct {
   int gll_off[CV_MAX_DEGREE + 1];
   double gauss[NG][CV_MAX_DEGREE + 1]; /* at the G Gauss points */
   int gauss_off[NG];
-  double ip[NG][CV_MAX_DEGREE + 1];    /* degree-p interpolant at the Gauss points */
+  double ip[NG][CV_MAX_DEGREE + 1];                 /* degree-p interpolant at the Gauss points */
   double leg[CV_MAX_DEGREE + 1][CV_MAX_DEGREE + 1]; /* Legendre coefficients from GLL_P values */
-  double warm[NF][CV_MAX_DEGREE + 1];  /* the element's degree-p values at the enriched nodes */
-  double self[CV_MAX_DEGREE + 1][CV_MAX_DEGREE + 1]; /* Legendre coefficients from GLL_p values */
+  double warm[NF][CV_MAX_DEGREE + 1]; /* the element's degree-p values at the enriched nodes */
+  double self[CV_MAX_DEGREE + 1][CV_MAX_DEGREE + 1];   /* Legendre coefficients from GLL_p values */
   double xi[CV_MAX_DEGREE + 1], bw[CV_MAX_DEGREE + 1]; /* GLL_p nodes, barycentric weights */
-  int nwarm;                           /* enriched nodes (both halves when split) */
+  int nwarm;                                           /* enriched nodes (both halves when split) */
 } est_table;
 
 static pthread_mutex_t table_lock = PTHREAD_MUTEX_INITIALIZER;
@@ -93,11 +93,13 @@ static void table_compute(est_table *T, int p) {
   /* a_k = (2k + 1)/2 sum_l w_l y_l P_k(x_l), a_P with the discrete norm 2/P of P_P */
   for (int l = 0; l <= P; l++) {
     legendre_all(P, xiP[l], L);
-    for (int k = 0; k <= P; k++) T->leg[k][l] = wP[l] * L[k] * (k < P ? 0.5 * (2 * k + 1) : 0.5 * P);
+    for (int k = 0; k <= P; k++)
+      T->leg[k][l] = wP[l] * L[k] * (k < P ? 0.5 * (2 * k + 1) : 0.5 * P);
   }
   for (int l = 0; l <= p; l++) {
     legendre_all(p, xi[l], L);
-    for (int k = 0; k <= p; k++) T->self[k][l] = wl[l] * L[k] * (k < p ? 0.5 * (2 * k + 1) : 0.5 * p);
+    for (int k = 0; k <= p; k++)
+      T->self[k][l] = wl[l] * L[k] * (k < p ? 0.5 * (2 * k + 1) : 0.5 * p);
   }
   for (int l = 0; l <= p; l++) {
     double w = 1.0;
@@ -296,7 +298,7 @@ cv_status cv_estimate_pilot(const cv_solver *s, double *tail, double *sigma) {
       double rate = decay_rate(a, pe);
       sg = fmin(sg, rate);
       double next = fabs(a[pe]) * exp(-fmax(rate, 0.0)); /* a_{p+1}, extrapolated */
-      if (!(next <= tl)) tl = next;                        /* NaN propagates */
+      if (!(next <= tl)) tl = next;                      /* NaN propagates */
     }
     tail[e] = tl;
     sigma[e] = sg;
@@ -304,8 +306,8 @@ cv_status cv_estimate_pilot(const cv_solver *s, double *tail, double *sigma) {
   return CVAR_OK;
 }
 
-cv_status cv_estimate_indicators(const cv_solver *s, const cv_solver *f, double *eta,
-                                 double *sigma, double *where) {
+cv_status cv_estimate_indicators(const cv_solver *s, const cv_solver *f, double *eta, double *sigma,
+                                 double *where) {
   const cv_disc *d = &s->disc;
   int n = d->n;
   double *F = cv_malloc((size_t)n * NF * sizeof *F);
@@ -396,6 +398,14 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
   *est = NAN;
   if (est_vertex) *est_vertex = NAN;
   if (floor_out) *floor_out = NAN;
+  if (s->smooth_w > 0) { /* HC-4: an enriched solve would miss the smoothing's own error */
+    cv_free(t), cv_free(deg);
+    cv_set_msg(msg, len,
+               "the answer is of the integrand with its jumps smoothed over w = %.3g, whose "
+               "error (first order in w) a solve with higher degrees cannot measure",
+               s->smooth_w);
+    return CVAR_ESTATE;
+  }
   f->nq = 0;
   f->rtol = s->rtol;
   f->atol = s->atol;

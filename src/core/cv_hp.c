@@ -87,8 +87,8 @@ static int smooth_pieces(int p, double eta, double sigma, double target) {
  * merges could undo the refinements of a solution that is only piecewise smooth (a
  * tabulated spline) and the rounds would go round in circles. */
 #define MERGE_AIM 0.1 /* merged surplus predicted at most this x target (HP-8) */
-static int merged_degree(const cv_disc *d, const double *eta, const double *sigma,
-                         double thresh, double target, long e) {
+static int merged_degree(const cv_disc *d, const double *eta, const double *sigma, double thresh,
+                         double target, long e) {
   int p = cv_disc_edeg(d, e);
   if (cv_disc_edeg(d, e + 1) != p || (e == 0 && d->sing_a) || (e + 2 == d->E && d->sing_b))
     return 0;

@@ -8,6 +8,10 @@
 #include "cv_memory.h" /* the one allocator (tests may inject failures) */
 #include "cv_table_internal.h"
 
+/* The functions of every solve: placed together (.text.hot), so that a solve touches few
+ * pages of code, the first in a process few fresh ones (docs/performance.md). */
+#define CV_HOT __attribute__((hot))
+
 /* Largest batch handed to an integrand callback (documented in calcvar.h). */
 #define CV_BATCH      256
 #define CV_MAX_DEGREE 8
@@ -44,6 +48,9 @@ struct cv_problem {
   void *guess_user;
   int nnotes; /* failure notes of callbacks (cv_table_internal.h) */
   cv_note_source *notes;
+  cv_smooth_fn smooth; /* jumps that can be smoothed (cv_table_internal.h, theory HC-4) */
+  void *smooth_user;
+  int nsmooth;
   int ntables; /* tables added by cv_problem_add_table, each with a reference */
   char **table_name;
   cv_table **table;
@@ -67,14 +74,17 @@ typedef struct {
   const double *tau, *omega, *B, *D;
 } cv_rule;
 
-void cv_gauss_legendre(int q, double *t, double *w);
-void cv_gauss_lobatto(int p, double *xi, double *w);
+CV_HOT void cv_gauss_legendre(int q, double *t, double *w);
+/* The same computed (Newton on the Legendre recurrence), for the table's test. */
+void cv_gauss_legendre_compute(int q, double *t, double *w);
+void cv_gauss_lobatto_compute(int p, double *xi, double *w);
+CV_HOT void cv_gauss_lobatto(int p, double *xi, double *w);
 /* Lagrange basis on nodes xi[0..p] at s: phi[l] and (if dphi) phi_l'(s). */
-void cv_lagrange(int p, const double *xi, double s, double *phi, double *dphi);
-void cv_refelem_init(cv_refelem *r, int p, int q);
+CV_HOT void cv_lagrange(int p, const double *xi, double s, double *phi, double *dphi);
+CV_HOT void cv_refelem_init(cv_refelem *r, int p, int q);
 /* The singular-end rule (Q-2) on the element touching end 0 (a) or 1 (b), qs points, for
  * degree p (1 <= p <= CV_MAX_DEGREE, 1 <= qs <= CV_MAX_QUAD); cached for the process. */
-cv_rule cv_end_rule(int p, int qs, int end);
+CV_HOT cv_rule cv_end_rule(int p, int qs, int end);
 
 /* ---- mesh (cv_mesh.c) ---- */
 enum { CV_MESH_UNIFORM, CV_MESH_GRADED, CV_MESH_USER };
@@ -87,8 +97,8 @@ typedef struct {
   int *degrees; /* user mesh only: degree of each of its elements (hp), or NULL */
 } cv_meshspec;
 /* Element boundaries on [a, b] from a spec; *xe is allocated (E+1 entries). */
-cv_status cv_mesh_build(const cv_meshspec *m, double a, double b, int *E, double **xe, char *msg,
-                        size_t len);
+CV_HOT cv_status cv_mesh_build(const cv_meshspec *m, double a, double b, int *E, double **xe,
+                               char *msg, size_t len);
 /* Degrees of the E elements xe[0..E] built from m (m->degrees set): an element takes the
  * degree of the user element containing its midpoint (breakpoints may have split some). */
 void cv_mesh_degrees(const cv_meshspec *m, double a, double b, int E, const double *xe, int *pe);
@@ -156,7 +166,7 @@ static inline int cv_disc_elem_first(const cv_disc *d, long e) {
  * to count only) and, if gof is not NULL, the y dof of each unknown or -1 - (index into
  * the multipliers). Returns the number of entries of the upper triangle; colptr is filled
  * only when that fits an int (the caller checks against INT_MAX first). */
-long cv_disc_pattern(const cv_disc *d, int *colptr, int *gof);
+CV_HOT long cv_disc_pattern(const cv_disc *d, int *colptr, int *gof);
 
 /* The rule of element e (Gauss, or the singular-end rule on a flagged end element). */
 cv_rule cv_disc_rule(const cv_disc *d, long e);
@@ -171,8 +181,8 @@ typedef struct cv_ldlt cv_ldlt;
 /* The matrix of disc's pattern (cv_disc_pattern; gof filled if not NULL), upper triangle in
  * compressed columns: column c holds rows rstart(c)..c, contiguous. 32-bit indices:
  * CVAR_EINVAL with a message beyond 2^31 - 1 entries, CVAR_ENOMEM without one. */
-cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size_t len);
-void cv_ldlt_free(cv_ldlt *L);
+CV_HOT cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size_t len);
+CV_HOT void cv_ldlt_free(cv_ldlt *L);
 /* 1 when L (with its gof) is the matrix of disc's pattern: a new solve on the same mesh,
  * degrees, unknowns and constraints keeps the factor and its analysis. */
 int cv_ldlt_matches(const cv_ldlt *L, const cv_disc *d, const int *gof);
@@ -184,9 +194,10 @@ double *cv_ldlt_values(cv_ldlt *L);          /* Ax, length colptr[nfree] */
 /* Factor numerically (analysis happens on the first call). Returns CVAR_OK, or
  * CVAR_ESINGULAR with *minor set when a pivot is exactly zero/NaN. *neg = number of
  * negative pivots, *dmin the smallest |D(j)| / |A(j,j)|, *dmax the largest |D(j)|. */
-cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg, size_t len);
+CV_HOT cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg,
+                                size_t len);
 /* Solve in place: x <- A^{-1} x. */
-cv_status cv_ldlt_solve(cv_ldlt *L, double *x);
+CV_HOT cv_status cv_ldlt_solve(cv_ldlt *L, double *x);
 /* x <- L^{-1} x (transpose 0) or L^{-T} x (transpose 1), L unit lower triangular. */
 cv_status cv_ldlt_solve_L(cv_ldlt *L, int transpose, double *x);
 /* The pivots D(j) of the last factorisation. */
@@ -205,8 +216,8 @@ typedef struct {
   long nevals;
 } cv_assembler;
 
-cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc *d);
-void cv_assembler_free(cv_assembler *as);
+CV_HOT cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc *d);
+CV_HOT void cv_assembler_free(cv_assembler *as);
 /* Set *S to the discrete integral of Fn (theory A-1), add its gradient (A-2) to g (rows of the
  * y unknowns; may be NULL) and hscale times its Hessian (A-3) to Ax (may be NULL; column
  * layout colptr), at nodal values Y (length nodes*n). With overwrite 0 nothing is zeroed;
@@ -214,8 +225,9 @@ void cv_assembler_free(cv_assembler *as);
  * cleared batch by batch before the sums, so they end up holding this assembly alone
  * (integral-multiplier rows and columns are not touched). Returns CVAR_OK,
  * CVAR_ENONFINITE (non-finite output or > 0 from the callback), CVAR_ECALLBACK. */
-cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y, double *S,
-                      double *g, const int *colptr, double *Ax, double hscale, int overwrite);
+CV_HOT cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const double *Y,
+                             double *S, double *g, const int *colptr, double *Ax, double hscale,
+                             int overwrite);
 
 /* ---- the Lagrangian system with constraints (cv_kkt.c) ---- */
 typedef struct {
@@ -227,8 +239,8 @@ typedef struct {
   double *cbuf; /* batch buffers of constraint calls */
   double *gK;   /* gradient of one integral constraint */
 } cv_kkt;
-cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const int *colptr);
-void cv_kkt_free(cv_kkt *k);
+CV_HOT cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const int *colptr);
+CV_HOT void cv_kkt_free(cv_kkt *k);
 /* Reject pointwise constraints that fail at an end whose unknowns are all fixed. */
 cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len);
 /* Constraint values and dense Jacobian rows for the NLopt engine. */
@@ -237,8 +249,8 @@ cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, dou
 /* Least-squares starting multipliers from the stationarity condition at Y (C-5). */
 cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M);
 /* M: multipliers, lam[node*nc + k] then nu[r]. Ax and dreg may be NULL. */
-cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, double *G, double *Ax,
-                      double *dreg);
+CV_HOT cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, double *G,
+                             double *Ax, double *dreg);
 
 /* ---- Newton (cv_newton.c) ---- */
 typedef struct {
@@ -272,8 +284,9 @@ struct cv_solver {
   double time_limit;        /* seconds for the rounds (HP-6); 0: none */
   int hp;                   /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
   int continuation, csteps; /* automatic continuation (cv_continuation.c) */
-  char note[320];           /* what the solver decided on its own, prefixed to msg */
-  cv_progress_fn progress;  /* cv_solver_set_progress; NULL: none */
+  double smooth_w;         /* > 0: the answer is of the integrand smoothed over this width (HC-4) */
+  char note[640];          /* what the solver decided on its own, prefixed to msg */
+  cv_progress_fn progress; /* cv_solver_set_progress; NULL: none */
   void *progress_user;
   int near_sing[2];         /* ends found nearly singular after a solve */
   double search_work;       /* cv_solve_all's work limit (cv_deflation.c) */
@@ -284,21 +297,22 @@ struct cv_solver {
   struct cv_ldlt *ldlt;
   int *gof;
 };
-cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
+CV_HOT cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
 /* Release the solver's factor of its mesh (before the mesh changes). */
 void cv_solver_drop_factor(cv_solver *s);
 /* Release the last solve's mesh, nodal values and multipliers (not the factor). */
-void cv_solver_drop_results(cv_solver *s);
+CV_HOT void cv_solver_drop_results(cv_solver *s);
 /* The start of a solve (cv_start.c): cv_start_setup discretises the current mesh spec,
  * allocates the results and fills s->y with the starting values and flags singular ends;
  * cv_start_values fills Y with the given start / guess, or (line = 1) the straight line. */
-cv_status cv_start_setup(cv_solver *s, const cv_problem *p);
-cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y, int line);
+CV_HOT cv_status cv_start_setup(cv_solver *s, const cv_problem *p);
+CV_HOT cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y,
+                                 int line);
 /* After a solve: is the integrand at end `end` (0 = a, 1 = b) nearly singular, so that
  * the end element's rule under-integrates it (theory Q-3)? *rel: the relative change of
  * the action under the singular-end rule there. */
-int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
-                            double action, double *rel);
+CV_HOT int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
+                                   double action, double *rel);
 /* The paths found by cv_solve_all (cv_deflation.c); NULL is a no-op. */
 void cv_pathset_free(struct cv_pathset *ps);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
@@ -312,8 +326,8 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
                                double *est_vertex, double *floor_out, char *msg, size_t len);
 /* HP-4: the indicators eta, sigma, where (E entries each) of s's elements from f, the
  * enriched solve of a successful cv_estimate_enriched. */
-cv_status cv_estimate_indicators(const cv_solver *s, const cv_solver *f, double *eta,
-                                 double *sigma, double *where);
+cv_status cv_estimate_indicators(const cv_solver *s, const cv_solver *f, double *eta, double *sigma,
+                                 double *where);
 /* HP-7: from s's own solution, no solve: per element the decay rate sigma of its Legendre
  * coefficients and the next coefficient it predicts, tail = |a_p| e^(-sigma) (the largest
  * over the unknowns); a prediction to refine by, never an estimate. */
@@ -334,14 +348,15 @@ typedef struct {
   double t, w;
   const double *Y0;
 } cv_homotopy;
-cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *y, double *M,
-                        const cv_homotopy *h);
+CV_HOT cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *y, double *M,
+                               const cv_homotopy *h);
 /* After a failed Newton solve from Y0: continuation in t from Y0 (theory HC-2). */
 cv_status cv_continuation_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M,
                               const double *Y0);
 
-void cv_disc_free(cv_disc *d);
-cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg, size_t len);
+CV_HOT void cv_disc_free(cv_disc *d);
+CV_HOT cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
+                              size_t len);
 void cv_set_msg(char *msg, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 
 #endif /* CV_INTERNAL_H */

@@ -41,6 +41,7 @@ static void release_integrand(cv_problem *p) {
   for (int k = 0; k < p->nnotes; k++)
     if (!p->user || p->notes[k].user != p->user) p->notes[kept++] = p->notes[k];
   p->nnotes = kept;
+  if (p->smooth_user == p->user) p->smooth = NULL, p->smooth_user = NULL, p->nsmooth = 0;
   if (p->release) p->release(p->user);
   p->release = NULL;
   p->user = NULL;
@@ -180,6 +181,12 @@ cv_status cv_problem_add_note(cv_problem *p, cv_note_fn fn, void *user) {
   if (!grown) return CVAR_ENOMEM;
   p->notes = grown;
   p->notes[p->nnotes++] = (cv_note_source){fn, user};
+  return CVAR_OK;
+}
+
+cv_status cv_problem_set_smoothing(cv_problem *p, cv_smooth_fn fn, void *user, int count) {
+  if (!p || !fn || !user || user != p->user || count < 1) return CVAR_EINVAL;
+  p->smooth = fn, p->smooth_user = user, p->nsmooth = count;
   return CVAR_OK;
 }
 

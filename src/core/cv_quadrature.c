@@ -6,12 +6,16 @@
 #include <string.h>
 
 #include "cv_internal.h"
+#include "cv_rules_table.h"
 
-/* The rules depend only on (p, q) and are the same for every solver: each is computed
- * once per process, on first use, and copied from then on (theory Q-1, E-1). Computing
- * them was ~10 % of a small warm solve and a third of the instructions of a cold one
- * (docs/performance.md). Writers hold the lock; a reader sees a slot only after its
- * ready flag is set with release order, so the copy is never torn. */
+/* The rules depend only on (p, q) and are the same for every solver. Gauss-Legendre rules
+ * up to CV_MAX_QUAD points, the GLL nodes of every degree, and each degree's default
+ * element (q = p + 1) with its end rules (Q-2) are constants (cv_rules_table.h, generated
+ * by scripts/gen_rules.py, checked by tests/core/test_rules.c): no rule is computed on the
+ * first solve of a process (docs/performance.md). Other (p, q) are computed once per
+ * process, on first use, and copied from then on (theory Q-1, E-1). Writers hold the
+ * lock; a reader sees a slot only after its ready flag is set with release order, so the
+ * copy is never torn. */
 static pthread_mutex_t rule_lock = PTHREAD_MUTEX_INITIALIZER;
 
 /* Legendre P_n(s) and P_n'(s) by the three-term recurrence. */
@@ -34,7 +38,7 @@ static void legendre(int n, double s, double *P, double *dP) {
 
 /* q-point Gauss-Legendre rule on [-1, 1], theory (Q-1): roots of P_q by Newton from
  * the Chebyshev-like guess cos(pi (k + 3/4) / (q + 1/2)), weights 2 / ((1 - t^2) P_q'^2). */
-static void gauss_legendre_compute(int q, double *t, double *w) {
+void cv_gauss_legendre_compute(int q, double *t, double *w) {
   for (int k = 0; k < q; k++) {
     double s = cos(CV_PI * (k + 0.75) / (q + 0.5)), P, dP;
     for (int it = 0; it < 100; it++) {
@@ -52,7 +56,7 @@ static void gauss_legendre_compute(int q, double *t, double *w) {
 /* Gauss-Lobatto-Legendre nodes: +-1 and the roots of P_p'; weights 2/(p(p+1) P_p^2),
  * theory (E-1). Interior roots by Newton on P_p' using P_p'' from the Legendre ODE:
  * (1 - s^2) P'' = 2 s P' - p (p + 1) P. */
-static void gauss_lobatto_compute(int p, double *xi, double *w) {
+void cv_gauss_lobatto_compute(int p, double *xi, double *w) {
   xi[0] = -1.0;
   xi[p] = 1.0;
   for (int j = 1; j < p; j++) {
@@ -76,48 +80,22 @@ static void gauss_lobatto_compute(int p, double *xi, double *w) {
   }
 }
 
-static struct {
-  atomic_int ready;
-  double t[CV_MAX_QUAD], w[CV_MAX_QUAD];
-} gl_cache[CV_MAX_QUAD + 1];
-
-static struct {
-  atomic_int ready;
-  double xi[CV_MAX_DEGREE + 1], w[CV_MAX_DEGREE + 1];
-} gll_cache[CV_MAX_DEGREE + 1];
-
 void cv_gauss_legendre(int q, double *t, double *w) {
   if (q < 1 || q > CV_MAX_QUAD) {
-    gauss_legendre_compute(q, t, w);
+    cv_gauss_legendre_compute(q, t, w);
     return;
   }
-  if (!atomic_load_explicit(&gl_cache[q].ready, memory_order_acquire)) {
-    pthread_mutex_lock(&rule_lock);
-    if (!atomic_load_explicit(&gl_cache[q].ready, memory_order_relaxed)) {
-      gauss_legendre_compute(q, gl_cache[q].t, gl_cache[q].w);
-      atomic_store_explicit(&gl_cache[q].ready, 1, memory_order_release);
-    }
-    pthread_mutex_unlock(&rule_lock);
-  }
-  memcpy(t, gl_cache[q].t, (size_t)q * sizeof *t);
-  memcpy(w, gl_cache[q].w, (size_t)q * sizeof *w);
+  memcpy(t, gl_t + q * (q - 1) / 2, (size_t)q * sizeof *t);
+  memcpy(w, gl_w + q * (q - 1) / 2, (size_t)q * sizeof *w);
 }
 
 void cv_gauss_lobatto(int p, double *xi, double *w) {
   if (p < 1 || p > CV_MAX_DEGREE) {
-    gauss_lobatto_compute(p, xi, w);
+    cv_gauss_lobatto_compute(p, xi, w);
     return;
   }
-  if (!atomic_load_explicit(&gll_cache[p].ready, memory_order_acquire)) {
-    pthread_mutex_lock(&rule_lock);
-    if (!atomic_load_explicit(&gll_cache[p].ready, memory_order_relaxed)) {
-      gauss_lobatto_compute(p, gll_cache[p].xi, gll_cache[p].w);
-      atomic_store_explicit(&gll_cache[p].ready, 1, memory_order_release);
-    }
-    pthread_mutex_unlock(&rule_lock);
-  }
-  memcpy(xi, gll_cache[p].xi, (size_t)(p + 1) * sizeof *xi);
-  memcpy(w, gll_cache[p].w, (size_t)(p + 1) * sizeof *w);
+  memcpy(xi, gll_x + p * (p + 1) / 2 - 1, (size_t)(p + 1) * sizeof *xi);
+  memcpy(w, gll_w + p * (p + 1) / 2 - 1, (size_t)(p + 1) * sizeof *w);
 }
 
 void cv_lagrange(int p, const double *xi, double s, double *phi, double *dphi) {
@@ -151,7 +129,9 @@ static struct {
   cv_refelem r;
 } ref_cache[CV_MAX_DEGREE + 1][CV_MAX_QUAD + 1];
 
-void cv_refelem_init(cv_refelem *r, int p, int q) {
+/* A (p, q) other than the default: computed once per process (out of line, with its
+ * temporary, so that the default's frame stays small). */
+static __attribute__((noinline)) void refelem_other(cv_refelem *r, int p, int q) {
   if (p < 1 || p > CV_MAX_DEGREE || q < 1 || q > CV_MAX_QUAD) {
     refelem_compute(r, p, q);
     return;
@@ -169,6 +149,32 @@ void cv_refelem_init(cv_refelem *r, int p, int q) {
   *r = ref_cache[p][q].r;
 }
 
+/* Offsets of degree p's default element and end rules in cv_rules_table.h. */
+static int ref_offset(int p) {
+  int o = 0;
+  for (int r = 1; r < p; r++) o += (r + 1) * (r + 1);
+  return o;
+}
+static void end_offsets(int p, int *pts, int *tab) {
+  *pts = *tab = 0;
+  for (int r = 1; r < p; r++) *pts += 2 * r + 6, *tab += (2 * r + 6) * (r + 1);
+}
+
+void cv_refelem_init(cv_refelem *r, int p, int q) {
+  if (p >= 1 && p <= CV_MAX_DEGREE && q == p + 1) { /* the default: constants */
+    size_t nb = (size_t)q * (p + 1) * sizeof *r->B;
+    r->p = p;
+    r->q = q;
+    cv_gauss_lobatto(p, r->xi, r->wl);
+    cv_gauss_legendre(q, r->tau, r->omega);
+    memcpy(r->B, ref_B + ref_offset(p), nb);
+    memcpy(r->D, ref_D + ref_offset(p), nb);
+    r->qs = 2 * q + 4;
+    return;
+  }
+  refelem_other(r, p, q);
+}
+
 /* The singular-end rule (Q-2) on the element touching an end, in reference coordinates:
  * x = c +- u^2 with u from 0 to sqrt(h) maps Gauss point t_k in u to
  * tau_k = -+(1 - (t_k + 1)^2 / 2) whatever h, with weight omega_k = w_k (t_k + 1) in tau
@@ -179,8 +185,8 @@ static struct {
   double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
 } end_cache[2][CV_MAX_DEGREE + 1][CV_MAX_QUAD + 1];
 
-cv_rule cv_end_rule(int p, int qs, int end) {
-  end = end != 0;
+/* An end rule other than the default element's: computed once per process (out of line). */
+static __attribute__((noinline)) void end_rule_compute(int p, int qs, int end) {
   if (!atomic_load_explicit(&end_cache[end][p][qs].ready, memory_order_acquire)) {
     double t[CV_MAX_QUAD], w[CV_MAX_QUAD], xi[CV_MAX_DEGREE + 1], wl[CV_MAX_DEGREE + 1];
     cv_gauss_legendre(qs, t, w);
@@ -198,6 +204,17 @@ cv_rule cv_end_rule(int p, int qs, int end) {
     }
     pthread_mutex_unlock(&rule_lock);
   }
+}
+
+cv_rule cv_end_rule(int p, int qs, int end) {
+  end = end != 0;
+  if (qs == 2 * (p + 1) + 4) { /* the default element's: constants */
+    int o, ot;
+    end_offsets(p, &o, &ot);
+    return end ? (cv_rule){qs, end1_t + o, end1_w + o, end1_B + ot, end1_D + ot}
+               : (cv_rule){qs, end0_t + o, end0_w + o, end0_B + ot, end0_D + ot};
+  }
+  end_rule_compute(p, qs, end);
   return (cv_rule){qs, end_cache[end][p][qs].tau, end_cache[end][p][qs].om, end_cache[end][p][qs].B,
                    end_cache[end][p][qs].D};
 }

@@ -24,6 +24,7 @@ static void results_reset(cv_solver *s) {
   s->action = s->gnorm = s->gfloor = NAN;
   s->t_assemble = s->t_factor = 0.0;
   s->csteps = 0;
+  s->smooth_w = 0.0;
   s->note[0] = '\0';
 }
 
@@ -38,7 +39,7 @@ static void results_reset(cv_solver *s) {
  * difference of nearly equal large terms, and both a count too high (a minimum called a
  * saddle) and one that changes with the quadrature were measured. The count stays what the
  * discrete Hessian says; the message says it may be the mesh's. */
-static void caution_tiny_end_elements(cv_solver *s) {
+static __attribute__((noinline, cold)) void caution_tiny_end_elements(cv_solver *s) {
   const cv_disc *d = &s->disc;
   double L = d->b - d->a, h = INFINITY;
   if (d->E < 1 || !(L > 0)) return;
@@ -91,7 +92,9 @@ static cv_status grade_singular_ends(cv_solver *s, const cv_problem *p) {
  * where the Hessian is indefinite, docs/faq.md): one Newton run, cheaper than the
  * continuation. Returns CVAR_OK when it converged (the note says so); otherwise the
  * first attempt's results are restored and what continues is that attempt. */
-static cv_status retry_straight_line(cv_solver *s, const cv_problem *p, cv_status first) {
+static __attribute__((noinline, cold)) cv_status retry_straight_line(cv_solver *s,
+                                                                     const cv_problem *p,
+                                                                     cv_status first) {
   cv_status st = first;
   double *Y1 = cv_malloc((size_t)s->disc.ndof * sizeof *Y1);
   if (Y1 && !cv_start_values(s, p, &s->disc, Y1, 1)) {
@@ -122,7 +125,9 @@ static cv_status retry_straight_line(cv_solver *s, const cv_problem *p, cv_statu
 }
 
 /* Continuation from the start, computed again (theory HC-2). */
-static cv_status continue_from_start(cv_solver *s, const cv_problem *p, cv_status first) {
+static __attribute__((noinline, cold)) cv_status continue_from_start(cv_solver *s,
+                                                                     const cv_problem *p,
+                                                                     cv_status first) {
   cv_status st = first;
   double *Y0 = cv_malloc((size_t)s->disc.ndof * sizeof *Y0);
   char keep[sizeof s->msg];
@@ -136,9 +141,173 @@ static cv_status continue_from_start(cv_solver *s, const cv_problem *p, cv_statu
   return st;
 }
 
+/* One level of the smoothing homotopy: Newton from Yc on the integrand smoothed over w.
+ * On success Yc holds the solution and *A its action. */
+static cv_status smooth_level(cv_solver *s, const cv_problem *p, double w, double *Yc, double *Yt,
+                              double *A) {
+  size_t nd = (size_t)s->disc.ndof * sizeof *Yt;
+  p->smooth(p->smooth_user, w);
+  memcpy(Yt, Yc, nd);
+  cv_status st = cv_newton_run(s, p, &s->disc, Yt, s->mult, NULL);
+  if (st == CVAR_OK) {
+    memcpy(Yc, Yt, nd);
+    *A = s->action;
+  }
+  return st;
+}
+
+/* The first width of HC-4: half the largest spread of the values Y (1 if they are flat). */
+static double first_width(const cv_solver *s, const double *Y) {
+  double range = 0.0;
+  for (int k = 0; k < s->n; k++) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (int j = k; j < s->disc.ndof; j += s->n) lo = fmin(lo, Y[j]), hi = fmax(hi, Y[j]);
+    range = fmax(range, hi - lo);
+  }
+  return range > 0 ? 0.5 * range : 1.0;
+}
+
+/* HC-4: does the converged path s->y cross a jump? The blend of X-6 is exact outside its
+ * band, so the action with the jumps smoothed over w equals the sharp one bit for bit
+ * unless some quadrature point lies in a band; where the path crosses a jump of size J
+ * the change is ~ J w (first order), where it crosses a kink of a continuous `if` only
+ * ~ w^2. So: a jump when the change at w is less than 3 times the change at w/2 (2 for a
+ * jump, 4 for a kink). */
+static __attribute__((noinline, cold)) int near_jump(cv_solver *s, const cv_problem *p, double w) {
+  cv_assembler as;
+  double S[3] = {NAN, NAN, NAN}, width[3] = {0.0, w, 0.5 * w};
+  int ok = 1;
+  if (cv_assembler_init(&as, p, &s->disc)) return 0;
+  for (int k = 0; k < 3 && ok; k++) {
+    p->smooth(p->smooth_user, width[k]);
+    ok = cv_assemble(&as, p->F, p->user, s->y, &S[k], NULL, NULL, NULL, 0.0, 0) == CVAR_OK;
+  }
+  p->smooth(p->smooth_user, 0.0);
+  cv_assembler_free(&as);
+  double d1 = fabs(S[1] - S[0]), d2 = fabs(S[2] - S[0]);
+  return ok && d1 > 0 && d1 < 3.0 * d2;
+}
+
+/* (HC-4) Jumps of the integrand in y: the discrete action jumps when a quadrature point
+ * crosses one and its gradient never sees the interface (F_y is 0 on both sides), so Newton
+ * cannot find the minimiser. Smooth the jumps over a width w (X-6), solve from the start,
+ * and halve w with warm starts while the mesh resolves the band: there the action moves
+ * like A(w) = A(0) + C w + O(w^2), each halving by half the change of the one before.
+ * The last level whose change kept that ratio (within [0.3, 0.7]) is the answer; its
+ * action differs from the sharp problem's by about its last change (first order in w). */
+static __attribute__((noinline, cold)) cv_status smooth_homotopy(cv_solver *s, const cv_problem *p,
+                                                                 cv_status first) {
+  char firstmsg[sizeof s->msg];
+  memcpy(firstmsg, s->msg, sizeof firstmsg);
+  int nd = s->disc.ndof, levels = 0, total = s->iterations, ok = 0;
+  double *Yc = cv_malloc((size_t)nd * sizeof *Yc), *Yt = cv_malloc((size_t)nd * sizeof *Yt);
+  double *Yok = cv_malloc((size_t)nd * sizeof *Yok);
+  cv_status st = Yc && Yt && Yok ? cv_start_values(s, p, &s->disc, Yc, 0) : CVAR_ENOMEM;
+  double w, wok = 0.0, A = NAN, Aprev = NAN, dprev = NAN, dok = NAN;
+  int morse0 = -1;
+  if (st) goto cleanup;
+  w = first_width(s, Yc);
+  for (levels = 0; levels < 48; levels++, w *= 0.5) {
+    st = smooth_level(s, p, w, Yc, Yt, &A);
+    total += s->iterations;
+    if (st == CVAR_ECALLBACK || st == CVAR_ENOMEM || st == CVAR_EINVAL || st == CVAR_ECANCELLED)
+      goto cleanup;
+    if (st != CVAR_OK) break;
+    if (levels == 0) morse0 = s->morse;
+    if (s->morse != morse0) break; /* an unresolved band makes spurious negative curvature */
+    double dA = Aprev - A;         /* the change of this halving */
+    if (levels >= 2) {
+      double r = dA / dprev;
+      if (!(r >= 0.3 && r <= 0.7)) break; /* the band is no longer resolved */
+    }
+    if (levels >= 1) {
+      wok = w, dok = dA, ok = levels >= 2;
+      memcpy(Yok, Yc, (size_t)nd * sizeof *Yok);
+    }
+    dprev = dA;
+    Aprev = A;
+  }
+  if (!ok) {
+    st = first == CVAR_OK ? CVAR_ESTALL : first;
+    cv_set_msg(s->msg, sizeof s->msg,
+               "%s; the integrand jumps in y (%d if%s on the unknowns), and smoothing the "
+               "jumps did not help: %s after %d halvings of the width",
+               firstmsg, p->nsmooth, p->nsmooth > 1 ? "s" : "",
+               levels == 0 ? "the widest smoothing was not solved"
+                           : "the action did not change in proportion to the width",
+               levels);
+    p->smooth(p->smooth_user, 0.0);
+    goto cleanup;
+  }
+  /* one step of a factor sqrt(2) further (halving is coarse: the band is resolved down
+   * to about half an element), kept when its Morse index and its change agree */
+  double slope = dok / wok; /* C of A(w) = A(0) + C w */
+  memcpy(Yc, Yok, (size_t)nd * sizeof *Yc);
+  w = wok * 0.70710678118654752;
+  st = smooth_level(s, p, w, Yc, Yt, &A);
+  total += s->iterations;
+  if (st == CVAR_OK && s->morse == morse0) {
+    double r = (Aprev - A) / (slope * (wok - w)); /* Aprev is A(wok) */
+    if (r >= 0.6 && r <= 1.4) wok = w, memcpy(Yok, Yc, (size_t)nd * sizeof *Yok);
+  }
+  /* the accepted level once more, for its own action, Morse index and message */
+  p->smooth(p->smooth_user, wok);
+  memcpy(s->y, Yok, (size_t)nd * sizeof *Yok);
+  st = cv_newton_run(s, p, &s->disc, s->y, s->mult, NULL);
+  total += s->iterations;
+  if (st == CVAR_OK) {
+    size_t ln = strlen(s->note);
+    s->smooth_w = wok;
+    cv_set_msg(s->note + ln, sizeof s->note - ln,
+               "the integrand jumps in y and %s%s%s, so the jumps were smoothed over a "
+               "width w down to %.3g, the finest the mesh resolves (theory HC-4): the answer "
+               "is the smoothed problem's, its action ~%.2g from the sharp one's (extrapolated "
+               "to w = 0: %.10g); ",
+               first == CVAR_OK ? "Newton's path crosses one without its interface force"
+                                : "Newton failed on them (",
+               first == CVAR_OK ? "" : cv_strerror(first), first == CVAR_OK ? "" : ")", wok,
+               fabs(slope * wok), s->action - slope * wok);
+  } else {
+    p->smooth(p->smooth_user, 0.0);
+  }
+cleanup:
+  s->iterations = total;
+  cv_free(Yc);
+  cv_free(Yt);
+  cv_free(Yok);
+  return st;
+}
+
+/* The sharp solve converged on a path that meets a jump: the homotopy from the start; if
+ * it fails, the sharp answer is kept with a warning in the note. */
+static __attribute__((noinline, cold)) cv_status resmooth_converged(cv_solver *s,
+                                                                    const cv_problem *p) {
+  size_t nd = (size_t)s->disc.ndof * sizeof *s->y;
+  double *keep = cv_malloc(nd), act = s->action, gn = s->gnorm;
+  int it = s->iterations, morse = s->morse, deg = s->degenerate;
+  char msg[sizeof s->msg];
+  if (!keep) return CVAR_ENOMEM;
+  memcpy(keep, s->y, nd);
+  memcpy(msg, s->msg, sizeof msg);
+  cv_status st = smooth_homotopy(s, p, CVAR_OK);
+  if (st != CVAR_OK && st != CVAR_ENOMEM && st != CVAR_ECANCELLED) {
+    memcpy(s->y, keep, nd);
+    memcpy(s->msg, msg, sizeof msg);
+    s->action = act, s->gnorm = gn, s->iterations = it, s->morse = morse, s->degenerate = deg;
+    p->smooth(p->smooth_user, 0.0);
+    size_t ln = strlen(s->note);
+    cv_set_msg(s->note + ln, sizeof s->note - ln,
+               "warning: the path crosses a jump of the integrand in y, where Newton's "
+               "equations miss the interface force, and smoothing the jumps failed: this "
+               "path may not be the minimiser (theory HC-4); ");
+    st = CVAR_OK;
+  }
+  cv_free(keep);
+  return st;
+}
+
 /* Prefix the solver's own decisions (s->note) to the message. */
-static void prefix_note(cv_solver *s) {
-  if (!s->note[0]) return;
+static __attribute__((noinline)) void prefix_note(cv_solver *s) {
   char m[sizeof s->msg];
   size_t ln = strlen(s->note), lm = strlen(s->msg);
   if (ln + lm >= sizeof m) lm = sizeof m - 1 - ln;
@@ -149,7 +318,7 @@ static void prefix_note(cv_solver *s) {
 }
 
 /* One solve on the mesh of s->mesh, with the singular ends known so far. */
-static cv_status solve_once(cv_solver *s, const cv_problem *p) {
+CV_HOT static cv_status solve_once(cv_solver *s, const cv_problem *p) {
   cv_status st;
   results_reset(s);
   if (!p || !p->F) {
@@ -182,6 +351,15 @@ static cv_status solve_once(cv_solver *s, const cv_problem *p) {
     lost = st != CVAR_OK;
   }
   if (lost && unconstrained && s->continuation) st = continue_from_start(s, p, st);
+  lost = st == CVAR_ESTALL || st == CVAR_EDIVERGED || st == CVAR_ENONFINITE ||
+         st == CVAR_ESINGULAR || (st == CVAR_EMAXITER && s->maxit >= 20);
+  if (lost && p->smooth && unconstrained && s->continuation) st = smooth_homotopy(s, p, st);
+  /* converged on the sharp jumps: a stationary point of the frozen problem (the wrong
+   * law at an interface) when the path crosses one; smoothed again from the start, and
+   * kept when that fails, with a sentence */
+  else if (st == CVAR_OK && p->smooth && unconstrained && s->continuation &&
+           near_jump(s, p, 0.25 * first_width(s, s->y)))
+    st = resmooth_converged(s, p);
 done:
   return st;
 }
@@ -211,6 +389,73 @@ static int twice_agrees(const cv_solver *s, const cv_problem *p, double *dev) {
   return ok;
 }
 
+/* The graded retry (HC-3) after Newton and continuation both failed on a uniform mesh;
+ * out of line, with its message buffers, so that the frames of a plain solve stay small
+ * (the first solve in a process pays a page fault per fresh stack page). */
+static __attribute__((noinline, cold)) cv_status graded_retry(cv_solver *s, const cv_problem *p,
+                                                              cv_status st) {
+  char first[sizeof s->msg];
+  memcpy(first, s->msg, sizeof first);
+  s->near_sing[0] = s->near_sing[1] = 1;
+  cv_status st2 = solve_once(s, p);
+  s->near_sing[0] = s->near_sing[1] = 0;
+  double dev = 0.0;
+  if (st2 == CVAR_OK && !twice_agrees(s, p, &dev)) {
+    st2 = CVAR_ESTALL;
+    if (isfinite(dev))
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "a stationary path of this mesh was found, but twice the elements moved its "
+                 "action by %.1e of itself: it is an artefact of the mesh, not a solution",
+                 dev);
+    else
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "a stationary path of this mesh was found, but none on twice the elements: "
+                 "it is an artefact of the mesh, not a solution");
+  }
+  if (st2 == CVAR_OK) {
+    char keep[sizeof s->note];
+    memcpy(keep, s->note, sizeof keep);
+    cv_set_msg(s->note, sizeof s->note,
+               "on the uniform mesh Newton and continuation failed (%s), so both ends were "
+               "integrated as singular; %s",
+               cv_strerror(st), keep);
+    st = CVAR_OK;
+  } else {
+    /* both attempts failed: say what was tried, with the first attempt's detail */
+    char second[sizeof s->msg];
+    memcpy(second, s->msg, sizeof second);
+    s->note[0] = '\0';
+    cv_set_msg(s->msg, sizeof s->msg,
+               "%s; with the mesh graded towards both ends and both integrated as singular: "
+               "%s",
+               first, strcmp(first, second) ? second : "the same again");
+    st = st2;
+  }
+  return st;
+}
+
+/* A converged solve whose end element under-integrates (Q-3): once more with that end
+ * integrated as singular. Out of line, like graded_retry. */
+static __attribute__((noinline, cold)) cv_status resolve_singular_ends(cv_solver *s,
+                                                                       const cv_problem *p,
+                                                                       const int un[2],
+                                                                       const double rel[2]) {
+  cv_status st;
+  s->near_sing[0] = un[0], s->near_sing[1] = un[1];
+  st = solve_once(s, p);
+  char first[sizeof s->note];
+  memcpy(first, s->note, sizeof first);
+  cv_set_msg(s->note, sizeof s->note,
+             "the integrand is nearly singular at %s (the singular-end rule changed the "
+             "action by %.1e of itself there), so it is integrated as singular; %s",
+             un[0] && un[1] ? "both ends"
+             : un[0]        ? "the start"
+                            : "the end",
+             fmax(rel[0], rel[1]), first);
+  s->near_sing[0] = s->near_sing[1] = 0;
+  return st;
+}
+
 /* One solve on the mesh of s->mesh (no adaptation). A converged solve whose end element
  * under-integrates a nearly singular integrand (theory Q-3) is solved again with that end
  * treated as singular (Q-2 rule, and grading on a uniform mesh, M-2). */
@@ -225,68 +470,26 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
    * slope 100, which the uniform mesh does not resolve). */
   if ((st == CVAR_ESTALL || st == CVAR_EDIVERGED || st == CVAR_EMAXITER) &&
       s->method == CVAR_METHOD_NEWTON && s->mesh.kind == CV_MESH_UNIFORM && !s->start && s->have &&
-      !s->disc.sing_a && !s->disc.sing_b && s->maxit >= 20) {
-    char first[sizeof s->msg];
-    memcpy(first, s->msg, sizeof first);
-    s->near_sing[0] = s->near_sing[1] = 1;
-    cv_status st2 = solve_once(s, p);
-    s->near_sing[0] = s->near_sing[1] = 0;
-    double dev = 0.0;
-    if (st2 == CVAR_OK && !twice_agrees(s, p, &dev)) {
-      st2 = CVAR_ESTALL;
-      if (isfinite(dev))
-        cv_set_msg(s->msg, sizeof s->msg,
-                   "a stationary path of this mesh was found, but twice the elements moved its "
-                   "action by %.1e of itself: it is an artefact of the mesh, not a solution",
-                   dev);
-      else
-        cv_set_msg(s->msg, sizeof s->msg,
-                   "a stationary path of this mesh was found, but none on twice the elements: "
-                   "it is an artefact of the mesh, not a solution");
-    }
-    if (st2 == CVAR_OK) {
-      char keep[sizeof s->note];
-      memcpy(keep, s->note, sizeof keep);
-      cv_set_msg(s->note, sizeof s->note,
-                 "on the uniform mesh Newton and continuation failed (%s), so both ends were "
-                 "integrated as singular; %s",
-                 cv_strerror(st), keep);
-      st = CVAR_OK;
-    } else {
-      /* both attempts failed: say what was tried, with the first attempt's detail */
-      char second[sizeof s->msg];
-      memcpy(second, s->msg, sizeof second);
-      s->note[0] = '\0';
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "%s; with the mesh graded towards both ends and both integrated as singular: "
-                 "%s",
-                 first, strcmp(first, second) ? second : "the same again");
-      st = st2;
-    }
-  }
+      !s->disc.sing_a && !s->disc.sing_b && s->maxit >= 20)
+    st = graded_retry(s, p, st);
   for (int end = 0; end < 2 && st == CVAR_OK; end++)
     un[end] = cv_start_end_unresolved(p, &s->disc, s->y, end, s->action, &rel[end]);
-  if (un[0] || un[1]) {
-    s->near_sing[0] = un[0], s->near_sing[1] = un[1];
-    st = solve_once(s, p);
-    char first[sizeof s->note];
-    memcpy(first, s->note, sizeof first);
-    cv_set_msg(s->note, sizeof s->note,
-               "the integrand is nearly singular at %s (the singular-end rule changed the "
-               "action by %.1e of itself there), so it is integrated as singular; %s",
-               un[0] && un[1] ? "both ends"
-               : un[0]        ? "the start"
-                              : "the end",
-               fmax(rel[0], rel[1]), first);
-    s->near_sing[0] = s->near_sing[1] = 0;
-  }
+  if (un[0] || un[1]) st = resolve_singular_ends(s, p, un, rel);
   if (st == CVAR_OK && s->morse > 0) caution_tiny_end_elements(s);
-  prefix_note(s);
+  if (s->note[0]) prefix_note(s);
   s->status = st;
   return st;
 }
 
-cv_status cv_solve(cv_solver *s, const cv_problem *p) {
+/* The integrand's own explanation of a failure before the engine's (out of line). */
+static __attribute__((noinline, cold)) void prefix_failure_note(cv_solver *s, const char *note) {
+  char m[2 * sizeof s->msg];
+  snprintf(m, sizeof m, "%s%s%s", note, s->msg[0] ? "; " : "", s->msg);
+  memcpy(s->msg, m, sizeof s->msg - 1); /* truncated to the message buffer */
+  s->msg[sizeof s->msg - 1] = '\0';
+}
+
+CV_HOT cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   if (!s) return CVAR_EINVAL;
   double t0 = cv_now();
   cv_pathset_free(s->paths); /* a plain solve forgets the paths of cv_solve_all */
@@ -294,6 +497,7 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   s->err_est = NAN;
   s->rounds = 0;
   for (int k = 0; p && k < p->nnotes; k++) p->notes[k].fn(p->notes[k].user, 1);
+  if (p && p->smooth) p->smooth(p->smooth_user, 0.0); /* the integrand as written (HC-4) */
   cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
   s->status = st;
   /* A failure the integrand can explain (a table's grid left): the cause first, then what
@@ -301,12 +505,7 @@ cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   const char *note = NULL;
   for (int k = 0; st != CVAR_OK && p && k < p->nnotes && !(note && note[0]); k++)
     note = p->notes[k].fn(p->notes[k].user, 0);
-  if (note && note[0]) {
-    char m[2 * sizeof s->msg];
-    snprintf(m, sizeof m, "%s%s%s", note, s->msg[0] ? "; " : "", s->msg);
-    memcpy(s->msg, m, sizeof s->msg - 1); /* truncated to the message buffer */
-    s->msg[sizeof s->msg - 1] = '\0';
-  }
+  if (note && note[0]) prefix_failure_note(s, note);
   s->time = cv_now() - t0;
   return st;
 }

@@ -19,6 +19,33 @@ static void straight_line(const cv_problem *p, double t, double *y) {
   }
 }
 
+/* Starting values from the guess callback, batch by batch (out of line, with its batch of
+ * abscissae, so that the frame of a solve without a guess stays small). */
+static __attribute__((noinline)) cv_status guess_values(cv_solver *s, const cv_problem *p,
+                                                        const cv_disc *d, double *Y) {
+  int n = p->n;
+  double xb[CV_BATCH], *yb = cv_malloc((size_t)n * CV_BATCH * sizeof *yb);
+  if (!yb) return CVAR_ENOMEM;
+  for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
+    int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
+    for (int k = 0; k < m; k++) xb[k] = cv_disc_node_x(d, j0 + k);
+    int rc = p->guess(m, xb, yb, p->guess_user);
+    for (int k = 0; k < m && rc == 0; k++)
+      for (int i = 0; i < n; i++) {
+        if (!isfinite(yb[i * m + k])) rc = 1;
+        Y[(j0 + k) * n + i] = yb[i * m + k];
+      }
+    if (rc) {
+      cv_free(yb);
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "the initial guess is not finite (or its callback failed) near x = %g", xb[0]);
+      return CVAR_ECALLBACK;
+    }
+  }
+  cv_free(yb);
+  return CVAR_OK;
+}
+
 /* Initial nodal values: user start, guess callback, or (always with line = 1) the
  * straight line. Fixed ends always win. */
 cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y,
@@ -33,25 +60,8 @@ cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, d
     }
     memcpy(Y, s->start, (size_t)d->ndof * sizeof *Y);
   } else if (p->guess && !line) {
-    double xb[CV_BATCH], *yb = cv_malloc((size_t)n * CV_BATCH * sizeof *yb);
-    if (!yb) return CVAR_ENOMEM;
-    for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
-      int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
-      for (int k = 0; k < m; k++) xb[k] = cv_disc_node_x(d, j0 + k);
-      int rc = p->guess(m, xb, yb, p->guess_user);
-      for (int k = 0; k < m && rc == 0; k++)
-        for (int i = 0; i < n; i++) {
-          if (!isfinite(yb[i * m + k])) rc = 1;
-          Y[(j0 + k) * n + i] = yb[i * m + k];
-        }
-      if (rc) {
-        cv_free(yb);
-        cv_set_msg(s->msg, sizeof s->msg,
-                   "the initial guess is not finite (or its callback failed) near x = %g", xb[0]);
-        return CVAR_ECALLBACK;
-      }
-    }
-    cv_free(yb);
+    cv_status st = guess_values(s, p, d, Y);
+    if (st) return st;
   } else {
     /* node by node, element by element: no array of abscissae (a large solve faults in
      * every page it allocates, docs/performance.md) */
@@ -149,8 +159,8 @@ cv_status cv_start_setup(cv_solver *s, const cv_problem *p) {
 
 /* The discrete integral of F over element e with rule r (reference points, weights and
  * basis tables). buf: q (2 n + 2) doubles. Returns 0 when F fails or is not finite. */
-static int element_integral(const cv_problem *p, const cv_disc *d, const double *Y, long e,
-                            const cv_rule *r, double *buf, double *S) {
+CV_HOT static int element_integral(const cv_problem *p, const cv_disc *d, const double *Y, long e,
+                                   const cv_rule *r, double *buf, double *S) {
   int n = p->n, P1 = cv_disc_edeg(d, e) + 1, q = r->q;
   double x0 = d->xe[e], h = d->xe[e + 1] - x0, *x = buf, *y = x + q, *dy = y + (size_t)n * q;
   double *F = dy + (size_t)n * q;
@@ -178,33 +188,48 @@ static int element_integral(const cv_problem *p, const cv_disc *d, const double 
 /* |integral under the element's own rule - under the singular-end rule at the end| over
  * element e (Q-2: x = c +- u^2, qs Gauss points in u); INFINITY if F fails. *own: the
  * element's integral under its own rule. */
-static double rule_gap(const cv_problem *p, const cv_disc *d, const double *Y, long e, int end,
-                       double *buf, double *own) {
-  const cv_refelem *re = cv_disc_eref(d, e); /* the element's own degree (HP-1) */
-  int qs = re->qs, P1 = re->p + 1;
+/* The gap of element e between its own rule and r1 (see rule_gap). */
+CV_HOT static double gap_with(const cv_problem *p, const cv_disc *d, const double *Y, long e,
+                              const cv_rule *r1, double *buf, double *own) {
   double S0, S1;
-  cv_rule r0 = cv_disc_rule(d, e), r1;
-  double tau[CV_MAX_QUAD], om[CV_MAX_QUAD];
-  double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
-  if (e == (end ? d->E - 1 : 0)) {
-    r1 = cv_end_rule(re->p, qs, end); /* the element touching the end: fixed tables */
-  } else {
-    double t[CV_MAX_QUAD], w[CV_MAX_QUAD];
-    cv_gauss_legendre(qs, t, w);
-    double x0 = d->xe[e], x1 = d->xe[e + 1], h = x1 - x0, J = 0.5 * h, c = end ? d->b : d->a;
-    double u0 = sqrt(fabs(x0 - c)), u1 = sqrt(fabs(x1 - c));
-    for (int k = 0; k < qs; k++) {
-      double u = u0 + (u1 - u0) * 0.5 * (t[k] + 1.0), x = end ? c - u * u : c + u * u;
-      tau[k] = 2.0 * (x - x0) / h - 1.0;
-      om[k] = 0.5 * fabs(u1 - u0) * w[k] * 2.0 * u / J;
-      cv_lagrange(re->p, re->xi, tau[k], B + k * P1, D + k * P1);
-    }
-    r1 = (cv_rule){qs, tau, om, B, D};
-  }
+  cv_rule r0 = cv_disc_rule(d, e);
   int ok =
-      element_integral(p, d, Y, e, &r0, buf, &S0) && element_integral(p, d, Y, e, &r1, buf, &S1);
+      element_integral(p, d, Y, e, &r0, buf, &S0) && element_integral(p, d, Y, e, r1, buf, &S1);
   *own = ok ? fabs(S0) : 0.0;
   return ok ? fabs(S1 - S0) : INFINITY;
+}
+
+/* The singular-end rule on an element not touching the end, built here (rarely needed:
+ * out of line with its tables, so that the frames of a plain solve stay small). */
+static __attribute__((noinline, cold)) double gap_inner(const cv_problem *p, const cv_disc *d,
+                                                        const double *Y, long e, int end,
+                                                        double *buf, double *own) {
+  const cv_refelem *re = cv_disc_eref(d, e); /* the element's own degree (HP-1) */
+  int qs = re->qs, P1 = re->p + 1;
+  double tau[CV_MAX_QUAD], om[CV_MAX_QUAD], t[CV_MAX_QUAD], w[CV_MAX_QUAD];
+  double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
+  cv_gauss_legendre(qs, t, w);
+  double x0 = d->xe[e], x1 = d->xe[e + 1], h = x1 - x0, J = 0.5 * h, c = end ? d->b : d->a;
+  double u0 = sqrt(fabs(x0 - c)), u1 = sqrt(fabs(x1 - c));
+  for (int k = 0; k < qs; k++) {
+    double u = u0 + (u1 - u0) * 0.5 * (t[k] + 1.0), x = end ? c - u * u : c + u * u;
+    tau[k] = 2.0 * (x - x0) / h - 1.0;
+    om[k] = 0.5 * fabs(u1 - u0) * w[k] * 2.0 * u / J;
+    cv_lagrange(re->p, re->xi, tau[k], B + k * P1, D + k * P1);
+  }
+  cv_rule r1 = {qs, tau, om, B, D};
+  return gap_with(p, d, Y, e, &r1, buf, own);
+}
+
+/* |integral under the element's own rule - under the singular-end rule at the end| over
+ * element e (Q-2: x = c +- u^2, qs Gauss points in u); INFINITY if F fails. *own: the
+ * element's integral under its own rule. */
+CV_HOT static double rule_gap(const cv_problem *p, const cv_disc *d, const double *Y, long e,
+                              int end, double *buf, double *own) {
+  if (e != (end ? d->E - 1 : 0)) return gap_inner(p, d, Y, e, end, buf, own);
+  const cv_refelem *re = cv_disc_eref(d, e);
+  cv_rule r1 = cv_end_rule(re->p, re->qs, end); /* the element touching the end: constants */
+  return gap_with(p, d, Y, e, &r1, buf, own);
 }
 
 /* A nearly singular end (theory Q-3): F finite at the end value but varying on a scale
@@ -226,7 +251,9 @@ int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double 
   if (!buf) return 0;
   double own, own1;
   double gap = rule_gap(p, d, Y, e, end, buf, &own), next = 0.0;
-  *rel = gap / fmax(fmax(fabs(action), own), DBL_MIN);
+  /* no libm call on the path of every solve (each first call binds a symbol) */
+  double scale = fabs(action) > own ? fabs(action) : own;
+  *rel = gap / (scale > DBL_MIN ? scale : DBL_MIN);
   /* the neighbour only when the end element's gap is large (rarely: a solve's cost) */
   if (!(*rel <= 1e-8) && d->E > 1 && isfinite(gap)) next = rule_gap(p, d, Y, e1, end, buf, &own1);
   cv_free(buf);

@@ -38,4 +38,10 @@ typedef struct {
   void *user;
 } cv_note_source;
 cv_status cv_problem_add_note(cv_problem *p, cv_note_fn fn, void *user);
+/* An integrand with jumps (a formula's if on y): fn(user, w) makes it the integrand with
+ * its `count` jumps smoothed over a width w > 0 (w = 0: the integrand as written). The
+ * solve policy uses it when Newton fails on the jumps (theory HC-4); `user` must be the
+ * integrand's user data, and the hook goes when the integrand is replaced or released. */
+typedef void (*cv_smooth_fn)(void *user, double w);
+cv_status cv_problem_set_smoothing(cv_problem *p, cv_smooth_fn fn, void *user, int count);
 #endif

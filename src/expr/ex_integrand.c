@@ -74,6 +74,13 @@ void ex_integrand_set_params(ex_integrand *g, const double *p) {
         g->pbuf[(size_t)j * EX_INTEGRAND_BATCH + k] = p[j];
 }
 
+int ex_integrand_num_params(const ex_integrand *g) { return g->np; }
+
+void ex_integrand_set_param(ex_integrand *g, int j, double v) {
+  if (j < 0 || j >= g->np || !g->used[j]) return;
+  for (int k = 0; k < EX_INTEGRAND_BATCH; k++) g->pbuf[(size_t)j * EX_INTEGRAND_BATCH + k] = v;
+}
+
 ex_integrand *ex_integrand_new_params(ex_dag *d, int n, int np, ex_id F, unsigned max_need,
                                       char *err, size_t errlen) {
   if (!d || n < 1 || np < 0 || F < 0 || F >= ex_dag_num_nodes(d) || n > 1000) {

@@ -41,6 +41,9 @@ ex_integrand *ex_integrand_clone(const ex_integrand *g);
 
 /* Parameter values p[0..np-1] for the following evaluations. */
 void ex_integrand_set_params(ex_integrand *g, const double *p);
+/* Parameter j alone (0 <= j < np; ignored otherwise). */
+void ex_integrand_set_param(ex_integrand *g, int j, double v);
+int ex_integrand_num_params(const ex_integrand *g);
 
 /* A cv_integrand_fn: user is the ex_integrand. Fills every requested group (NULL members
  * of out are groups not asked for), including both triangles of Fyy and Fpp. Values are

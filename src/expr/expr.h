@@ -116,6 +116,13 @@ ex_id ex_diff(ex_dag *d, ex_id e, int slot);
 /* Replace slot `slot` by node `by` everywhere in e (for chain rules and substitution). */
 ex_id ex_subst(ex_dag *d, ex_id e, int slot, ex_id by);
 
+/* e with its jumps in the slots lo..hi smoothed over the width read from slot wslot
+ * (theory X-6): every if(u cmp v, a, b) and every comparison used as a number whose
+ * condition depends on one of those slots becomes a C^2 blend of its branches across
+ * |t| < w, t the signed distance of the comparison's operands; w = 0 gives e's own
+ * values. *count: the jumps smoothed (0: the result is e itself). -1 on allocation failure. */
+ex_id ex_smooth_jumps(ex_dag *d, ex_id e, int lo, int hi, int wslot, int *count);
+
 /* Print e in the SCENES.md grammar, fully re-parseable, minimal parentheses. Slot names
  * come from names[slot] (e.g. "th", "th'", "th''"). Returns the length that the full text
  * needs (like snprintf); writes at most len bytes including the terminating NUL. */

@@ -78,8 +78,8 @@ typedef struct scene {
   int adapt_line;
   double tol; /* [mesh] tol: automatic accuracy (hp), 0: off */
   int tol_line;
-  double time_limit; /* --time-limit: seconds for the rounds of tol/adapt, 0: none */
-  int elements_line, degree_line;        /* 0 when not given (--tol then picks its start) */
+  double time_limit;              /* --time-limit: seconds for the rounds of tol/adapt, 0: none */
+  int elements_line, degree_line; /* 0 when not given (--tol then picks its start) */
 #define SCENE_TOL_MAX_NODES      1000000 /* cap of --tol / [mesh] tol on the nodes */
 #define SCENE_TOL_START_ELEMENTS 4       /* --tol's starting mesh when the scene gives none */
 #define SCENE_TOL_START_DEGREE   4

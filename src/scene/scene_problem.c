@@ -29,6 +29,29 @@ static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *m
   return g;
 }
 
+/* The smoothing hook of the core (theory HC-4): the width is the integrand's last input. */
+static void set_width(void *user, double w) {
+  ex_integrand *g = user;
+  ex_integrand_set_param(g, ex_integrand_num_params(g) - 1, w);
+}
+
+/* The integrand: when it jumps in y or y' (an if or a comparison on the unknowns), compiled
+ * with the jumps smoothable (X-6), the width one more input after the parameters, 0 (the
+ * integrand as written) until the solve policy sets it. *count: the jumps, 0 for none. */
+static ex_integrand *compile_integrand(const scene *s, unsigned max_need, int *count, char *msg,
+                                       size_t len) {
+  int np = s->params_as_inputs ? s->nparams : 0;
+  ex_id Fs = ex_smooth_jumps(s->dag, s->F, 1, 2 * s->n, 2 * s->n + 1 + np, count);
+  if (Fs < 0) return NULL;
+  if (*count == 0) return compile(s, s->F, max_need, msg, len);
+  ex_integrand *g = ex_integrand_new_params(s->dag, s->n, np + 1, Fs, max_need, msg, len);
+  if (g) {
+    for (int i = 0; i < np; i++) ex_integrand_set_param(g, i, s->params[i].value);
+    ex_integrand_set_param(g, np, 0.0);
+  }
+  return g;
+}
+
 cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size_t errlen) {
   cv_status why;
   char msg[512] = "";
@@ -38,7 +61,8 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
     sc_err(err, errlen, s->file, 0, "cannot create the problem: %s", cv_strerror(why));
     return NULL;
   }
-  ex_integrand *ig = compile(s, s->F, max_need, msg, sizeof msg);
+  int njumps = 0;
+  ex_integrand *ig = compile_integrand(s, max_need, &njumps, msg, sizeof msg);
   if (!ig) {
     sc_err(err, errlen, s->file, s->F_line, "integrand: %s", msg[0] ? msg : "out of memory");
     goto fail;
@@ -46,6 +70,7 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
   why = cv_problem_set_integrand_owned(p, ex_integrand_eval, ig, ex_integrand_release);
   if (why == CVAR_OK && ex_integrand_has_tables(ig)) /* names a table whose grid was left */
     why = cv_problem_add_note(p, ex_integrand_note, ig);
+  if (why == CVAR_OK && njumps > 0) why = cv_problem_set_smoothing(p, set_width, ig, njumps);
   if (why != CVAR_OK) {
     sc_err(err, errlen, s->file, s->F_line, "integrand: %s", cv_strerror(why));
     goto fail;
