@@ -166,32 +166,76 @@ static int table_row(table *t, double *vals) {
 /* ---- one output row ----------------------------------------------------------------- */
 
 static void num(cli_buf *o, double v, const char *fmt) {
-  cli_buf_printf(o, ",");
+  cli_buf_put(o, ",", 1);
   if (isfinite(v)) cli_buf_printf(o, fmt, v);
 }
 
-/* The row's output line (input fields as given) appended to o. */
+/* A non-negative integer in decimal (no printf: a row has several). */
+static void integer(cli_buf *o, long v) {
+  char d[24];
+  int k = (int)sizeof d;
+  unsigned long u = v < 0 ? 0UL - (unsigned long)v : (unsigned long)v;
+  do d[--k] = (char)('0' + u % 10); while ((u /= 10) > 0);
+  if (v < 0) d[--k] = '-';
+  cli_buf_put(o, d + k, sizeof d - (size_t)k);
+}
+
+/* The row's output line (input fields as given) appended to o. Strings and integers are
+ * copied and only the real numbers go through printf (a row's text costs about as much
+ * as its LDL^T otherwise: docs/performance.md). */
 static void format_row(cli_buf *o, const cli_batch_cols *cols, char *const *in,
                        const cv_batch_result *r) {
-  for (int c = 0; c < cols->ncols; c++) cli_buf_printf(o, "%s%s", c ? "," : "", in[c]);
-  cli_buf_printf(o, "%s%s", cols->ncols ? "," : "", cli_status_string(r->status));
+  for (int c = 0; c < cols->ncols; c++) {
+    if (c) cli_buf_put(o, ",", 1);
+    cli_buf_put(o, in[c], strlen(in[c]));
+  }
+  if (cols->ncols) cli_buf_put(o, ",", 1);
+  const char *st = cli_status_string(r->status);
+  cli_buf_put(o, st, strlen(st));
   num(o, r->has_result ? r->action : NAN, "%.17g");
-  cli_buf_printf(o, ",%d", r->iterations);
+  cli_buf_put(o, ",", 1);
+  integer(o, r->iterations);
   num(o, r->time_s, "%.6f");
-  cli_buf_printf(o, ",");
-  if (r->has_result && r->morse_index >= 0) cli_buf_printf(o, "%d", r->morse_index);
+  cli_buf_put(o, ",", 1);
+  if (r->has_result && r->morse_index >= 0) integer(o, r->morse_index);
   if (cols->err_nodal) num(o, r->has_result ? r->error_max_nodal : NAN, "%.3e");
   if (cols->err_est) num(o, r->has_result ? r->error_estimate : NAN, "%.3e");
   for (int k = 0; k < cols->nout; k++) num(o, r->has_result ? r->outputs[k] : NAN, "%.17g");
-  /* the message as one quoted CSV field */
-  cli_buf_printf(o, ",\"");
-  for (const char *m = r->message; *m; m++) {
-    if (*m == '"')
-      cli_buf_printf(o, "\"\"");
-    else if (*m != '\n' && *m != '\r')
-      cli_buf_printf(o, "%c", *m);
+  /* the message as one quoted CSV field: quotes doubled, line ends dropped */
+  cli_buf_put(o, ",\"", 2);
+  const char *m = r->message;
+  while (*m) {
+    size_t run = strcspn(m, "\"\n\r");
+    cli_buf_put(o, m, run);
+    m += run;
+    if (*m == '"') cli_buf_put(o, "\"\"", 2);
+    if (*m) m++;
   }
-  cli_buf_printf(o, "\"\n");
+  cli_buf_put(o, "\"\n", 2);
+}
+
+/* Room for `more` bytes after the text of o. 0, or -1 (o->failed) out of memory. */
+static int reserve(cli_buf *o, size_t more) {
+  if (o->failed) return -1;
+  if (o->data && o->cap - o->len > more) return 0;
+  size_t ncap = o->cap ? o->cap : 1024;
+  while (ncap - o->len <= more) ncap *= 2;
+  char *nd = realloc(o->data, ncap);
+  if (!nd) {
+    o->failed = 1;
+    return -1;
+  }
+  o->data = nd;
+  o->cap = ncap;
+  return 0;
+}
+
+int cli_buf_put(cli_buf *o, const char *s, size_t len) {
+  if (reserve(o, len) < 0) return -1;
+  memcpy(o->data + o->len, s, len);
+  o->len += len;
+  o->data[o->len] = '\0';
+  return 0;
 }
 
 int cli_buf_printf(cli_buf *o, const char *fmt, ...) {

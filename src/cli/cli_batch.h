@@ -15,6 +15,8 @@ typedef struct {
   size_t len, cap;
   int failed;
 } cli_buf;
+/* Append len bytes of s (not NUL-terminated) to o. 0, or -1 out of memory (o->failed). */
+int cli_buf_put(cli_buf *o, const char *s, size_t len);
 int cli_buf_printf(cli_buf *o, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
