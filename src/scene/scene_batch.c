@@ -328,38 +328,36 @@ cv_status sc_batch_workers(cv_batch *b, int T) {
 
 typedef struct {
   cv_batch *b;
-  int nrows, block;
-  const double *rows;
-  cv_batch_result *res;
+  int n, block;
+  scene_batch_item_fn fn;
+  void *user;
   atomic_int next;
 } job;
 
 typedef struct {
   job *j;
-  worker *w;
+  int t; /* worker index */
 } task;
 
 static void *run(void *arg) {
   task *t = arg;
   job *j = t->j;
   for (;;) {
-    int r0 = atomic_fetch_add(&j->next, j->block);
-    if (r0 >= j->nrows) break;
-    int r1 = r0 + j->block < j->nrows ? r0 + j->block : j->nrows;
-    for (int r = r0; r < r1; r++)
-      sc_batch_solve_row(j->b, t->w, r, j->rows + (size_t)r * j->b->ncols, &j->res[r]);
+    int i0 = atomic_fetch_add(&j->next, j->block);
+    if (i0 >= j->n) break;
+    int i1 = i0 + j->block < j->n ? i0 + j->block : j->n;
+    for (int i = i0; i < i1; i++) j->fn(j->b, t->t, i, j->user);
   }
   return NULL;
 }
 
-cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_result *res) {
-  if (!b || nrows < 0 || (nrows > 0 && (!res || (b->ncols > 0 && !rows)))) return CVAR_EINVAL;
-  if (nrows == 0) return CVAR_OK;
-  int T = b->nthreads < nrows ? b->nthreads : nrows;
+cv_status scene_batch_for_each(cv_batch *b, int n, int block, scene_batch_item_fn fn, void *user) {
+  if (!b || n < 0 || !fn) return CVAR_EINVAL;
+  if (n == 0) return CVAR_OK;
+  int T = b->nthreads < n ? b->nthreads : n;
   if (sc_batch_workers(b, T) != CVAR_OK) return CVAR_ENOMEM;
-  /* Blocks of consecutive rows, claimed in turn: about 8 per thread keeps the threads
-   * busy to the end; inside a block each row may warm-start from the one before. */
-  job j = {b, nrows, nrows / (8 * T) > 0 ? nrows / (8 * T) : 1, rows, res, 0};
+  if (block < 1) block = 1;
+  job j = {b, n, block, fn, user, 0};
   task *tk = cv_malloc((size_t)T * sizeof *tk);
   pthread_t *th = cv_malloc((size_t)T * sizeof *th);
   if (!tk || !th) {
@@ -368,13 +366,10 @@ cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_re
     return CVAR_ENOMEM;
   }
   int started = 0;
-  for (int t = 0; t < T; t++) {
-    tk[t].j = &j;
-    tk[t].w = &b->w[t];
-  }
+  for (int t = 0; t < T; t++) tk[t] = (task){&j, t};
   for (int t = 1; t < T; t++) {
     if (pthread_create(&th[t], NULL, run, &tk[t]) != 0)
-      break; /* fewer threads: the others take the rows */
+      break; /* fewer threads: the others take the items */
     started = t;
   }
   run(&tk[0]);
@@ -382,4 +377,42 @@ cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_re
   cv_free(tk);
   cv_free(th);
   return CVAR_OK;
+}
+
+int scene_batch_block(const cv_batch *b, int n) {
+  int T = b->nthreads < n ? b->nthreads : n;
+  if (T < 1) T = 1;
+  /* Warm starts follow the previous row on the same thread: blocks of consecutive rows,
+   * about 8 per thread (the threads still finish together). Without them, small blocks:
+   * the last ones even out the threads' ends (a claim is one atomic add, a row tens of
+   * microseconds). */
+  int per = b->warm ? 8 * T : 64 * T;
+  return n / per > 0 ? n / per : 1;
+}
+
+void scene_batch_solve_row(cv_batch *b, int t, int row, const double *vals, cv_batch_result *r) {
+  sc_batch_solve_row(b, &b->w[t], row, vals, r);
+}
+
+cv_status scene_batch_check_row(cv_batch *b, int t, const double *row, char *err, size_t errlen) {
+  worker *w = &b->w[t];
+  return sc_batch_set_row(b, w->inst, w->pv, w->rv, w->rw, row, err, errlen) < 0 ? CVAR_EINVAL
+                                                                                : CVAR_OK;
+}
+
+typedef struct {
+  const double *rows;
+  cv_batch_result *res;
+} solve_job;
+
+static int solve_item(cv_batch *b, int t, int i, void *user) {
+  solve_job *sj = user;
+  sc_batch_solve_row(b, &b->w[t], i, sj->rows + (size_t)i * b->ncols, &sj->res[i]);
+  return 0;
+}
+
+cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_result *res) {
+  if (!b || nrows < 0 || (nrows > 0 && (!res || (b->ncols > 0 && !rows)))) return CVAR_EINVAL;
+  solve_job sj = {rows, res};
+  return scene_batch_for_each(b, nrows, scene_batch_block(b, nrows), solve_item, &sj);
 }

@@ -252,33 +252,66 @@ static void keep_for_warm(worker *w, int row) {
   w->prev_row = row;
 }
 
+/* Append text to buf (capacity cap, length *k), truncating; buf stays terminated. */
+static void put(char *buf, size_t cap, size_t *k, const char *text) {
+  size_t len = strlen(text);
+  if (*k + 1 >= cap) return;
+  if (len > cap - 1 - *k) len = cap - 1 - *k;
+  memcpy(buf + *k, text, len);
+  *k += len;
+  buf[*k] = '\0';
+}
+
+static void put_int(char *buf, size_t cap, size_t *k, int v) {
+  char d[16];
+  int i = (int)sizeof d - 1;
+  unsigned u = v < 0 ? 0U - (unsigned)v : (unsigned)v;
+  d[i] = '\0';
+  do d[--i] = (char)('0' + u % 10); while ((u /= 10) > 0);
+  if (v < 0) d[--i] = '-';
+  put(buf, cap, k, d + i);
+}
+
+/* The row's sentence, as `solve` words it. Built by copies: snprintf costs a few thousand
+ * instructions a call, a noticeable part of a small row. */
 static void compose_message(cv_batch_result *r, const cv_solver *sv, int morse, int nfree,
                             int degenerate, const char *note) {
   const char *detail = cv_solver_last_error(sv);
   size_t cap = sizeof r->message, k = 0;
+  r->message[0] = '\0';
   if (r->status != CVAR_OK) {
-    k = (size_t)snprintf(r->message, cap, "%s",
-                         detail && detail[0] ? detail : cv_strerror(r->status));
+    put(r->message, cap, &k, detail && detail[0] ? detail : cv_strerror(r->status));
   } else {
-    k = (size_t)snprintf(r->message, cap, "Converged in %d iteration%s", r->iterations,
-                         r->iterations == 1 ? "" : "s");
+    put(r->message, cap, &k, "Converged in ");
+    put_int(r->message, cap, &k, r->iterations);
+    put(r->message, cap, &k, r->iterations == 1 ? " iteration" : " iterations");
     const char *kind = degenerate       ? "degenerate"
                        : morse == 0     ? "minimum"
                        : morse == nfree ? "maximum"
                                         : "saddle";
-    if (k < cap && morse >= 0 && degenerate)
-      k += (size_t)snprintf(r->message + k, cap - k, "; the Hessian is degenerate there.");
-    else if (k < cap && morse >= 0)
-      k += (size_t)snprintf(r->message + k, cap - k, " to a %s of the action (Morse index %d).",
-                            kind, morse);
-    else if (k < cap)
-      k += (size_t)snprintf(r->message + k, cap - k, ".");
-    if (k < cap && detail && detail[0] && strncmp(detail, "converged in ", 13) != 0)
-      k += (size_t)snprintf(
-          r->message + k, cap - k, " %c%s.",
-          detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A' : detail[0], detail + 1);
+    if (morse >= 0 && degenerate) {
+      put(r->message, cap, &k, "; the Hessian is degenerate there.");
+    } else if (morse >= 0) {
+      put(r->message, cap, &k, " to a ");
+      put(r->message, cap, &k, kind);
+      put(r->message, cap, &k, " of the action (Morse index ");
+      put_int(r->message, cap, &k, morse);
+      put(r->message, cap, &k, ").");
+    } else {
+      put(r->message, cap, &k, ".");
+    }
+    if (detail && detail[0] && strncmp(detail, "converged in ", 13) != 0) {
+      char first[3] = {' ', detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A' : detail[0],
+                       '\0'};
+      put(r->message, cap, &k, first);
+      put(r->message, cap, &k, detail + 1);
+      put(r->message, cap, &k, ".");
+    }
   }
-  if (note && k < cap) snprintf(r->message + k, cap - k, " %s", note);
+  if (note) {
+    put(r->message, cap, &k, " ");
+    put(r->message, cap, &k, note);
+  }
 }
 
 /* Solve row number `row` (its values `vals`) on worker w into r. */
