@@ -68,6 +68,7 @@ typedef struct {
   double k;             /* scalar operand (K variants, T_FILL) */
   loc dst, a, b, c;
   int tab, multi; /* T_TABLE: index in the tape's tables and in its call groups */
+  int pd, pa, pb, pc; /* the locations as indices of ex_tape_eval's pointer table */
 } instr;
 
 /* One T_TABLE instruction computes every partial the tape needs of one table at the same
@@ -324,6 +325,17 @@ static int select_instr(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id, 
   return 0;
 }
 
+/* A location's index in the pointer table of an evaluation: 0 NULL (no operand), then
+ * the input slots, the outputs and the registers. */
+static int ptr_index(const ex_tape *t, loc l) {
+  switch (l.space) {
+  case L_IN: return 1 + l.idx;
+  case L_OUT: return 1 + t->nslots + l.idx;
+  case L_REG: return 1 + t->nslots + t->nout + l.idx;
+  default: return 0;
+  }
+}
+
 ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
   if (!d || nslots < 0 || nout < 0 || (nout > 0 && !outs)) return NULL;
   int top = -1;
@@ -400,6 +412,12 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
   }
   t->ins = ins;
   t->nins = n;
+  for (int i = 0; i < n; i++) {
+    ins[i].pd = ptr_index(t, ins[i].dst);
+    ins[i].pa = ptr_index(t, ins[i].a);
+    ins[i].pb = ptr_index(t, ins[i].b);
+    ins[i].pc = ptr_index(t, ins[i].c);
+  }
   cv_free(cn);
   cv_free(rp.free);
   return t;
@@ -518,11 +536,35 @@ static double *where(loc l, int m, const double *const *in, double *const *out, 
   }
 }
 
+/* Pointer tables up to this many entries live on the stack; larger tapes (rare) find
+ * each location by its kind instead. */
+enum { EX_TAPE_PTRS = 2048 };
+
 void ex_tape_eval(const ex_tape *t, int m, const double *const *in, double *const *out,
                   double *work) {
   if (!t || m <= 0) return;
   double *fault = t->ntab ? work + (size_t)t->nregs * (size_t)m : NULL;
   if (fault) fault[0] = 0;
+  int np = 1 + t->nslots + t->nout + t->nregs;
+  if (np <= EX_TAPE_PTRS) {
+    /* Every location's address once per evaluation, then each instruction finds its
+     * operands by index: on the few points of a small mesh the per-instruction
+     * overhead, not the arithmetic, is most of the cost (docs/performance.md). */
+    double *P[EX_TAPE_PTRS];
+    P[0] = NULL;
+    for (int q = 0; q < t->nslots; q++) P[1 + q] = (double *)in[q]; /* read only */
+    for (int o = 0; o < t->nout; o++) P[1 + t->nslots + o] = out[o];
+    double *R = work;
+    for (int r = 0; r < t->nregs; r++, R += m) P[1 + t->nslots + t->nout + r] = R;
+    for (int i = 0; i < t->nins; i++) {
+      const instr *p = &t->ins[i];
+      if (p->op == T_TABLE)
+        run_table(t, p, m, in, out, work, P[p->pa], P[p->pb], P[p->pc], fault);
+      else
+        run(p, m, P[p->pd], P[p->pa], P[p->pb], P[p->pc]);
+    }
+    return;
+  }
   for (int i = 0; i < t->nins; i++) {
     const instr *p = &t->ins[i];
     double *D = where(p->dst, m, in, out, work);
