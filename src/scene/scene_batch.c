@@ -86,6 +86,7 @@ void cv_batch_free(cv_batch *b) {
   for (int t = 0; t < b->nworkers; t++) worker_free(b, &b->w[t]);
   cv_free(b->w);
   scene_free(b->check);
+  cv_free(b->sing);
   ex_integrand_free(b->F);
   for (int k = 0; b->cons && k < b->s->ncons; k++) ex_integrand_free(b->cons[k]);
   for (int k = 0; b->ints && k < b->s->nints; k++) ex_integrand_free(b->ints[k]);
@@ -131,6 +132,7 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen) {
   b->check = scene_instance_new(s);
   if (!b->cons || !b->ints || !b->outname || !b->given || !b->check) goto nomem;
   for (int i = 0; i < s->n; i++) b->any_exact |= s->exact[i] >= 0;
+  if ((b->nsing = scene_singular_candidates(s, &b->sing)) < 0) goto nomem;
   /* Compile once: every expression of the problem with the parameters as inputs. */
   if (!(b->F = ex_integrand_new_params(s->dag, s->n, b->np, s->F, b->need, msg, sizeof msg))) {
     snprintf(err, errlen, "%s:%d: integrand: %s", s->file, s->F_line,

@@ -49,6 +49,8 @@ struct cv_batch {
   int *guess_of; /* tape output of unknown i's guess, or -1 */
   worker *w;
   scene *check; /* instance for cv_batch_check_row */
+  ex_id *sing;  /* scene_singular_candidates, found once */
+  int nsing;
 };
 
 /* scene_batch.c */

@@ -366,7 +366,7 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
   r->iterations = cv_solver_get_num_iterations(w->sv);
   int morse = -1, nfree = 0, degenerate = 0;
   double xs, alpha;
-  if (st == CVAR_OK && scene_interior_singularity(w->inst, w->sv, &xs, &alpha) == 1) {
+  if (st == CVAR_OK && scene_interior_singularity_of(w->inst, w->sv, b->nsing, b->sing, &xs, &alpha) == 1) {
     /* as `solve` does: a finite discrete action of an infinite one (theory (SG-1)) */
     r->status = CVAR_ENONFINITE;
     snprintf(r->message, sizeof r->message,
