@@ -322,9 +322,11 @@ static cv_status factor_hessian(cv_solver *s, newton_ws *w, double *Ax, int ncon
                           "iteration %d): the constraints may be dependent or the action flat "
                           "along them"
                         : "the Hessian is singular (pivot ratio %.1e at iteration %d): the "
-                          "action is flat along some direction, as for an integrand invariant "
-                          "under reparametrisation such as arc length sqrt(x'^2 + y'^2); use "
-                          "the energy form x'^2 + y'^2 instead",
+                          "action is flat along some direction. Either the integrand is "
+                          "invariant under reparametrisation, as arc length sqrt(x'^2 + y'^2) "
+                          "is (use the energy form x'^2 + y'^2 instead), or one end is a "
+                          "conjugate point of the other (then there is no stationary path "
+                          "between these ends, or a whole family of them)",
                dmin, s->iterations);
   } else if (st) {
     cv_set_msg(s->msg, sizeof s->msg, "%s", detail);

@@ -231,7 +231,7 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
       cv_set_msg(s->msg, sizeof s->msg,
                  "%s; with the mesh graded towards both ends and both integrated as singular: "
                  "%s",
-                 first, second);
+                 first, strcmp(first, second) ? second : "the same again");
       st = st2;
     }
   }
