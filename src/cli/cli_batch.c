@@ -221,6 +221,19 @@ static int table_fields(table *t, char *msg, size_t len) {
   return 1;
 }
 
+/* Per-thread arrays of k doubles each, one after the other: a thread's slice starts at
+ * t * stride(k), a multiple of 8 doubles (a cache line) with a line to spare, so two
+ * threads never write into one line (false sharing costs more than the row's text). */
+static size_t stride(int k) { return ((size_t)k + 7) / 8 * 8 + 8; }
+
+/* Per-thread state of pass 2, padded to keep the threads' lines apart (as above). */
+typedef struct {
+  cli_buf tb;          /* the thread's formatted rows of the window */
+  cv_batch_result res; /* the row being solved */
+  long fails;
+  char pad[64];
+} thread_state;
+
 /* Pass 1 on the workers: bad[r] = 0, or 1 when row r of the window is not a row of
  * numbers or not a valid scene. */
 typedef struct {
@@ -231,7 +244,7 @@ typedef struct {
 
 static int check_item(cv_batch *b, int t, int r, void *user) {
   check_job *j = user;
-  double *v = j->vals + (size_t)t * (j->w->ncols + 1);
+  double *v = j->vals + (size_t)t * stride(j->w->ncols);
   char err[8];
   j->bad[r] = window_values(j->w, r, v) != 0 ||
               scene_batch_check_row(b, t, v, err, sizeof err) != CVAR_OK;
@@ -257,10 +270,8 @@ typedef struct {
   const window *w;
   const cli_batch_cols *cols;
   long first; /* number of the window's first row in the table */
-  double *vals, *outs;
-  cli_buf *tb; /* one per thread */
-  cv_batch_result *res; /* one per thread */
-  long *fails;          /* per thread */
+  double *vals, *outs; /* per thread (stride) */
+  thread_state *ts;
   size_t (*where)[3];
 } solve_job;
 
@@ -269,15 +280,16 @@ static void format_row(cli_buf *o, const cli_batch_cols *cols, const window *w, 
 
 static int solve_item(cv_batch *b, int t, int r, void *user) {
   solve_job *j = user;
-  double *v = j->vals + (size_t)t * (j->w->ncols + 1);
-  cv_batch_result *res = &j->res[t];
-  res->outputs = j->outs + (size_t)t * (j->cols->nout + 1);
+  double *v = j->vals + (size_t)t * stride(j->w->ncols);
+  thread_state *ts = &j->ts[t];
+  cv_batch_result *res = &ts->res;
+  res->outputs = j->outs + (size_t)t * stride(j->cols->nout);
   if (window_values(j->w, r, v) != 0) return -1; /* checked in pass 1 */
   scene_batch_solve_row(b, t, (int)(j->first + r), v, res);
-  size_t at = j->tb[t].len;
-  format_row(&j->tb[t], j->cols, j->w, r, res);
-  j->where[r][0] = (size_t)t, j->where[r][1] = at, j->where[r][2] = j->tb[t].len - at;
-  j->fails[t] += res->status != CVAR_OK;
+  size_t at = ts->tb.len;
+  format_row(&ts->tb, j->cols, j->w, r, res);
+  j->where[r][0] = (size_t)t, j->where[r][1] = at, j->where[r][2] = ts->tb.len - at;
+  ts->fails += res->status != CVAR_OK;
   return 0;
 }
 
@@ -506,9 +518,8 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
   cv_batch *b = NULL;
   double *vals = NULL, *outs = NULL;
   window wd = {0};
-  cli_buf buf = {0}, *tb = NULL;
-  cv_batch_result *tres = NULL;
-  long *tfails = NULL;
+  cli_buf buf = {0};
+  thread_state *ts = NULL;
   unsigned char *bad = NULL;
   size_t(*where)[3] = NULL;
   scene *s = scene_load_file_inputs(o->scene_path, o->nset, o->set, err, sizeof err);
@@ -556,15 +567,13 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
   /* Windows: W rows per rank (threads x ROWS_PER_THREAD), under MPI the ranks take
    * consecutive blocks of one window of W * size rows. */
   int W = threads * ROWS_PER_THREAD, wsz = W * mpi->size;
-  vals = malloc(((size_t)threads * (nc + 1) + 1) * sizeof *vals);
+  vals = malloc((size_t)threads * stride(nc) * sizeof *vals);
   wd.ncols = nc;
-  tb = calloc((size_t)threads, sizeof *tb);
-  tres = calloc((size_t)threads, sizeof *tres);
-  tfails = calloc((size_t)threads, sizeof *tfails);
-  outs = malloc(((size_t)threads * (cv_batch_num_outputs(b) + 1) + 1) * sizeof *outs);
+  ts = calloc((size_t)threads, sizeof *ts);
+  outs = malloc((size_t)threads * stride(cv_batch_num_outputs(b)) * sizeof *outs);
   bad = malloc((size_t)W + 1);
   where = malloc(((size_t)W + 1) * sizeof *where);
-  if (!vals || !tb || !tres || !tfails || !outs || !bad || !where) {
+  if (!vals || !ts || !outs || !bad || !where) {
     fprintf(stderr, "calcvar batch: out of memory\n");
     goto done;
   }
@@ -659,8 +668,8 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
       }
     }
     if (!ok) break;
-    for (int k = 0; k < threads; k++) tb[k].len = 0;
-    solve_job sj = {&wd, &cols, m0, vals, outs, tb, tres, tfails, where};
+    for (int k = 0; k < threads; k++) ts[k].tb.len = 0;
+    solve_job sj = {&wd, &cols, m0, vals, outs, ts, where};
     if (scene_batch_for_each(b, wd.n, scene_batch_block(b, wd.n), solve_item, &sj) != CVAR_OK) {
       fprintf(stderr, "calcvar batch: out of memory\n");
       ok = 0;
@@ -668,8 +677,8 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     }
     buf.len = 0;
     for (int r = 0; r < wd.n; r++)
-      cli_buf_put(&buf, tb[where[r][0]].data + where[r][1], where[r][2]);
-    for (int k = 0; k < threads; k++) ok &= !tb[k].failed;
+      cli_buf_put(&buf, ts[where[r][0]].tb.data + where[r][1], where[r][2]);
+    for (int k = 0; k < threads; k++) ok &= !ts[k].tb.failed;
     if (buf.failed || !ok) {
       ok = 0;
       break;
@@ -681,14 +690,14 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     done_rows += wn;
     if (tty) {
       failures = 0;
-      for (int k = 0; k < threads; k++) failures += tfails[k];
+      for (int k = 0; k < threads; k++) failures += ts[k].fails;
       double el = wall() - t0;
       fprintf(stderr, "\rcalcvar batch: %ld/%ld rows, %.1f rows/s, %ld failed", done_rows, nrows,
               el > 0 ? done_rows / el : 0.0, failures);
     }
   }
   failures = 0;
-  for (int k = 0; k < threads; k++) failures += tfails[k];
+  for (int k = 0; k < threads; k++) failures += ts[k].fails;
   if (tty) fputc('\n', stderr);
   if (!ok) {
     rc = EXIT_UNSOLVED;
@@ -707,10 +716,8 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
 done:
   cli_outfile_abandon(&of);
   free(buf.data);
-  for (int k = 0; tb && k < threads; k++) free(tb[k].data);
-  free(tb);
-  free(tres);
-  free(tfails);
+  for (int k = 0; ts && k < threads; k++) free(ts[k].tb.data);
+  free(ts);
   free(outs);
   free(bad);
   free(where);
