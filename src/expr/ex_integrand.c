@@ -48,7 +48,10 @@ static int alloc_buffers(ex_integrand *g) {
   g->pbuf = cv_calloc((size_t)(g->np ? g->np : 1) * EX_INTEGRAND_BATCH, sizeof *g->pbuf);
   g->pval = cv_calloc((size_t)g->np + 1, sizeof *g->pval);
   g->pfill = 0;
-  return g->work && g->scratch && g->in && g->outp && g->pbuf && g->pval ? 0 : -1;
+  if (!(g->work && g->scratch && g->in && g->outp && g->pbuf && g->pval)) return -1;
+  /* the parameter slots read their batches, at every evaluation */
+  for (int j = 0; j < g->np; j++) g->in[1 + 2 * g->n + j] = g->pbuf + (size_t)j * EX_INTEGRAND_BATCH;
+  return 0;
 }
 
 ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, char *err,
@@ -202,7 +205,6 @@ static int eval_into(ex_integrand *g, int m, const double *x, const double *y, c
       g->in[1 + i] = y + i * M + k0;
       g->in[1 + n + i] = dy ? dy + i * M + k0 : NULL; /* NULL: a constraint G(x, y) */
     }
-    for (int j = 0; j < g->np; j++) g->in[1 + 2 * n + j] = g->pbuf + (size_t)j * EX_INTEGRAND_BATCH;
     g->outp[0] = dest(g, F, (size_t)k0, 0);
     if (level >= 1) {
       for (int i = 0; i < n; i++) {

@@ -87,6 +87,8 @@ void cv_batch_free(cv_batch *b) {
   cv_free(b->w);
   scene_free(b->check);
   cv_free(b->sing);
+  cv_free(b->rep_used);
+  cv_free(b->guess_used);
   ex_integrand_free(b->F);
   for (int k = 0; b->cons && k < b->s->ncons; k++) ex_integrand_free(b->cons[k]);
   for (int k = 0; b->ints && k < b->s->nints; k++) ex_integrand_free(b->ints[k]);
@@ -133,6 +135,16 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen) {
   if (!b->cons || !b->ints || !b->outname || !b->given || !b->check) goto nomem;
   for (int i = 0; i < s->n; i++) b->any_exact |= s->exact[i] >= 0;
   if ((b->nsing = scene_singular_candidates(s, &b->sing)) < 0) goto nomem;
+  b->rep_used = cv_calloc((size_t)b->np + 1, 1);
+  b->guess_used = cv_calloc((size_t)b->np + 1, 1);
+  if (!b->rep_used || !b->guess_used) goto nomem;
+  for (int j = 0; j < b->np; j++) {
+    int slot = 1 + 2 * s->n + j;
+    for (int r = 0; r < s->nreports && !b->rep_used[j]; r++)
+      b->rep_used[j] = (unsigned char)ex_depends_on(s->dag, s->reports[r].expr, slot);
+    for (int i = 0; i < s->n && !b->guess_used[j]; i++)
+      b->guess_used[j] = s->guess[i] >= 0 && ex_depends_on(s->dag, s->guess[i], slot);
+  }
   /* Compile once: every expression of the problem with the parameters as inputs. */
   if (!(b->F = ex_integrand_new_params(s->dag, s->n, b->np, s->F, b->need, msg, sizeof msg))) {
     snprintf(err, errlen, "%s:%d: integrand: %s", s->file, s->F_line,

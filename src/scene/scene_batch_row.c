@@ -106,13 +106,15 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
   return p;
 }
 
-/* The parameter batches w->pb (one per parameter, each its value repeated), filled for the
- * first min(m, QBATCH) points only: a row's reports need a few points, not a whole batch. */
-static void fill_params(worker *w, int m) {
+/* The parameter batches w->pb (one per parameter, each its value repeated) of the
+ * parameters a tape reads (used[j]), filled for the first min(m, QBATCH) points only: a
+ * row's reports need a few points of a few parameters, not whole batches of all. */
+static void fill_params(worker *w, int m, const unsigned char *used) {
   const scene *s = w->inst;
   int mm = m < QBATCH ? m : QBATCH;
   for (int j = 0; j < s->nparams; j++)
-    for (int k = 0; k < mm; k++) w->pb[(size_t)j * QBATCH + k] = s->params[j].value;
+    if (used[j])
+      for (int k = 0; k < mm; k++) w->pb[(size_t)j * QBATCH + k] = s->params[j].value;
 }
 
 /* cv_guess_fn over the compiled [guess] tape; the default (the straight line between
@@ -125,7 +127,7 @@ int sc_batch_guess(int m, const double *x, double *y, void *user) {
   const double *in[1 + 2 * n + np];
   double *out[b->nguess + 1];
   for (int q = 0; q < 1 + 2 * n + np; q++) in[q] = NULL;
-  fill_params(w, m);
+  fill_params(w, m, b->guess_used);
   for (int j = 0; j < np; j++) in[1 + 2 * n + j] = w->pb + (size_t)j * QBATCH;
   for (int k0 = 0; k0 < m; k0 += QBATCH) {
     int mm = m - k0 < QBATCH ? m - k0 : QBATCH;
@@ -171,7 +173,7 @@ static int eval_reports(const cv_batch *b, worker *w, double *out) {
   int ns = 1 + 2 * n + np;
   const double *in[ns];
   double *o[s->nreports];
-  fill_params(w, nq);
+  fill_params(w, nq, b->rep_used);
   for (int j = 0; j < np; j++) in[1 + 2 * n + j] = w->pb + (size_t)j * QBATCH;
   for (int r = 0; r < s->nreports; r++) {
     out[r] = 0.0;
