@@ -246,8 +246,8 @@ static int check_item(cv_batch *b, int t, int r, void *user) {
   check_job *j = user;
   double *v = j->vals + (size_t)t * stride(j->w->ncols);
   char err[8];
-  j->bad[r] = window_values(j->w, r, v) != 0 ||
-              scene_batch_check_row(b, t, v, err, sizeof err) != CVAR_OK;
+  j->bad[r] =
+      window_values(j->w, r, v) != 0 || scene_batch_check_row(b, t, v, err, sizeof err) != CVAR_OK;
   return 0;
 }
 
@@ -269,7 +269,7 @@ static void bad_row_message(cv_batch *b, const table *t, const window *w, int r,
 typedef struct {
   const window *w;
   const cli_batch_cols *cols;
-  long first; /* number of the window's first row in the table */
+  long first;          /* number of the window's first row in the table */
   double *vals, *outs; /* per thread (stride) */
   thread_state *ts;
   size_t (*where)[3];
@@ -312,7 +312,8 @@ static void integer(cli_buf *o, long v) {
   char d[24];
   int k = (int)sizeof d;
   unsigned long u = v < 0 ? 0UL - (unsigned long)v : (unsigned long)v;
-  do d[--k] = (char)('0' + u % 10); while ((u /= 10) > 0);
+  do d[--k] = (char)('0' + u % 10);
+  while ((u /= 10) > 0);
   if (v < 0) d[--k] = '-';
   cli_buf_put(o, d + k, sizeof d - (size_t)k);
 }

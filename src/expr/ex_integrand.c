@@ -50,7 +50,8 @@ static int alloc_buffers(ex_integrand *g) {
   g->pfill = 0;
   if (!(g->work && g->scratch && g->in && g->outp && g->pbuf && g->pval)) return -1;
   /* the parameter slots read their batches, at every evaluation */
-  for (int j = 0; j < g->np; j++) g->in[1 + 2 * g->n + j] = g->pbuf + (size_t)j * EX_INTEGRAND_BATCH;
+  for (int j = 0; j < g->np; j++)
+    g->in[1 + 2 * g->n + j] = g->pbuf + (size_t)j * EX_INTEGRAND_BATCH;
   return 0;
 }
 

@@ -55,7 +55,7 @@ typedef enum {
   T_GE,
   T_IF,
   T_TABLE, /* a table's spline or partial at 1..3 operands (ex_table.c, theory TB-2) */
-  T_SINCOS  /* sin(a) into dst and cos(a) into c: one call for both (the partials of a
+  T_SINCOS /* sin(a) into dst and cos(a) into c: one call for both (the partials of a
                sin or cos have the other) */
 } tape_op;
 
@@ -70,7 +70,7 @@ typedef struct {
   double (*fn)(double); /* T_FN1: the libm function */
   double k;             /* scalar operand (K variants, T_FILL) */
   loc dst, a, b, c;
-  int tab, multi; /* T_TABLE: index in the tape's tables and in its call groups */
+  int tab, multi;     /* T_TABLE: index in the tape's tables and in its call groups */
   int pd, pa, pb, pc; /* the locations as indices of ex_tape_eval's pointer table */
 } instr;
 
@@ -483,7 +483,8 @@ typedef const double *restrict cptr;
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
-static inline void run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
+static inline void
+run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
   const double K = in->k;
   switch (in->op) {
   case T_FILL: LOOP(K); break;
@@ -526,7 +527,7 @@ static inline void run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
   case T_GT: LOOP(A[k] > B[k] ? 1.0 : 0.0); break;
   case T_GE: LOOP(A[k] >= B[k] ? 1.0 : 0.0); break;
   case T_IF: LOOP(A[k] != 0 ? B[k] : C[k]); break;
-  case T_TABLE:  /* run_table */
+  case T_TABLE:         /* run_table */
   case T_SINCOS: break; /* run_sincos */
   }
 }

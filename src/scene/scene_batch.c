@@ -411,7 +411,7 @@ void scene_batch_solve_row(cv_batch *b, int t, int row, const double *vals, cv_b
 cv_status scene_batch_check_row(cv_batch *b, int t, const double *row, char *err, size_t errlen) {
   worker *w = &b->w[t];
   return sc_batch_set_row(b, w->inst, w->pv, w->rv, w->rw, row, err, errlen) < 0 ? CVAR_EINVAL
-                                                                                : CVAR_OK;
+                                                                                 : CVAR_OK;
 }
 
 typedef struct {

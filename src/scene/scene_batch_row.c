@@ -269,7 +269,8 @@ static void put_int(char *buf, size_t cap, size_t *k, int v) {
   int i = (int)sizeof d - 1;
   unsigned u = v < 0 ? 0U - (unsigned)v : (unsigned)v;
   d[i] = '\0';
-  do d[--i] = (char)('0' + u % 10); while ((u /= 10) > 0);
+  do d[--i] = (char)('0' + u % 10);
+  while ((u /= 10) > 0);
   if (v < 0) d[--i] = '-';
   put(buf, cap, k, d + i);
 }
@@ -303,8 +304,8 @@ static void compose_message(cv_batch_result *r, const cv_solver *sv, int morse, 
       put(r->message, cap, &k, ".");
     }
     if (detail && detail[0] && strncmp(detail, "converged in ", 13) != 0) {
-      char first[3] = {' ', detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A' : detail[0],
-                       '\0'};
+      char first[3] = {
+          ' ', detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A' : detail[0], '\0'};
       put(r->message, cap, &k, first);
       put(r->message, cap, &k, detail + 1);
       put(r->message, cap, &k, ".");
@@ -368,7 +369,8 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
   r->iterations = cv_solver_get_num_iterations(w->sv);
   int morse = -1, nfree = 0, degenerate = 0;
   double xs, alpha;
-  if (st == CVAR_OK && scene_interior_singularity_of(w->inst, w->sv, b->nsing, b->sing, &xs, &alpha) == 1) {
+  if (st == CVAR_OK &&
+      scene_interior_singularity_of(w->inst, w->sv, b->nsing, b->sing, &xs, &alpha) == 1) {
     /* as `solve` does: a finite discrete action of an infinite one (theory (SG-1)) */
     r->status = CVAR_ENONFINITE;
     snprintf(r->message, sizeof r->message,
