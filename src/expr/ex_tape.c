@@ -481,10 +481,11 @@ typedef const double *restrict cptr;
 /* Inlined into the evaluation loop: a call per instruction (saving and restoring its
  * registers) costs as much as the loop of a few points. */
 #if defined(__GNUC__)
-__attribute__((always_inline))
+#define EX_INLINE inline __attribute__((always_inline))
+#else
+#define EX_INLINE inline
 #endif
-static inline void
-run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
+static EX_INLINE void run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
   const double K = in->k;
   switch (in->op) {
   case T_FILL: LOOP(K); break;
