@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "calcvar.h"
@@ -34,11 +35,20 @@ static double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// Wall seconds of a shell command; -1 when it fails.
-static double timed(const std::string &cmd) {
-  double t0 = now();
+// CPU seconds (user + system) of the children waited for so far.
+static double child_cpu() {
+  struct rusage ru;
+  getrusage(RUSAGE_CHILDREN, &ru);
+  return (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+         (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+}
+
+// Wall seconds of a shell command (its CPU seconds into *cpu); -1 when it fails.
+static double timed(const std::string &cmd, double *cpu = nullptr) {
+  double t0 = now(), c0 = child_cpu();
   int rc = std::system(cmd.c_str());
   double t = now() - t0;
+  if (cpu) *cpu = child_cpu() - c0;
   if (rc != 0) {
     std::printf("  (command failed, status %d: %s)\n", rc, cmd.c_str());
     return -1;
@@ -180,15 +190,48 @@ int main(int argc, char **argv) {
   std::printf("  calcvar batch, 2 threads          %8.2f us/row   speed-up %.2f  "
               "max |error| %.2e m, %ld > 1 mm, %ld not converged\n",
               1e6 * t2 / N, t1 / t2, c2.maxerr, c2.wrong, c2.failed);
+
+  // Scaling on a longer table (the pairs repeated to about 10^5 rows, so that a run is
+  // seconds, not milliseconds): wall and CPU time per row, and for MPI the launcher's
+  // start-up (mpirun on a one-row table, same run) apart from the rows' time.
+  long R = N < 100000 ? (100000 + N - 1) / N : 1, NB = R * N;
+  std::string big = tmp + "/big.csv", one = tmp + "/one.csv";
+  {
+    FILE *fb = std::fopen(big.c_str(), "w"), *f1 = std::fopen(one.c_str(), "w");
+    if (!fb || !f1) return 1;
+    std::fprintf(fb, "lat1,lon1,lat2,lon2\n");
+    std::fprintf(f1, "lat1,lon1,lat2,lon2\n%.17g,%.17g,%.17g,%.17g\n", P[0], P[1], P[2], P[3]);
+    for (long r = 0; r < R; r++)
+      for (long i = 0; i < N; i++)
+        std::fprintf(fb, "%.17g,%.17g,%.17g,%.17g\n", P[4 * i], P[4 * i + 1], P[4 * i + 2],
+                     P[4 * i + 3]);
+    std::fclose(fb);
+    std::fclose(f1);
+  }
+  std::string bigb = std::string(CV_CALCVAR) + " batch " + scene + " " + big;
+  double cpu1, cpu2;
+  double b1 = timed(bigb + " --threads 1 --out " + tmp + "/b1.csv", &cpu1);
+  double b2 = timed(bigb + " --threads 2 --out " + tmp + "/b2.csv", &cpu2);
+  std::printf("  %ld rows: batch 1 thread %.2f us/row (CPU %.2f), 2 threads %.2f us/row (CPU "
+              "%.2f): speed-up %.2f, CPU per row 2 threads / 1 thread %.2f\n",
+              NB, 1e6 * b1 / NB, 1e6 * cpu1 / NB, 1e6 * b2 / NB, 1e6 * cpu2 / NB, b1 / b2,
+              cpu2 / cpu1);
 #ifdef CV_MPIRUN
   std::string mpi = std::string(CV_MPIRUN) + " --oversubscribe" +
                     (geteuid() == 0 ? " --allow-run-as-root" : "") + " -np ";
-  double m1 = timed(mpi + "1 " + base + " --threads 1 --out " + tmp + "/m1.csv");
-  double m2 = timed(mpi + "2 " + base + " --threads 1 --out " + tmp + "/m2.csv");
-  Check cm = compare(lengths(tmp + "/m2.csv", "s"), ref);
-  std::printf("  mpirun -np 1 / -np 2 (1 thread)   %8.2f / %.2f us/row   speed-up %.2f  "
+  std::string oneb = std::string(CV_CALCVAR) + " batch " + scene + " " + one;
+  double s1 = timed(mpi + "1 " + oneb + " --threads 1 --out " + tmp + "/s1.csv");
+  double s2 = timed(mpi + "2 " + oneb + " --threads 1 --out " + tmp + "/s2.csv");
+  double m1 = timed(mpi + "1 " + bigb + " --threads 1 --out " + tmp + "/m1.csv");
+  double m2 = timed(mpi + "2 " + bigb + " --threads 1 --out " + tmp + "/m2.csv");
+  std::vector<double> refb;
+  for (long r = 0; r < R; r++) refb.insert(refb.end(), ref.begin(), ref.end());
+  Check cm = compare(lengths(tmp + "/m2.csv", "s"), refb);
+  std::printf("  %ld rows: mpirun -np 1 / -np 2 (1 thread each) %.2f / %.2f s, speed-up %.2f; "
+              "start-up (one row) %.2f / %.2f s; without it %.2f / %.2f us/row, speed-up %.2f  "
               "max |error| %.2e m, %ld > 1 mm, %ld not converged\n",
-              1e6 * m1 / N, 1e6 * m2 / N, m1 / m2, cm.maxerr, cm.wrong, cm.failed);
+              NB, m1, m2, m1 / m2, s1, s2, 1e6 * (m1 - s1) / NB, 1e6 * (m2 - s2) / NB,
+              (m1 - s1) / (m2 - s2), cm.maxerr, cm.wrong, cm.failed);
 #else
   std::printf("  mpirun: not measured (calcvar built without MPI)\n");
 #endif

@@ -23,7 +23,9 @@
 #include "cli/cli_batch.h"
 #include "scene/scene_batch.h"
 
-enum { ROWS_PER_THREAD = 32 }; /* window = threads x this (x ranks under MPI) */
+/* window = threads x this (x ranks under MPI): the threads meet once a window (and the
+ * ranks, to gather it), so a window is many rows; memory depends on it only. */
+enum { ROWS_PER_THREAD = 256 };
 
 static void usage(FILE *f) {
   fputs("usage: calcvar batch SCENE TABLE.csv [options]\n"
@@ -97,8 +99,9 @@ static void table_close(table *t) {
   memset(t, 0, sizeof *t);
 }
 
-/* Open and read the header. 0, or EXIT_BADINPUT after a message. */
-static int table_open(table *t, const char *path, cv_batch *b) {
+/* Open and read the header (and make its names the batch's columns when set_columns). 0, or
+ * EXIT_BADINPUT after a message. */
+static int table_open(table *t, const char *path, cv_batch *b, int set_columns) {
   char err[512];
   memset(t, 0, sizeof *t);
   t->path = path;
@@ -130,69 +133,249 @@ static int table_open(table *t, const char *path, cv_batch *b) {
   t->ncols = k;
   for (int c = 0; c < k; c++)
     if (!(t->names[c] = strdup(t->field[c]))) return EXIT_BADINPUT;
-  if (cv_batch_set_columns(b, k, (const char *const *)t->names, err, sizeof err) != CVAR_OK) {
+  if (set_columns &&
+      cv_batch_set_columns(b, k, (const char *const *)t->names, err, sizeof err) != CVAR_OK) {
     fprintf(stderr, "%s:%d: %s\n", path, t->lineno, err[0] ? err : "out of memory");
     return EXIT_BADINPUT;
   }
   return 0;
 }
 
-/* Next row into vals (ncols numbers): 1, 0 at the end, or EXIT_BADINPUT (negated: -2)
- * after a message. */
-static int table_row(table *t, double *vals) {
+/* ---- windows of rows ---------------------------------------------------------------- */
+
+/* Rows read from the table and not yet solved: their fields' text (copied: the line
+ * buffer is reused) and line numbers. */
+typedef struct {
+  int n, cap, ncols;
+  char *store;
+  size_t slen, scap;
+  size_t *off; /* off[r * ncols + c]: field c of row r in store */
+  int *line;
+} window;
+
+static void window_free(window *w) {
+  free(w->store);
+  free(w->off);
+  free(w->line);
+  memset(w, 0, sizeof *w);
+}
+
+/* The current line's fields as row w->n of the window. 0, or -1 out of memory. */
+static int window_add(window *w, const table *t) {
+  if (w->n == w->cap) {
+    int ncap = w->cap ? 2 * w->cap : 256;
+    size_t *no = realloc(w->off, (size_t)ncap * (size_t)(w->ncols + 1) * sizeof *no);
+    if (!no) return -1;
+    w->off = no;
+    int *nl = realloc(w->line, (size_t)ncap * sizeof *nl);
+    if (!nl) return -1;
+    w->line = nl;
+    w->cap = ncap;
+  }
+  for (int c = 0; c < w->ncols; c++) {
+    size_t l = strlen(t->field[c]) + 1;
+    if (w->slen + l > w->scap) {
+      size_t ncap = w->scap ? 2 * w->scap : 4096;
+      while (ncap < w->slen + l) ncap *= 2;
+      char *ns = realloc(w->store, ncap);
+      if (!ns) return -1;
+      w->store = ns, w->scap = ncap;
+    }
+    memcpy(w->store + w->slen, t->field[c], l);
+    w->off[(size_t)w->n * w->ncols + c] = w->slen;
+    w->slen += l;
+  }
+  w->line[w->n++] = t->lineno;
+  return 0;
+}
+
+static const char *window_field(const window *w, int r, int c) {
+  return w->store + w->off[(size_t)r * w->ncols + c];
+}
+
+/* Row r's numbers into vals: 0, or 1 + the first column that is not a finite number. */
+static int window_values(const window *w, int r, double *vals) {
+  for (int c = 0; c < w->ncols; c++) {
+    const char *f = window_field(w, r, c);
+    char *end;
+    vals[c] = strtod(f, &end);
+    if (end == f || *end || !isfinite(vals[c])) return 1 + c;
+  }
+  return 0;
+}
+
+/* The next line of the table as fields: 1, 0 at the end, or -EXIT_BADINPUT with the
+ * message in msg (read error, wrong number of fields). The numbers are read by the
+ * workers. */
+static int table_fields(table *t, char *msg, size_t len) {
   int k = next_line(t, t->ncols);
   if (k == 0) return 0;
   if (k < 0) {
-    fprintf(stderr, "%s:%d: read error\n", t->path, t->lineno);
+    snprintf(msg, len, "%s:%d: read error", t->path, t->lineno);
     return -EXIT_BADINPUT;
   }
   if (k != t->ncols) {
-    fprintf(stderr, "%s:%d: %d value%s, but the header has %d column%s\n", t->path, t->lineno, k,
-            k == 1 ? "" : "s", t->ncols, t->ncols == 1 ? "" : "s");
+    snprintf(msg, len, "%s:%d: %d value%s, but the header has %d column%s", t->path, t->lineno, k,
+             k == 1 ? "" : "s", t->ncols, t->ncols == 1 ? "" : "s");
     return -EXIT_BADINPUT;
-  }
-  for (int c = 0; c < k; c++) {
-    char *end;
-    errno = 0;
-    vals[c] = strtod(t->field[c], &end);
-    if (end == t->field[c] || *end || !isfinite(vals[c])) {
-      fprintf(stderr, "%s:%d: column '%s': '%s' is not a finite number\n", t->path, t->lineno,
-              t->names[c], t->field[c]);
-      return -EXIT_BADINPUT;
-    }
   }
   return 1;
 }
 
-/* ---- one output row ----------------------------------------------------------------- */
+/* Per-thread arrays of k doubles each, one after the other: a thread's slice starts at
+ * t * stride(k), a multiple of 8 doubles (a cache line) with a line to spare, so two
+ * threads never write into one line (false sharing costs more than the row's text). */
+static size_t stride(int k) { return ((size_t)k + 7) / 8 * 8 + 8; }
 
-static void num(cli_buf *o, double v, const char *fmt) {
-  cli_buf_printf(o, ",");
-  if (isfinite(v)) cli_buf_printf(o, fmt, v);
+/* Per-thread state of pass 2, padded to keep the threads' lines apart (as above). */
+typedef struct {
+  cli_buf tb;          /* the thread's formatted rows of the window */
+  cv_batch_result res; /* the row being solved */
+  long fails;
+  char pad[64];
+} thread_state;
+
+/* Pass 1 on the workers: bad[r] = 0, or 1 when row r of the window is not a row of
+ * numbers or not a valid scene. */
+typedef struct {
+  const window *w;
+  double *vals; /* ncols per thread */
+  unsigned char *bad;
+} check_job;
+
+static int check_item(cv_batch *b, int t, int r, void *user) {
+  check_job *j = user;
+  double *v = j->vals + (size_t)t * stride(j->w->ncols);
+  char err[8];
+  j->bad[r] =
+      window_values(j->w, r, v) != 0 || scene_batch_check_row(b, t, v, err, sizeof err) != CVAR_OK;
+  return 0;
 }
 
-/* The row's output line (input fields as given) appended to o. */
-static void format_row(cli_buf *o, const cli_batch_cols *cols, char *const *in,
+/* Row r's message into msg, found again on this thread (the first bad row only). */
+static void bad_row_message(cv_batch *b, const table *t, const window *w, int r, double *vals,
+                            char *msg, size_t len) {
+  char err[SC_ERRLEN];
+  int c = window_values(w, r, vals);
+  if (c > 0)
+    snprintf(msg, len, "%s:%d: column '%s': '%s' is not a finite number", t->path, w->line[r],
+             t->names[c - 1], window_field(w, r, c - 1));
+  else if (cv_batch_check_row(b, vals, err, sizeof err) != CVAR_OK)
+    /* the scene's message names the scene; the row is where the values came from */
+    snprintf(msg, len, "%s:%d: %s", t->path, w->line[r], err);
+}
+
+/* Pass 2 on the workers: read, solve and format row r of the window into the thread's
+ * buffer; where[r] = its text's thread, offset and length. */
+typedef struct {
+  const window *w;
+  const cli_batch_cols *cols;
+  long first;          /* number of the window's first row in the table */
+  double *vals, *outs; /* per thread (stride) */
+  thread_state *ts;
+  size_t (*where)[3];
+} solve_job;
+
+static void format_row(cli_buf *o, const cli_batch_cols *cols, const window *w, int row,
+                       const cv_batch_result *r);
+
+static int solve_item(cv_batch *b, int t, int r, void *user) {
+  solve_job *j = user;
+  double *v = j->vals + (size_t)t * stride(j->w->ncols);
+  thread_state *ts = &j->ts[t];
+  cv_batch_result *res = &ts->res;
+  res->outputs = j->outs + (size_t)t * stride(j->cols->nout);
+  if (window_values(j->w, r, v) != 0) return -1; /* checked in pass 1 */
+  scene_batch_solve_row(b, t, (int)(j->first + r), v, res);
+  size_t at = ts->tb.len;
+  format_row(&ts->tb, j->cols, j->w, r, res);
+  j->where[r][0] = (size_t)t, j->where[r][1] = at, j->where[r][2] = ts->tb.len - at;
+  ts->fails += res->status != CVAR_OK;
+  return 0;
+}
+
+/* ---- one output row ----------------------------------------------------------------- */
+
+/* ",v" with v in fmt (one conversion), nothing after the comma when v is not finite.
+ * strfromd formats the number directly: printf's machinery costs several times more per
+ * call (with the printf hooks some linked libraries register, every call takes glibc's
+ * slow positional path). */
+static void num(cli_buf *o, double v, const char *fmt) {
+  cli_buf_put(o, ",", 1);
+  if (!isfinite(v)) return;
+  char d[64];
+  int k = strfromd(d, sizeof d, fmt, v);
+  if (k > 0 && (size_t)k < sizeof d) cli_buf_put(o, d, (size_t)k);
+}
+
+/* A non-negative integer in decimal (no printf: a row has several). */
+static void integer(cli_buf *o, long v) {
+  char d[24];
+  int k = (int)sizeof d;
+  unsigned long u = v < 0 ? 0UL - (unsigned long)v : (unsigned long)v;
+  do d[--k] = (char)('0' + u % 10);
+  while ((u /= 10) > 0);
+  if (v < 0) d[--k] = '-';
+  cli_buf_put(o, d + k, sizeof d - (size_t)k);
+}
+
+/* The row's output line (input fields as given) appended to o. Strings and integers are
+ * copied and only the real numbers go through printf (a row's text costs about as much
+ * as its LDL^T otherwise: docs/performance.md). */
+static void format_row(cli_buf *o, const cli_batch_cols *cols, const window *w, int row,
                        const cv_batch_result *r) {
-  for (int c = 0; c < cols->ncols; c++) cli_buf_printf(o, "%s%s", c ? "," : "", in[c]);
-  cli_buf_printf(o, "%s%s", cols->ncols ? "," : "", cli_status_string(r->status));
+  for (int c = 0; c < cols->ncols; c++) {
+    const char *in = window_field(w, row, c);
+    if (c) cli_buf_put(o, ",", 1);
+    cli_buf_put(o, in, strlen(in));
+  }
+  if (cols->ncols) cli_buf_put(o, ",", 1);
+  const char *st = cli_status_string(r->status);
+  cli_buf_put(o, st, strlen(st));
   num(o, r->has_result ? r->action : NAN, "%.17g");
-  cli_buf_printf(o, ",%d", r->iterations);
+  cli_buf_put(o, ",", 1);
+  integer(o, r->iterations);
   num(o, r->time_s, "%.6f");
-  cli_buf_printf(o, ",");
-  if (r->has_result && r->morse_index >= 0) cli_buf_printf(o, "%d", r->morse_index);
+  cli_buf_put(o, ",", 1);
+  if (r->has_result && r->morse_index >= 0) integer(o, r->morse_index);
   if (cols->err_nodal) num(o, r->has_result ? r->error_max_nodal : NAN, "%.3e");
   if (cols->err_est) num(o, r->has_result ? r->error_estimate : NAN, "%.3e");
   for (int k = 0; k < cols->nout; k++) num(o, r->has_result ? r->outputs[k] : NAN, "%.17g");
-  /* the message as one quoted CSV field */
-  cli_buf_printf(o, ",\"");
-  for (const char *m = r->message; *m; m++) {
-    if (*m == '"')
-      cli_buf_printf(o, "\"\"");
-    else if (*m != '\n' && *m != '\r')
-      cli_buf_printf(o, "%c", *m);
+  /* the message as one quoted CSV field: quotes doubled, line ends dropped */
+  cli_buf_put(o, ",\"", 2);
+  const char *m = r->message;
+  while (*m) {
+    size_t run = strcspn(m, "\"\n\r");
+    cli_buf_put(o, m, run);
+    m += run;
+    if (*m == '"') cli_buf_put(o, "\"\"", 2);
+    if (*m) m++;
   }
-  cli_buf_printf(o, "\"\n");
+  cli_buf_put(o, "\"\n", 2);
+}
+
+/* Room for `more` bytes after the text of o. 0, or -1 (o->failed) out of memory. */
+static int reserve(cli_buf *o, size_t more) {
+  if (o->failed) return -1;
+  if (o->data && o->cap - o->len > more) return 0;
+  size_t ncap = o->cap ? o->cap : 1024;
+  while (ncap - o->len <= more) ncap *= 2;
+  char *nd = realloc(o->data, ncap);
+  if (!nd) {
+    o->failed = 1;
+    return -1;
+  }
+  o->data = nd;
+  o->cap = ncap;
+  return 0;
+}
+
+int cli_buf_put(cli_buf *o, const char *s, size_t len) {
+  if (reserve(o, len) < 0) return -1;
+  memcpy(o->data + o->len, s, len);
+  o->len += len;
+  o->data[o->len] = '\0';
+  return 0;
 }
 
 int cli_buf_printf(cli_buf *o, const char *fmt, ...) {
@@ -335,11 +518,12 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
   memset(&t, 0, sizeof t);
   cli_outfile of = {0};
   cv_batch *b = NULL;
-  double *vals = NULL;
-  char **text = NULL;
-  cv_batch_result *res = NULL;
-  double *outs = NULL;
+  double *vals = NULL, *outs = NULL;
+  window wd = {0};
   cli_buf buf = {0};
+  thread_state *ts = NULL;
+  unsigned char *bad = NULL;
+  size_t(*where)[3] = NULL;
   scene *s = scene_load_file_inputs(o->scene_path, o->nset, o->set, err, sizeof err);
   if (!s) {
     fprintf(stderr, "%s\n", err);
@@ -367,7 +551,7 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     fprintf(stderr, "%s\n", err);
     goto done;
   }
-  if ((rc = table_open(&t, table_path, b)) != 0) goto done;
+  if ((rc = table_open(&t, table_path, b, 1)) != 0) goto done;
   rc = EXIT_BADINPUT;
   if (settings_line && t.ncols > 0) {
     /* a [mesh]/[solver] number computed from a parameter: it would have to follow the
@@ -379,31 +563,73 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     goto done;
   }
   int nc = t.ncols;
-  vals = malloc(((size_t)nc + 1) * sizeof *vals);
-  if (!vals) goto done;
-  /* Pass 1: the whole table is checked before anything is written. */
-  long nrows = 0;
-  for (;;) {
-    int k = table_row(&t, vals);
-    if (k < 0) goto done;
-    if (k == 0) break;
-    if (cv_batch_check_row(b, vals, err, sizeof err) != CVAR_OK) {
-      /* the scene's message names the scene; the row is where the values came from */
-      fprintf(stderr, "%s:%d: %s\n", t.path, t.lineno, err);
+  if (threads == 0) threads = cli_cores_available();
+  cv_batch_set_threads(b, threads);
+  cv_batch_set_warm_start(b, warm);
+  /* Windows: W rows per rank (threads x ROWS_PER_THREAD), under MPI the ranks take
+   * consecutive blocks of one window of W * size rows. */
+  int W = threads * ROWS_PER_THREAD, wsz = W * mpi->size;
+  vals = malloc((size_t)threads * stride(nc) * sizeof *vals);
+  wd.ncols = nc;
+  ts = calloc((size_t)threads, sizeof *ts);
+  outs = malloc((size_t)threads * stride(cv_batch_num_outputs(b)) * sizeof *outs);
+  bad = malloc((size_t)W + 1);
+  where = malloc(((size_t)W + 1) * sizeof *where);
+  if (!vals || !ts || !outs || !bad || !where) {
+    fprintf(stderr, "calcvar batch: out of memory\n");
+    goto done;
+  }
+
+  /* Pass 1: the whole table is checked before anything is written. Lines are read and
+   * counted here; the numbers and the scene each row makes are checked by the workers
+   * (each rank its blocks); the first bad row over all ranks is reported. */
+  long nrows = 0, first_bad = LONG_MAX;
+  int kind = 0; /* of this rank's first bad row: 1 a value, 2 the line itself */
+  char badmsg[2 * SC_ERRLEN] = "";
+  for (int at_end = 0; !at_end && first_bad == LONG_MAX;) {
+    long w0 = nrows, m0 = w0 + (long)mpi->rank * W;
+    wd.n = 0, wd.slen = 0;
+    for (long r = w0; r < w0 + wsz; r++) {
+      int k = table_fields(&t, badmsg, sizeof badmsg);
+      if (k == 0) {
+        at_end = 1;
+        break;
+      }
+      if (k < 0) { /* every rank sees it; rank 0 says so */
+        first_bad = r, kind = 2, at_end = 1;
+        break;
+      }
+      nrows++;
+      if (r >= m0 && r < m0 + W && window_add(&wd, &t) < 0) {
+        fprintf(stderr, "calcvar batch: out of memory\n");
+        goto done;
+      }
+    }
+    check_job cj = {&wd, vals, bad};
+    if (scene_batch_for_each(b, wd.n, scene_batch_block(b, wd.n), check_item, &cj) != CVAR_OK) {
+      fprintf(stderr, "calcvar batch: out of memory\n");
       goto done;
     }
-    nrows++;
+    for (int r = 0; r < wd.n; r++)
+      if (bad[r] && m0 + r < first_bad) {
+        first_bad = m0 + r, kind = 1;
+        bad_row_message(b, &t, &wd, r, vals, badmsg, sizeof badmsg);
+        break;
+      }
+  }
+  long global_bad = cli_mpi_min_long(mpi, first_bad);
+  if (global_bad != LONG_MAX) { /* said once: by the rank whose row it is */
+    if (first_bad == global_bad && (kind == 1 || mpi->rank == 0)) fprintf(stderr, "%s\n", badmsg);
+    goto done;
   }
   if (nrows > INT_MAX / 2) {
     fprintf(stderr, "%s: more than %d rows\n", t.path, INT_MAX / 2);
     goto done;
   }
   table_close(&t);
-  if ((rc = table_open(&t, table_path, b)) != 0) goto done;
+  /* the header again (the columns were set from it in pass 1, before the workers) */
+  if ((rc = table_open(&t, table_path, b, 0)) != 0) goto done;
   rc = EXIT_BADINPUT;
-  if (threads == 0) threads = cli_cores_available();
-  cv_batch_set_threads(b, threads);
-  cv_batch_set_warm_start(b, warm);
   if (out_path && strcmp(out_path, table_path) == 0) {
     fprintf(stderr, "calcvar batch: --out %s would overwrite the table being read\n", out_path);
     goto done;
@@ -425,80 +651,37 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     fprintf(f, ",message\n");
   }
 
-  /* Pass 2: windows of W rows per rank; under MPI the ranks take consecutive blocks of
-   * one window of W * size rows, and rank 0 writes them in order. */
-  int W = threads * ROWS_PER_THREAD, wsz = W * mpi->size;
-  text = calloc((size_t)W * nc + 1, sizeof *text);
-  double *wvals = malloc(((size_t)W * nc + 1) * sizeof *wvals);
-  res = calloc((size_t)W, sizeof *res);
-  outs = malloc(((size_t)W * cols.nout + 1) * sizeof *outs);
-  char *store = NULL; /* the field texts of the rank's rows (a copy: lines are reused) */
-  if (!text || !wvals || !res || !outs) {
-    free(wvals);
-    goto done;
-  }
-  for (int r = 0; r < W; r++) res[r].outputs = outs + (size_t)r * cols.nout;
+  /* Pass 2: each window is read here, solved and formatted by the workers (each into its
+   * own buffer), put together in input order and written (under MPI: rank 0 gathers). */
   long done_rows = 0, failures = 0;
   int tty = mpi->rank == 0 && isatty(2);
   double t0 = wall();
   int ok = 1;
   while (done_rows < nrows && ok) {
-    /* this window: rows [done_rows, done_rows + wsz); ours: a block of up to W */
     long w0 = done_rows, wn = nrows - w0 < wsz ? nrows - w0 : wsz;
-    long m0 = w0 + (long)mpi->rank * W, mine = 0;
-    size_t slen = 0, scap = 0;
-    free(store);
-    store = NULL;
-    size_t *off = malloc(((size_t)W * nc + 1) * sizeof *off);
-    if (!off) {
-      ok = 0;
-      break;
-    }
-    for (long r = w0; r < w0 + wn; r++) {
-      int k = table_row(&t, vals);
-      if (k <= 0) { /* the file changed since pass 1 */
+    long m0 = w0 + (long)mpi->rank * W;
+    wd.n = 0, wd.slen = 0;
+    for (long r = w0; r < w0 + wn && ok; r++) {
+      if (table_fields(&t, badmsg, sizeof badmsg) <= 0) { /* the file changed since pass 1 */
         fprintf(stderr, "%s: the table changed while it was read\n", t.path);
         ok = 0;
-        break;
+      } else if (r >= m0 && r < m0 + W && window_add(&wd, &t) < 0) {
+        ok = 0;
       }
-      if (r < m0 || r >= m0 + W) continue;
-      for (int c = 0; c < nc; c++) {
-        size_t l = strlen(t.field[c]) + 1;
-        if (slen + l > scap) {
-          size_t ncap = scap ? 2 * scap : 4096;
-          while (ncap < slen + l) ncap *= 2;
-          char *ns = realloc(store, ncap);
-          if (!ns) {
-            ok = 0;
-            break;
-          }
-          store = ns, scap = ncap;
-        }
-        memcpy(store + slen, t.field[c], l);
-        off[mine * nc + c] = slen;
-        slen += l;
-        wvals[mine * nc + c] = vals[c];
-      }
-      mine++;
     }
-    if (!ok) {
-      free(off);
-      break;
-    }
-    for (long r = 0; r < mine; r++)
-      for (int c = 0; c < nc; c++) text[r * nc + c] = store + off[r * nc + c];
-    free(off);
-    if (mine > 0 && cv_batch_solve(b, (int)mine, wvals, res) != CVAR_OK) {
+    if (!ok) break;
+    for (int k = 0; k < threads; k++) ts[k].tb.len = 0;
+    solve_job sj = {&wd, &cols, m0, vals, outs, ts, where};
+    if (scene_batch_for_each(b, wd.n, scene_batch_block(b, wd.n), solve_item, &sj) != CVAR_OK) {
       fprintf(stderr, "calcvar batch: out of memory\n");
       ok = 0;
       break;
     }
     buf.len = 0;
-    for (long r = 0; r < mine; r++) {
-      format_row(&buf, &cols, text + r * nc, &res[r]);
-      failures += res[r].status != CVAR_OK;
-    }
-    if (buf.failed) {
+    for (int r = 0; r < wd.n; r++)
+      cli_buf_put(&buf, ts[where[r][0]].tb.data + where[r][1], where[r][2]);
+    for (int k = 0; k < threads; k++) ok &= !ts[k].tb.failed;
+    if (buf.failed || !ok) {
       ok = 0;
       break;
     }
@@ -508,13 +691,15 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
     }
     done_rows += wn;
     if (tty) {
+      failures = 0;
+      for (int k = 0; k < threads; k++) failures += ts[k].fails;
       double el = wall() - t0;
       fprintf(stderr, "\rcalcvar batch: %ld/%ld rows, %.1f rows/s, %ld failed", done_rows, nrows,
               el > 0 ? done_rows / el : 0.0, failures);
     }
   }
-  free(wvals);
-  free(store);
+  failures = 0;
+  for (int k = 0; k < threads; k++) failures += ts[k].fails;
   if (tty) fputc('\n', stderr);
   if (!ok) {
     rc = EXIT_UNSOLVED;
@@ -533,10 +718,13 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
 done:
   cli_outfile_abandon(&of);
   free(buf.data);
+  for (int k = 0; ts && k < threads; k++) free(ts[k].tb.data);
+  free(ts);
   free(outs);
-  free(res);
-  free(text);
+  free(bad);
+  free(where);
   free(vals);
+  window_free(&wd);
   table_close(&t);
   cv_batch_free(b);
   return rc;

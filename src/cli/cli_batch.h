@@ -15,6 +15,8 @@ typedef struct {
   size_t len, cap;
   int failed;
 } cli_buf;
+/* Append len bytes of s (not NUL-terminated) to o. 0, or -1 out of memory (o->failed). */
+int cli_buf_put(cli_buf *o, const char *s, size_t len);
 int cli_buf_printf(cli_buf *o, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
@@ -37,6 +39,8 @@ void cli_mpi_init(cli_mpi *m);
 void cli_mpi_finish(cli_mpi *m);
 /* Rank 0 writes every rank's rows of the window to f, in rank order. 0, or -1. */
 int cli_mpi_gather_write(cli_mpi *m, FILE *f, const cli_buf *rows);
+/* The least of v over all ranks (every rank gets it). */
+long cli_mpi_min_long(cli_mpi *m, long v);
 /* The number of failed rows over all ranks (every rank gets it). */
 long cli_mpi_reduce_failures(cli_mpi *m, long failures);
 

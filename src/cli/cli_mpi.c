@@ -63,6 +63,12 @@ int cli_mpi_gather_write(cli_mpi *m, FILE *f, const cli_buf *rows) {
   return rc;
 }
 
+long cli_mpi_min_long(cli_mpi *m, long v) {
+  long least = v;
+  if (m->size > 1) MPI_Allreduce(&v, &least, 1, MPI_LONG, MPI_MIN, MPI_COMM_WORLD);
+  return least;
+}
+
 long cli_mpi_reduce_failures(cli_mpi *m, long failures) {
   long total = failures;
   if (m->size > 1) MPI_Allreduce(&failures, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
@@ -76,6 +82,10 @@ void cli_mpi_finish(cli_mpi *m) { (void)m; }
 int cli_mpi_gather_write(cli_mpi *m, FILE *f, const cli_buf *rows) {
   (void)m;
   return rows->len && fwrite(rows->data, 1, rows->len, f) != rows->len ? -1 : 0;
+}
+long cli_mpi_min_long(cli_mpi *m, long v) {
+  (void)m;
+  return v;
 }
 long cli_mpi_reduce_failures(cli_mpi *m, long failures) {
   (void)m;

@@ -10,7 +10,9 @@ struct ex_integrand {
   int n;
   int np;              /* parameters: tape slots 2n+1 .. 2n+np */
   int owns_tapes;      /* 0 for a clone (ex_integrand_clone) */
-  double *pbuf;        /* np batches, each filled with one parameter's value */
+  double *pbuf;        /* np batches, each filled with one parameter's value ... */
+  int pfill;           /* ... in its first pfill points (filled as evaluations need) */
+  double *pval;        /* the parameter values (np) */
   unsigned char *used; /* used[j]: the expression reads parameter j (shared by clones) */
   unsigned max_need;
   ex_tape *tape[3]; /* level 0: F; 1: F, Fy, Fp; 2: also Fyy (upper), Fyp, Fpp (upper) */
@@ -44,7 +46,13 @@ static int alloc_buffers(ex_integrand *g) {
   g->in = cv_malloc((size_t)(2 * g->n + 1 + g->np) * sizeof *g->in);
   g->outp = cv_malloc((size_t)nout * sizeof *g->outp);
   g->pbuf = cv_calloc((size_t)(g->np ? g->np : 1) * EX_INTEGRAND_BATCH, sizeof *g->pbuf);
-  return g->work && g->scratch && g->in && g->outp && g->pbuf ? 0 : -1;
+  g->pval = cv_calloc((size_t)g->np + 1, sizeof *g->pval);
+  g->pfill = 0;
+  if (!(g->work && g->scratch && g->in && g->outp && g->pbuf && g->pval)) return -1;
+  /* the parameter slots read their batches, at every evaluation */
+  for (int j = 0; j < g->np; j++)
+    g->in[1 + 2 * g->n + j] = g->pbuf + (size_t)j * EX_INTEGRAND_BATCH;
+  return 0;
 }
 
 ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, char *err,
@@ -57,7 +65,7 @@ ex_integrand *ex_integrand_clone(const ex_integrand *g) {
   if (!c) return NULL;
   *c = *g;
   c->owns_tapes = 0;
-  c->work = c->scratch = c->pbuf = NULL;
+  c->work = c->scratch = c->pbuf = c->pval = NULL;
   c->in = NULL;
   c->outp = NULL;
   if (alloc_buffers(c) < 0) {
@@ -67,11 +75,20 @@ ex_integrand *ex_integrand_clone(const ex_integrand *g) {
   return c;
 }
 
+/* The batches are filled lazily (fill_params): a batch solve sets new values for every
+ * row, and a small mesh evaluates a few points, not EX_INTEGRAND_BATCH. */
 void ex_integrand_set_params(ex_integrand *g, const double *p) {
+  for (int j = 0; j < g->np; j++) g->pval[j] = p[j];
+  g->pfill = 0;
+}
+
+/* The parameter batches valid for the first m points. */
+static void fill_params(ex_integrand *g, int m) {
+  if (m <= g->pfill) return;
   for (int j = 0; j < g->np; j++)
     if (g->used[j])
-      for (int k = 0; k < EX_INTEGRAND_BATCH; k++)
-        g->pbuf[(size_t)j * EX_INTEGRAND_BATCH + k] = p[j];
+      for (int k = g->pfill; k < m; k++) g->pbuf[(size_t)j * EX_INTEGRAND_BATCH + k] = g->pval[j];
+  g->pfill = m;
 }
 
 int ex_integrand_num_params(const ex_integrand *g) { return g->np; }
@@ -148,6 +165,7 @@ void ex_integrand_free(ex_integrand *g) {
     cv_free(g->used);
   }
   cv_free(g->pbuf);
+  cv_free(g->pval);
   cv_free(g->work);
   cv_free(g->scratch);
   cv_free(g->in);
@@ -187,6 +205,7 @@ static int eval_into(ex_integrand *g, int m, const double *x, const double *y, c
   if (!g->tape[level]) return -1;
   int n = g->n;
   size_t M = (size_t)m;
+  fill_params(g, m < EX_INTEGRAND_BATCH ? m : EX_INTEGRAND_BATCH);
   for (int k0 = 0; k0 < m; k0 += EX_INTEGRAND_BATCH) {
     int mm = m - k0 < EX_INTEGRAND_BATCH ? m - k0 : EX_INTEGRAND_BATCH;
     g->in[0] = x + k0;
@@ -194,7 +213,6 @@ static int eval_into(ex_integrand *g, int m, const double *x, const double *y, c
       g->in[1 + i] = y + i * M + k0;
       g->in[1 + n + i] = dy ? dy + i * M + k0 : NULL; /* NULL: a constraint G(x, y) */
     }
-    for (int j = 0; j < g->np; j++) g->in[1 + 2 * n + j] = g->pbuf + (size_t)j * EX_INTEGRAND_BATCH;
     g->outp[0] = dest(g, F, (size_t)k0, 0);
     if (level >= 1) {
       for (int i = 0; i < n; i++) {

@@ -9,6 +9,7 @@
 #pragma GCC optimize("vect-cost-model=dynamic")
 #endif
 
+#define _GNU_SOURCE /* sincos */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,7 +54,9 @@ typedef enum {
   T_GT,
   T_GE,
   T_IF,
-  T_TABLE /* a table's spline or partial at 1..3 operands (ex_table.c, theory TB-2) */
+  T_TABLE, /* a table's spline or partial at 1..3 operands (ex_table.c, theory TB-2) */
+  T_SINCOS /* sin(a) into dst and cos(a) into c: one call for both (the partials of a
+               sin or cos have the other) */
 } tape_op;
 
 /* A location: a work register, an input slot or an output buffer. */
@@ -67,7 +70,8 @@ typedef struct {
   double (*fn)(double); /* T_FN1: the libm function */
   double k;             /* scalar operand (K variants, T_FILL) */
   loc dst, a, b, c;
-  int tab, multi; /* T_TABLE: index in the tape's tables and in its call groups */
+  int tab, multi;     /* T_TABLE: index in the tape's tables and in its call groups */
+  int pd, pa, pb, pc; /* the locations as indices of ex_tape_eval's pointer table */
 } instr;
 
 /* One T_TABLE instruction computes every partial the tape needs of one table at the same
@@ -120,7 +124,7 @@ typedef struct {
   unsigned char live;  /* reachable from an output through non-constant nodes */
   unsigned char konst; /* constant: its value is cval */
   unsigned char needv; /* needs a vector location (computed or filled) */
-  unsigned char fused; /* a table call computed by an earlier call's instruction */
+  unsigned char fused; /* a table call (or a sin, cos) computed by an earlier instruction */
   double cval;
   int last; /* id of the last node reading it as a vector operand */
   loc home;
@@ -316,12 +320,41 @@ static int select_instr(const ex_dag *d, ex_tape *t, cnode *cn, int nn, int id, 
   case EX_GE: in->op = T_GE; break;
   case EX_IF: in->op = T_IF; break;
   case EX_TABLE: return select_table(d, t, cn, nn, id, rp, in);
+  case EX_SIN:
+  case EX_COS:
+    /* the other of sin, cos at the same operand later on: one sincos for both */
+    for (int j = id + 1; j < nn; j++) {
+      const ex_node *nj = &d->nodes[j];
+      if (!cn[j].live || cn[j].konst || cn[j].fused || nj->a != a ||
+          nj->op != (nd->op == EX_SIN ? EX_COS : EX_SIN))
+        continue;
+      if (cn[j].home.space < 0) cn[j].home = (loc){L_REG, take_register(rp, t)};
+      cn[j].fused = 1;
+      in->op = T_SINCOS;
+      in->c = cn[j].home;
+      in->k = nd->op == EX_SIN ? 0.0 : 1.0; /* 1: dst takes the cos, c the sin */
+      return 0;
+    }
+    in->op = T_FN1;
+    in->fn = unary_fn(nd->op);
+    break;
   default:
     in->op = T_FN1;
     in->fn = unary_fn(nd->op);
     if (!in->fn) return -1;
   }
   return 0;
+}
+
+/* A location's index in the pointer table of an evaluation: 0 NULL (no operand), then
+ * the input slots, the outputs and the registers. */
+static int ptr_index(const ex_tape *t, loc l) {
+  switch (l.space) {
+  case L_IN: return 1 + l.idx;
+  case L_OUT: return 1 + t->nslots + l.idx;
+  case L_REG: return 1 + t->nslots + t->nout + l.idx;
+  default: return 0;
+  }
 }
 
 ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
@@ -400,6 +433,12 @@ ex_tape *ex_tape_new(const ex_dag *d, int nslots, int nout, const ex_id *outs) {
   }
   t->ins = ins;
   t->nins = n;
+  for (int i = 0; i < n; i++) {
+    ins[i].pd = ptr_index(t, ins[i].dst);
+    ins[i].pa = ptr_index(t, ins[i].a);
+    ins[i].pb = ptr_index(t, ins[i].b);
+    ins[i].pc = ptr_index(t, ins[i].c);
+  }
   cv_free(cn);
   cv_free(rp.free);
   return t;
@@ -439,7 +478,14 @@ int ex_tape_num_instructions(const ex_tape *t) { return t ? t->nins : 0; }
 typedef double *restrict dptr;
 typedef const double *restrict cptr;
 
-static void run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
+/* Inlined into the evaluation loop: a call per instruction (saving and restoring its
+ * registers) costs as much as the loop of a few points. */
+#if defined(__GNUC__)
+#define EX_INLINE inline __attribute__((always_inline))
+#else
+#define EX_INLINE inline
+#endif
+static EX_INLINE void run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
   const double K = in->k;
   switch (in->op) {
   case T_FILL: LOOP(K); break;
@@ -482,11 +528,18 @@ static void run(const instr *in, int m, dptr D, cptr A, cptr B, cptr C) {
   case T_GT: LOOP(A[k] > B[k] ? 1.0 : 0.0); break;
   case T_GE: LOOP(A[k] >= B[k] ? 1.0 : 0.0); break;
   case T_IF: LOOP(A[k] != 0 ? B[k] : C[k]); break;
-  case T_TABLE: break; /* run_table */
+  case T_TABLE:         /* run_table */
+  case T_SINCOS: break; /* run_sincos */
   }
 }
 
 static double *where(loc l, int m, const double *const *in, double *const *out, double *work);
+
+/* T_SINCOS: the node's own function into D, the fused other one into E. */
+static void run_sincos(const instr *in, int m, dptr D, dptr E, cptr A) {
+  double *s = in->k == 0.0 ? D : E, *c = in->k == 0.0 ? E : D;
+  for (int k = 0; k < m; k++) sincos(A[k], &s[k], &c[k]);
+}
 
 /* T_TABLE over the m points: every partial of its group at once; a point outside the grid
  * gives NaN and, the first time in this evaluation, a fault record (EX_TAPE_FAULT). */
@@ -518,11 +571,37 @@ static double *where(loc l, int m, const double *const *in, double *const *out, 
   }
 }
 
+/* Pointer tables up to this many entries live on the stack; larger tapes (rare) find
+ * each location by its kind instead. */
+enum { EX_TAPE_PTRS = 2048 };
+
 void ex_tape_eval(const ex_tape *t, int m, const double *const *in, double *const *out,
                   double *work) {
   if (!t || m <= 0) return;
   double *fault = t->ntab ? work + (size_t)t->nregs * (size_t)m : NULL;
   if (fault) fault[0] = 0;
+  int np = 1 + t->nslots + t->nout + t->nregs;
+  if (np <= EX_TAPE_PTRS) {
+    /* Every location's address once per evaluation, then each instruction finds its
+     * operands by index: on the few points of a small mesh the per-instruction
+     * overhead, not the arithmetic, is most of the cost (docs/performance.md). */
+    double *P[EX_TAPE_PTRS];
+    P[0] = NULL;
+    for (int q = 0; q < t->nslots; q++) P[1 + q] = (double *)in[q]; /* read only */
+    for (int o = 0; o < t->nout; o++) P[1 + t->nslots + o] = out[o];
+    double *R = work;
+    for (int r = 0; r < t->nregs; r++, R += m) P[1 + t->nslots + t->nout + r] = R;
+    for (int i = 0; i < t->nins; i++) {
+      const instr *p = &t->ins[i];
+      if (p->op == T_TABLE)
+        run_table(t, p, m, in, out, work, P[p->pa], P[p->pb], P[p->pc], fault);
+      else if (p->op == T_SINCOS)
+        run_sincos(p, m, P[p->pd], P[p->pc], P[p->pa]);
+      else
+        run(p, m, P[p->pd], P[p->pa], P[p->pb], P[p->pc]);
+    }
+    return;
+  }
   for (int i = 0; i < t->nins; i++) {
     const instr *p = &t->ins[i];
     double *D = where(p->dst, m, in, out, work);
@@ -531,6 +610,8 @@ void ex_tape_eval(const ex_tape *t, int m, const double *const *in, double *cons
     const double *C = where(p->c, m, in, out, work);
     if (p->op == T_TABLE)
       run_table(t, p, m, in, out, work, A, B, C, fault);
+    else if (p->op == T_SINCOS)
+      run_sincos(p, m, D, (double *)C, A);
     else
       run(p, m, D, A, B, C);
   }

@@ -120,6 +120,12 @@ scene *scene_load_buffer(const char *text, size_t len, const char *name, int nse
  * grows like |x - x*|^(-alpha) with alpha >= 0.85 (the action is then infinite, theory
  * (SG-1)). Returns 1 with *xs and *alpha, 0 when there is none, -1 when out of memory. */
 int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double *alpha);
+/** Its two halves, for many solves of one scene (a batch): the sub-expressions of x alone
+ * that F divides by, takes the log of or raises to a negative power (*cands, cv_free it;
+ * returns their number, -1 out of memory), found once; then the check along a solution. */
+int scene_singular_candidates(const scene *s, ex_id **cands);
+int scene_interior_singularity_of(const scene *s, cv_solver *sv, int nc, const ex_id *cands,
+                                  double *xs, double *alpha);
 
 /** The same, with the parameters as inputs of every compiled expression (see the fields
  * above): one load and one compilation serve any parameter values. */

@@ -86,6 +86,9 @@ void cv_batch_free(cv_batch *b) {
   for (int t = 0; t < b->nworkers; t++) worker_free(b, &b->w[t]);
   cv_free(b->w);
   scene_free(b->check);
+  cv_free(b->sing);
+  cv_free(b->rep_used);
+  cv_free(b->guess_used);
   ex_integrand_free(b->F);
   for (int k = 0; b->cons && k < b->s->ncons; k++) ex_integrand_free(b->cons[k]);
   for (int k = 0; b->ints && k < b->s->nints; k++) ex_integrand_free(b->ints[k]);
@@ -131,6 +134,17 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen) {
   b->check = scene_instance_new(s);
   if (!b->cons || !b->ints || !b->outname || !b->given || !b->check) goto nomem;
   for (int i = 0; i < s->n; i++) b->any_exact |= s->exact[i] >= 0;
+  if ((b->nsing = scene_singular_candidates(s, &b->sing)) < 0) goto nomem;
+  b->rep_used = cv_calloc((size_t)b->np + 1, 1);
+  b->guess_used = cv_calloc((size_t)b->np + 1, 1);
+  if (!b->rep_used || !b->guess_used) goto nomem;
+  for (int j = 0; j < b->np; j++) {
+    int slot = 1 + 2 * s->n + j;
+    for (int r = 0; r < s->nreports && !b->rep_used[j]; r++)
+      b->rep_used[j] = (unsigned char)ex_depends_on(s->dag, s->reports[r].expr, slot);
+    for (int i = 0; i < s->n && !b->guess_used[j]; i++)
+      b->guess_used[j] = s->guess[i] >= 0 && ex_depends_on(s->dag, s->guess[i], slot);
+  }
   /* Compile once: every expression of the problem with the parameters as inputs. */
   if (!(b->F = ex_integrand_new_params(s->dag, s->n, b->np, s->F, b->need, msg, sizeof msg))) {
     snprintf(err, errlen, "%s:%d: integrand: %s", s->file, s->F_line,
@@ -328,38 +342,36 @@ cv_status sc_batch_workers(cv_batch *b, int T) {
 
 typedef struct {
   cv_batch *b;
-  int nrows, block;
-  const double *rows;
-  cv_batch_result *res;
+  int n, block;
+  scene_batch_item_fn fn;
+  void *user;
   atomic_int next;
 } job;
 
 typedef struct {
   job *j;
-  worker *w;
+  int t; /* worker index */
 } task;
 
 static void *run(void *arg) {
   task *t = arg;
   job *j = t->j;
   for (;;) {
-    int r0 = atomic_fetch_add(&j->next, j->block);
-    if (r0 >= j->nrows) break;
-    int r1 = r0 + j->block < j->nrows ? r0 + j->block : j->nrows;
-    for (int r = r0; r < r1; r++)
-      sc_batch_solve_row(j->b, t->w, r, j->rows + (size_t)r * j->b->ncols, &j->res[r]);
+    int i0 = atomic_fetch_add(&j->next, j->block);
+    if (i0 >= j->n) break;
+    int i1 = i0 + j->block < j->n ? i0 + j->block : j->n;
+    for (int i = i0; i < i1; i++) j->fn(j->b, t->t, i, j->user);
   }
   return NULL;
 }
 
-cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_result *res) {
-  if (!b || nrows < 0 || (nrows > 0 && (!res || (b->ncols > 0 && !rows)))) return CVAR_EINVAL;
-  if (nrows == 0) return CVAR_OK;
-  int T = b->nthreads < nrows ? b->nthreads : nrows;
+cv_status scene_batch_for_each(cv_batch *b, int n, int block, scene_batch_item_fn fn, void *user) {
+  if (!b || n < 0 || !fn) return CVAR_EINVAL;
+  if (n == 0) return CVAR_OK;
+  int T = b->nthreads < n ? b->nthreads : n;
   if (sc_batch_workers(b, T) != CVAR_OK) return CVAR_ENOMEM;
-  /* Blocks of consecutive rows, claimed in turn: about 8 per thread keeps the threads
-   * busy to the end; inside a block each row may warm-start from the one before. */
-  job j = {b, nrows, nrows / (8 * T) > 0 ? nrows / (8 * T) : 1, rows, res, 0};
+  if (block < 1) block = 1;
+  job j = {b, n, block, fn, user, 0};
   task *tk = cv_malloc((size_t)T * sizeof *tk);
   pthread_t *th = cv_malloc((size_t)T * sizeof *th);
   if (!tk || !th) {
@@ -368,13 +380,10 @@ cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_re
     return CVAR_ENOMEM;
   }
   int started = 0;
-  for (int t = 0; t < T; t++) {
-    tk[t].j = &j;
-    tk[t].w = &b->w[t];
-  }
+  for (int t = 0; t < T; t++) tk[t] = (task){&j, t};
   for (int t = 1; t < T; t++) {
     if (pthread_create(&th[t], NULL, run, &tk[t]) != 0)
-      break; /* fewer threads: the others take the rows */
+      break; /* fewer threads: the others take the items */
     started = t;
   }
   run(&tk[0]);
@@ -382,4 +391,42 @@ cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_re
   cv_free(tk);
   cv_free(th);
   return CVAR_OK;
+}
+
+int scene_batch_block(const cv_batch *b, int n) {
+  int T = b->nthreads < n ? b->nthreads : n;
+  if (T < 1) T = 1;
+  /* Warm starts follow the previous row on the same thread: blocks of consecutive rows,
+   * about 8 per thread (the threads still finish together). Without them, small blocks:
+   * the last ones even out the threads' ends (a claim is one atomic add, a row tens of
+   * microseconds). */
+  int per = b->warm ? 8 * T : 64 * T;
+  return n / per > 0 ? n / per : 1;
+}
+
+void scene_batch_solve_row(cv_batch *b, int t, int row, const double *vals, cv_batch_result *r) {
+  sc_batch_solve_row(b, &b->w[t], row, vals, r);
+}
+
+cv_status scene_batch_check_row(cv_batch *b, int t, const double *row, char *err, size_t errlen) {
+  worker *w = &b->w[t];
+  return sc_batch_set_row(b, w->inst, w->pv, w->rv, w->rw, row, err, errlen) < 0 ? CVAR_EINVAL
+                                                                                 : CVAR_OK;
+}
+
+typedef struct {
+  const double *rows;
+  cv_batch_result *res;
+} solve_job;
+
+static int solve_item(cv_batch *b, int t, int i, void *user) {
+  solve_job *sj = user;
+  sc_batch_solve_row(b, &b->w[t], i, sj->rows + (size_t)i * b->ncols, &sj->res[i]);
+  return 0;
+}
+
+cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_result *res) {
+  if (!b || nrows < 0 || (nrows > 0 && (!res || (b->ncols > 0 && !rows)))) return CVAR_EINVAL;
+  solve_job sj = {rows, res};
+  return scene_batch_for_each(b, nrows, scene_batch_block(b, nrows), solve_item, &sj);
 }

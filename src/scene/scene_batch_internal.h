@@ -48,7 +48,10 @@ struct cv_batch {
   int nguess;
   int *guess_of; /* tape output of unknown i's guess, or -1 */
   worker *w;
-  scene *check; /* instance for cv_batch_check_row */
+  scene *check;                         /* instance for cv_batch_check_row */
+  unsigned char *rep_used, *guess_used; /* parameters the report / guess tapes read */
+  ex_id *sing;                          /* scene_singular_candidates, found once */
+  int nsing;
 };
 
 /* scene_batch.c */

@@ -106,6 +106,17 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
   return p;
 }
 
+/* The parameter batches w->pb (one per parameter, each its value repeated) of the
+ * parameters a tape reads (used[j]), filled for the first min(m, QBATCH) points only: a
+ * row's reports need a few points of a few parameters, not whole batches of all. */
+static void fill_params(worker *w, int m, const unsigned char *used) {
+  const scene *s = w->inst;
+  int mm = m < QBATCH ? m : QBATCH;
+  for (int j = 0; j < s->nparams; j++)
+    if (used[j])
+      for (int k = 0; k < mm; k++) w->pb[(size_t)j * QBATCH + k] = s->params[j].value;
+}
+
 /* cv_guess_fn over the compiled [guess] tape; the default (the straight line between
  * fixed ends, SCENES.md [guess]) for unknowns without one. user: the worker's context. */
 int sc_batch_guess(int m, const double *x, double *y, void *user) {
@@ -116,10 +127,8 @@ int sc_batch_guess(int m, const double *x, double *y, void *user) {
   const double *in[1 + 2 * n + np];
   double *out[b->nguess + 1];
   for (int q = 0; q < 1 + 2 * n + np; q++) in[q] = NULL;
-  for (int j = 0; j < np; j++) {
-    for (int k = 0; k < QBATCH; k++) w->pb[(size_t)j * QBATCH + k] = s->params[j].value;
-    in[1 + 2 * n + j] = w->pb + (size_t)j * QBATCH;
-  }
+  fill_params(w, m, b->guess_used);
+  for (int j = 0; j < np; j++) in[1 + 2 * n + j] = w->pb + (size_t)j * QBATCH;
   for (int k0 = 0; k0 < m; k0 += QBATCH) {
     int mm = m - k0 < QBATCH ? m - k0 : QBATCH;
     in[0] = x + k0;
@@ -164,10 +173,8 @@ static int eval_reports(const cv_batch *b, worker *w, double *out) {
   int ns = 1 + 2 * n + np;
   const double *in[ns];
   double *o[s->nreports];
-  for (int j = 0; j < np; j++) {
-    for (int k = 0; k < QBATCH; k++) w->pb[(size_t)j * QBATCH + k] = s->params[j].value;
-    in[1 + 2 * n + j] = w->pb + (size_t)j * QBATCH;
-  }
+  fill_params(w, nq, b->rep_used);
+  for (int j = 0; j < np; j++) in[1 + 2 * n + j] = w->pb + (size_t)j * QBATCH;
   for (int r = 0; r < s->nreports; r++) {
     out[r] = 0.0;
     o[r] = w->qv + (size_t)r * QBATCH;
@@ -247,33 +254,67 @@ static void keep_for_warm(worker *w, int row) {
   w->prev_row = row;
 }
 
+/* Append text to buf (capacity cap, length *k), truncating; buf stays terminated. */
+static void put(char *buf, size_t cap, size_t *k, const char *text) {
+  size_t len = strlen(text);
+  if (*k + 1 >= cap) return;
+  if (len > cap - 1 - *k) len = cap - 1 - *k;
+  memcpy(buf + *k, text, len);
+  *k += len;
+  buf[*k] = '\0';
+}
+
+static void put_int(char *buf, size_t cap, size_t *k, int v) {
+  char d[16];
+  int i = (int)sizeof d - 1;
+  unsigned u = v < 0 ? 0U - (unsigned)v : (unsigned)v;
+  d[i] = '\0';
+  do d[--i] = (char)('0' + u % 10);
+  while ((u /= 10) > 0);
+  if (v < 0) d[--i] = '-';
+  put(buf, cap, k, d + i);
+}
+
+/* The row's sentence, as `solve` words it. Built by copies: snprintf costs a few thousand
+ * instructions a call, a noticeable part of a small row. */
 static void compose_message(cv_batch_result *r, const cv_solver *sv, int morse, int nfree,
                             int degenerate, const char *note) {
   const char *detail = cv_solver_last_error(sv);
   size_t cap = sizeof r->message, k = 0;
+  r->message[0] = '\0';
   if (r->status != CVAR_OK) {
-    k = (size_t)snprintf(r->message, cap, "%s",
-                         detail && detail[0] ? detail : cv_strerror(r->status));
+    put(r->message, cap, &k, detail && detail[0] ? detail : cv_strerror(r->status));
   } else {
-    k = (size_t)snprintf(r->message, cap, "Converged in %d iteration%s", r->iterations,
-                         r->iterations == 1 ? "" : "s");
+    put(r->message, cap, &k, "Converged in ");
+    put_int(r->message, cap, &k, r->iterations);
+    put(r->message, cap, &k, r->iterations == 1 ? " iteration" : " iterations");
     const char *kind = degenerate       ? "degenerate"
                        : morse == 0     ? "minimum"
                        : morse == nfree ? "maximum"
                                         : "saddle";
-    if (k < cap && morse >= 0 && degenerate)
-      k += (size_t)snprintf(r->message + k, cap - k, "; the Hessian is degenerate there.");
-    else if (k < cap && morse >= 0)
-      k += (size_t)snprintf(r->message + k, cap - k, " to a %s of the action (Morse index %d).",
-                            kind, morse);
-    else if (k < cap)
-      k += (size_t)snprintf(r->message + k, cap - k, ".");
-    if (k < cap && detail && detail[0] && strncmp(detail, "converged in ", 13) != 0)
-      k += (size_t)snprintf(
-          r->message + k, cap - k, " %c%s.",
-          detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A' : detail[0], detail + 1);
+    if (morse >= 0 && degenerate) {
+      put(r->message, cap, &k, "; the Hessian is degenerate there.");
+    } else if (morse >= 0) {
+      put(r->message, cap, &k, " to a ");
+      put(r->message, cap, &k, kind);
+      put(r->message, cap, &k, " of the action (Morse index ");
+      put_int(r->message, cap, &k, morse);
+      put(r->message, cap, &k, ").");
+    } else {
+      put(r->message, cap, &k, ".");
+    }
+    if (detail && detail[0] && strncmp(detail, "converged in ", 13) != 0) {
+      char first[3] = {
+          ' ', detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A' : detail[0], '\0'};
+      put(r->message, cap, &k, first);
+      put(r->message, cap, &k, detail + 1);
+      put(r->message, cap, &k, ".");
+    }
   }
-  if (note && k < cap) snprintf(r->message + k, cap - k, " %s", note);
+  if (note) {
+    put(r->message, cap, &k, " ");
+    put(r->message, cap, &k, note);
+  }
 }
 
 /* Solve row number `row` (its values `vals`) on worker w into r. */
@@ -328,7 +369,8 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
   r->iterations = cv_solver_get_num_iterations(w->sv);
   int morse = -1, nfree = 0, degenerate = 0;
   double xs, alpha;
-  if (st == CVAR_OK && scene_interior_singularity(w->inst, w->sv, &xs, &alpha) == 1) {
+  if (st == CVAR_OK &&
+      scene_interior_singularity_of(w->inst, w->sv, b->nsing, b->sing, &xs, &alpha) == 1) {
     /* as `solve` does: a finite discrete action of an infinite one (theory (SG-1)) */
     r->status = CVAR_ENONFINITE;
     snprintf(r->message, sizeof r->message,

@@ -92,18 +92,24 @@ static double f_near(const scene *s, cv_solver *sv, double xs, double d) {
   return fabs(out[0]) > fabs(out[1]) ? fabs(out[0]) : fabs(out[1]);
 }
 
-int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double *alpha) {
+int scene_singular_candidates(const scene *s, ex_id **cands) {
   ex_dag *d = s->dag;
-  int N = s->F + 1, rc = 0;
+  int N = s->F + 1, nc = 0;
   unsigned char *mark = cv_calloc((size_t)N, 1);
-  if (!mark) return -1;
+  ex_id *c = cv_malloc(((size_t)N + 1) * sizeof *c);
+  *cands = NULL;
+  if (!mark || !c) {
+    cv_free(mark);
+    cv_free(c);
+    return -1;
+  }
   mark[s->F] = 1;
   /* the nodes of F (children have smaller ids: one pass downwards) */
-  for (ex_id e = s->F; e >= 0 && rc == 0; e--) {
+  for (ex_id e = s->F; e >= 0; e--) {
     if (!mark[e]) continue;
     for (int i = 0; i < 3; i++) {
-      ex_id c = ex_node_arg(d, e, i);
-      if (c >= 0 && c < N) mark[c] = 1;
+      ex_id ch = ex_node_arg(d, e, i);
+      if (ch >= 0 && ch < N) mark[ch] = 1;
     }
     ex_op op = ex_node_op(d, e);
     ex_id cand = -1;
@@ -114,13 +120,19 @@ int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double
     else if (op == EX_POW && ex_node_op(d, ex_node_arg(d, e, 1)) == EX_NUM &&
              ex_node_value(d, ex_node_arg(d, e, 1)) < 0)
       cand = ex_node_arg(d, e, 0);
+    if (cand >= 0 && x_only(s, cand)) c[nc++] = cand;
+  }
+  cv_free(mark);
+  *cands = c;
+  return nc;
+}
+
+int scene_interior_singularity_of(const scene *s, cv_solver *sv, int nc, const ex_id *cands,
+                                  double *xs, double *alpha) {
+  for (int k = 0; k < nc; k++) {
     double x0;
-    if (cand < 0 || !x_only(s, cand)) continue;
-    int z = interior_zero(s, cand, &x0);
-    if (z < 0) {
-      rc = -1;
-      break;
-    }
+    int z = interior_zero(s, cands[k], &x0);
+    if (z < 0) return -1;
     if (z == 0) continue;
     double L = s->b - s->a, g1 = f_near(s, sv, x0, 1e-3 * L), g2 = f_near(s, sv, x0, 1e-5 * L);
     if (isnan(g1) || isnan(g2)) continue;
@@ -128,9 +140,16 @@ int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double
     if (!(al < 0.85)) {
       *xs = x0;
       *alpha = al;
-      rc = 1;
+      return 1;
     }
   }
-  cv_free(mark);
+  return 0;
+}
+
+int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double *alpha) {
+  ex_id *c = NULL;
+  int nc = scene_singular_candidates(s, &c);
+  int rc = nc < 0 ? -1 : scene_interior_singularity_of(s, sv, nc, c, xs, alpha);
+  cv_free(c);
   return rc;
 }

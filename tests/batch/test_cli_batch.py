@@ -190,7 +190,7 @@ if len(srow) == 3:
 def bad_case(name, text, line):
     path = write(name, text)
     outp = os.path.join(tmp, name + ".out")
-    rc, o, e = batch("line.scene", path, "--out", outp)
+    rc, o, e = batch("line.scene", path, "--out", outp, "--threads", "2")
     check("%s exit 2" % name, rc == 2, 2, (rc, e))
     check("%s message %s:%d:" % (name, path, line), e.startswith("%s:%d: " % (path, line)),
           "%s:%d: ..." % (path, line), e.strip())
@@ -202,6 +202,12 @@ bad_case("dupheader.csv", "A,A\n1,2\n", 1)
 bad_case("badnumber.csv", "A,B\n1,2\n\n3,x\n", 4)
 bad_case("badcount.csv", "A,B\n1,2\n3\n", 3)
 bad_case("badinterval.csv", "A,L\n1,2\n1,-1\n", 3)
+# Rows are checked by the threads, a window of rows at a time: the first bad row of the
+# file is the one named, whichever thread found it and whatever follows it.
+bad_case("badlate.csv", "A,B\n" + "1,2\n" * 700 + "3,x\n" + "1,2\n" * 400 + "4,y\n", 702)
+bad_case("badlateinterval.csv", "A,L\n" + "1,2\n" * 600 + "1,-1\n" + "1,x\n", 602)
+bad_case("badvaluethencount.csv", "A,B\n1,2\n3,x\n1\n", 3)
+bad_case("badcountthenvalue.csv", "A,B\n1,2\n1\n3,x\n", 3)
 
 # ---- the progress line: only when stderr is a terminal (a pty from script(1)) ----------
 script = shutil.which("script")

@@ -127,9 +127,72 @@ static void check_registers(void) {
   ex_dag_free(d);
 }
 
+/* sin and cos of one operand: one sincos instruction for both, whichever comes first in
+ * the DAG, with the values of libm's sin and cos (bit for bit: glibc's sincos shares their
+ * code); a sin or cos without its partner stays a plain call. */
+static void check_sincos(void) {
+  ex_dag *d = ex_dag_new();
+  ex_id outs[4];
+  outs[0] = parse_ok(d, "cos(x*y)*z");
+  outs[1] = parse_ok(d, "sin(x*y)");
+  outs[2] = parse_ok(d, "cos(x)");
+  outs[3] = parse_ok(d, "sin(z) + cos(z)");
+  ex_tape *t = ex_tape_new(d, NSLOTS, 4, outs);
+  /* x*y, sincos, *z, cos(x), sincos(z), +: 6 instructions (8 without the fusion) */
+  CHECK(t && ex_tape_num_instructions(t) == 6, "instructions: %d, expected 6",
+        t ? ex_tape_num_instructions(t) : -1);
+  double x[5] = {0.1, -2.0, 3.0, 1e5, 0.0}, y[5] = {1, 2, -3, 7, 4}, z[5] = {0.5, 9, -1, 2, 3};
+  const double *in[NSLOTS] = {x, y, z, NULL, NULL};
+  double o[4][5], work[64];
+  double *op[4] = {o[0], o[1], o[2], o[3]};
+  CHECK(t && ex_tape_work_size(t, 5) <= 64, "work %zu", t ? ex_tape_work_size(t, 5) : 0);
+  if (t) ex_tape_eval(t, 5, in, op, work);
+  for (int k = 0; t && k < 5; k++) {
+    CHECK(o[0][k] == cos(x[k] * y[k]) * z[k], "cos(x*y)*z at %d", k);
+    CHECK(o[1][k] == sin(x[k] * y[k]), "sin(x*y) at %d", k);
+    CHECK(o[2][k] == cos(x[k]), "cos(x) at %d", k);
+    CHECK(o[3][k] == sin(z[k]) + cos(z[k]), "sin(z) + cos(z) at %d", k);
+  }
+  ex_tape_free(t);
+  ex_dag_free(d);
+}
+
+/* A tape with more locations than the evaluation's pointer table holds (2048) finds its
+ * operands the other way: the same values. */
+static void check_large_tape(void) {
+  enum { NO = 2100 };
+  ex_dag *d = ex_dag_new();
+  ex_id *outs = malloc(NO * sizeof *outs);
+  char src[64];
+  for (int i = 0; i < NO; i++) {
+    snprintf(src, sizeof src, "sin(%d*x) + y", i + 1);
+    outs[i] = parse_ok(d, src);
+  }
+  ex_tape *t = ex_tape_new(d, NSLOTS, NO, outs);
+  CHECK(t != NULL, "tape of %d outputs", NO);
+  double x[2] = {0.3, -1.1}, y[2] = {2, 5}, *buf = malloc(2 * NO * sizeof *buf);
+  double **op = malloc(NO * sizeof *op);
+  size_t w = t ? ex_tape_work_size(t, 2) : 0;
+  double *work = malloc((w + 1) * sizeof *work);
+  for (int i = 0; i < NO; i++) op[i] = buf + 2 * i;
+  const double *in[NSLOTS] = {x, y, NULL, NULL, NULL};
+  if (t) ex_tape_eval(t, 2, in, op, work);
+  for (int i = 0; t && i < NO; i++)
+    for (int k = 0; k < 2; k++)
+      CHECK_CLOSE("large tape", op[i][k], sin((i + 1) * x[k]) + y[k], 0, 1);
+  ex_tape_free(t);
+  free(work);
+  free(op);
+  free(buf);
+  free(outs);
+  ex_dag_free(d);
+}
+
 int main(void) {
   check_corpus();
   check_structure();
   check_registers();
+  check_sincos();
+  check_large_tape();
   return finish("test_expr_tape");
 }
