@@ -210,9 +210,10 @@ static inline __attribute__((always_inline)) double batch_scalar(
     return batch_scalar(c, Q, d, r, e0, ne, o, g, colptr, Ax, hscale, bad);                        \
   }
 KERNEL(kernel_2, 2, 2)
-KERNEL(kernel_3, 3, 3) KERNEL(kernel_4, 4, 4) KERNEL(kernel_5, 5, 5) KERNEL(kernel_2q, 2, 0)
-    KERNEL(kernel_3q, 3, 0) KERNEL(kernel_4q, 4, 0) KERNEL(kernel_5q, 5, 0) KERNEL(kernel_6q, 6, 0)
-        KERNEL(kernel_7q, 7, 0) KERNEL(kernel_8q, 8, 0) KERNEL(kernel_9q, 9, 0)
+KERNEL(kernel_3, 3, 3)
+KERNEL(kernel_4, 4, 4) KERNEL(kernel_5, 5, 5) KERNEL(kernel_2q, 2, 0) KERNEL(kernel_3q, 3, 0)
+    KERNEL(kernel_4q, 4, 0) KERNEL(kernel_5q, 5, 0) KERNEL(kernel_6q, 6, 0) KERNEL(kernel_7q, 7, 0)
+        KERNEL(kernel_8q, 8, 0) KERNEL(kernel_9q, 9, 0)
 #undef KERNEL
 
             static double batch_scalar_dispatch(const cv_disc *d, const cv_rule *r, int e0, int ne,
