@@ -6,7 +6,8 @@
  * against sqrt(nodes) as the tolerance falls (HP-5: exp(-b sqrt(N))). The brachistochrone
  * runs twice: from --tol's own start, and from the example scene's [mesh] (100 graded
  * elements of degree 4) as the start.
- * Usage: bench_tol [scene_dir (default: the tests' copy of the reference problems)]
+ * Usage: bench_tol [scene_dir (default: the tests' copy of the reference problems)
+ *                  [name: only the scenes whose file name contains it]]
  * SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <stdio.h>
@@ -107,6 +108,7 @@ int main(int argc, char **argv) {
          "hand mesh", "time_s", "true_max", "ratio");
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     const bench_case *bc = &cases[c];
+    if (argc > 2 && !strstr(bc->scene, argv[2])) continue; /* only the scenes named so */
     char path[1024], err[SC_ERRLEN], nm[64] = "", val[64] = "";
     snprintf(path, sizeof path, "%s/%s", bc->own_mesh ? CV_EXAMPLES_DIR : dir, bc->scene);
     sc_set set = {nm, val};
@@ -145,6 +147,7 @@ int main(int argc, char **argv) {
   /* Exponential convergence in sqrt(unknowns) (HP-5): the brachistochrone's action error
    * against the nodes as T falls; b from the least-squares line ln(err) = c - b sqrt(N). */
   char path[1024], err[SC_ERRLEN];
+  if (argc > 2 && !strstr("brachistochrone.scene", argv[2])) return 0;
   snprintf(path, sizeof path, "%s/brachistochrone.scene", dir);
   scene *s = scene_load_file(path, 0, NULL, err, sizeof err);
   cv_problem *p = s ? scene_problem_new(s, scene_method_need(s->method), err, sizeof err) : NULL;
