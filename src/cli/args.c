@@ -76,7 +76,7 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o) {
         "--elements",   "--degree", "--method", "--tolerance", "--max-iterations",
         "--set",        "--adapt",  "--tol",    "--continue",  "--json",
         "--csv",        "--plot",   "--max",    "--work",      "--max-elements",
-        "--time-limit", NULL};
+        "--time-limit", "--max-nodes", NULL};
     int known = flag;
     for (int k = 0; valued[k]; k++) known |= strcmp(name, valued[k]) == 0;
     if (!known) return bad(cmd, "unknown option '%s' (see calcvar --help)", name);
@@ -133,6 +133,9 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o) {
     } else if (strcmp(name, "--max-elements") == 0) {
       if (parse_int(v, 1, INT_MAX / 9, &o->max_elements) < 0)
         return bad(cmd, "--max-elements needs a whole number >= 1, got '%s'", v);
+    } else if (strcmp(name, "--max-nodes") == 0) {
+      if (parse_int(v, 2, INT_MAX / 9, &o->max_nodes) < 0)
+        return bad(cmd, "--max-nodes needs a whole number >= 2, got '%s'", v);
     } else if (strcmp(name, "--adapt") == 0) {
       if (parse_pos_double(v, &o->adapt) < 0)
         return bad(cmd, "--adapt needs a target error > 0, got '%s'", v);
@@ -226,8 +229,14 @@ int cli_apply_accuracy(const cli_opts *o, scene *s) {
     }
     s->time_limit = o->time_limit;
   }
+  if (o->max_nodes && !(tol > 0)) {
+    fprintf(stderr, "calcvar: --max-nodes caps the nodes of --tol only (--tol T or [mesh] tol in "
+                    "the scene; --adapt has --max-elements)\n");
+    return EXIT_BADINPUT;
+  }
   if (tol > 0) { /* automatic accuracy: the scene's or the flags' mesh is only the start */
     s->tol = tol;
+    if (o->max_nodes) s->tol_max_nodes = o->max_nodes;
     if (!o->elements && !s->elements_line && s->grading <= 0)
       s->elements = SCENE_TOL_START_ELEMENTS;
     if (!o->degree && !s->degree_line) s->degree = SCENE_TOL_START_DEGREE;
@@ -244,7 +253,7 @@ void cli_apply_solver_options(const cli_opts *o, scene *s) {
 int cli_only_scene_options(const char *cmd, const cli_opts *o) {
   if (o->csv || o->plot || o->adapt > 0 || o->tol > 0 || o->cont || o->elements || o->degree ||
       o->method >= 0 || o->tolerance > 0 || o->max_iterations || o->all || o->max_elements ||
-      o->verbose || o->time_limit > 0) {
+      o->verbose || o->time_limit > 0 || o->max_nodes) {
     fprintf(stderr, "calcvar %s: only --set, --json and --quiet apply to %s\n", cmd, cmd);
     return EXIT_BADINPUT;
   }

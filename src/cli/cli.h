@@ -22,6 +22,7 @@ typedef struct {
   double adapt;
   double tol;        /* --tol: automatic accuracy (hp) */
   int max_elements;  /* --max-elements: the adaptive cap (0: 2e6) */
+  int max_nodes;     /* --max-nodes: the cap of --tol on the nodes (0: 1e6) */
   double time_limit; /* --time-limit S: a cap on the seconds of --tol / --adapt rounds */
   const char *cont;  /* --continue name=from:to */
   int nset;

@@ -34,7 +34,7 @@ static void usage(FILE *f) {
         "  --threads N          rows solved at once (default: the cores available)\n"
         "  --warm               start each row from the previous row's solution\n"
         "  --elements N, --degree P, --method M, --tolerance T, --max-iterations K,\n"
-        "  --set name=value, --adapt TOL, --tol T, --time-limit S\n"
+        "  --set name=value, --adapt TOL, --tol T, --time-limit S, --max-nodes N\n"
         "                       as for calcvar solve, for every row\n"
         "Output: the input columns, status, action, iterations, time_s, morse_index,\n"
         "error_max_nodal (with [exact]), error_estimate (with --adapt, always with --tol),\n"

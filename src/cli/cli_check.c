@@ -34,7 +34,7 @@ int cli_check(int argc, char **argv) {
     return rc;
   }
   if (o.json || o.csv || o.plot || o.adapt > 0 || o.tol > 0 || o.cont || o.elements || o.degree ||
-      o.time_limit > 0) {
+      o.time_limit > 0 || o.max_nodes) {
     fprintf(stderr, "calcvar check: only --set and --method apply to check\n");
     cli_opts_free(&o);
     return EXIT_BADINPUT;

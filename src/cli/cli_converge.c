@@ -249,6 +249,7 @@ int cli_converge(int argc, char **argv) {
                         : o.cont           ? "--continue"
                         : o.max_elements   ? "--max-elements"
                         : o.time_limit > 0 ? "--time-limit"
+                        : o.max_nodes      ? "--max-nodes"
                                            : NULL;
   if (notmine) {
     rc = bad("%s is an option of solve, not of converge", notmine);

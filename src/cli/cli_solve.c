@@ -26,6 +26,7 @@ static void usage(FILE *f) {
         "  --max-elements N     cap of adaptive refinement (default 2000000)\n"
         "  --tol T              choose mesh and degrees until the estimated max nodal\n"
         "                       error <= T (elements/degree, if given, are the start)\n"
+        "  --max-nodes N        cap of --tol on the nodes (default 1000000)\n"
         "  --time-limit S       stop the rounds of --tol / --adapt after S seconds (exit 1,\n"
         "                       with the estimate reached)\n"
         "  --continue name=from:to   continuation in a parameter\n"

@@ -15,6 +15,10 @@
  * estimate flat for as many rounds as the layer is halvings thin). */
 #define STALL_ROUNDS_FLOOR 3
 #define STALL_ROUNDS       40
+/* ... unless those rounds multiplied the nodes by STALL_GROWTH: refinement everywhere that
+ * buys nothing is a floor of the integrand's own values (a table's rounding), not a layer
+ * being approached (HP-6). */
+#define STALL_GROWTH 8
 
 cv_status cv_solver_set_tol(cv_solver *s, double tol, int max_nodes) {
   if (!s || !(tol >= 0) || !isfinite(tol) || max_nodes < 2) return CVAR_EINVAL;
@@ -101,13 +105,24 @@ static double value_scale(const cv_solver *s) {
   return m;
 }
 
+/* HP-6: the next mesh would exceed the cap on nodes (hp) or elements (--adapt). */
+static void say_cap(cv_solver *s, double est) {
+  cv_set_msg(s->msg, sizeof s->msg,
+             "the next refinement would exceed the cap of %d %s after %d rounds; the "
+             "estimated max nodal error reached is %.2g > %.2g; %s",
+             s->adapt_max, s->hp ? "nodes" : "elements", s->rounds, est, s->adapt_tol,
+             s->hp ? "ask for a larger tolerance (or raise the cap: --max-nodes, or the "
+                     "max_nodes argument of cv_solver_set_tol)"
+                   : "use a higher degree or a looser tolerance (or raise the cap: "
+                     "--max-elements, or the max_elements argument of cv_solver_set_adapt)");
+}
+
 /* HP-6: why the rounds must stop before reaching tol, as a sentence in s->msg, or 0 to go
  * on. best: smallest estimate so far; floor_: the estimate's round-off part (HP-2);
- * stalled: rounds since the best last halved. */
+ * stalled: rounds since the best last halved, at halved_nodes nodes. */
 static int stop_rule(cv_solver *s, double est, double best, double floor_, int stalled,
-                     int next_size, double elapsed) {
+                     int halved_nodes, int next_size, double elapsed) {
   double tol = s->adapt_tol;
-  const char *what = s->hp ? "nodes" : "elements";
   if ((best <= floor_ && tol < floor_) ||
       (stalled >= STALL_ROUNDS_FLOOR && best <= 10.0 * floor_)) {
     cv_set_msg(s->msg, sizeof s->msg,
@@ -116,6 +131,17 @@ static int stop_rule(cv_solver *s, double est, double best, double floor_, int s
                "values of size %.2g and the slope times the spacing of doubles at the "
                "nodes); ask for a larger tolerance",
                est, tol, floor_, value_scale(s));
+    return 1;
+  }
+  if (s->hp && stalled >= STALL_ROUNDS_FLOOR &&
+      s->disc.nodes >= (double)STALL_GROWTH * halved_nodes) {
+    cv_set_msg(s->msg, sizeof s->msg,
+               "the error estimate stopped decreasing at %.2g > %.2g: %d rounds multiplied the "
+               "nodes by %.0f (%d to %d) without halving it, a floor that refinement does not "
+               "lower (noise in the integrand's values, such as a table's rounding); ask for "
+               "a larger tolerance",
+               best, tol, stalled, (double)s->disc.nodes / halved_nodes, halved_nodes,
+               s->disc.nodes);
     return 1;
   }
   if (stalled >= STALL_ROUNDS) {
@@ -143,14 +169,7 @@ static int stop_rule(cv_solver *s, double est, double best, double floor_, int s
     return 1;
   }
   if (next_size > s->adapt_max) {
-    cv_set_msg(s->msg, sizeof s->msg,
-               "the next refinement would exceed the cap of %d %s after %d rounds; the "
-               "estimated max nodal error reached is %.2g > %.2g; %s",
-               s->adapt_max, what, s->rounds, est, tol,
-               s->hp ? "ask for a larger tolerance (or raise the cap: the max_nodes argument "
-                       "of cv_solver_set_tol)"
-                     : "use a higher degree or a looser tolerance (or raise the cap: "
-                       "--max-elements, or the max_elements argument of cv_solver_set_adapt)");
+    say_cap(s, est);
     return 1;
   }
   if (s->rounds >= MAX_ROUNDS) {
@@ -240,7 +259,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   cv_status st;
   cv_solver *f = cv_solver_new(&st);
   double *t = NULL, *eta = NULL, *sigma = NULL, *where = NULL;
-  int *deg = NULL, E = 0, stalled = 0, warm = 0, misses = 0;
+  int *deg = NULL, E = 0, stalled = 0, warm = 0, misses = 0, halved_nodes = 1;
   long iters = 0, iters_ref = 0; /* Newton iterations of all rounds; of the enriched solves */
   double tol = s->adapt_tol, best = INFINITY, t0 = cv_now();
   cv_meshspec spec0 = s->mesh;
@@ -332,7 +351,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
         done = 1; /* leaves after the progress report below */
       }
       if (est <= 0.5 * best)
-        stalled = 0;
+        stalled = 0, halved_nodes = s->disc.nodes;
       else
         stalled++;
       if (est < best) best = est;
@@ -359,7 +378,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       double td = dorfler_threshold(eta, E, 0.5 * tol / est);
       if (td > thresh) thresh = td;
     }
-    if (stop_rule(s, est, best, floor_, stalled,
+    if (stop_rule(s, est, best, floor_, stalled, halved_nodes,
                   next_size(&s->disc, eta, sigma, thresh, tol, s->hp), cv_now() - t0)) {
       st = CVAR_EMAXITER;
       goto cleanup;
@@ -369,6 +388,13 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     int mode = s->hp ? (s->rounds <= MERGE_ROUNDS ? 2 : 1) : 0;
     st = cv_hp_refine(&s->disc, eta, sigma, where, thresh, tol, mode, &E, &t, &deg);
     if (st) goto cleanup;
+    long size = s->hp ? 1 : E; /* next_size predicted it; the refined mesh is what counts */
+    for (int e = 0; s->hp && e < E; e++) size += deg[e];
+    if (size > s->adapt_max) { /* the solution and estimate of this round stay the answer */
+      say_cap(s, est);
+      st = CVAR_EMAXITER;
+      goto cleanup;
+    }
   }
 cleanup:
   s->iterations = (int)(iters > 2000000000L ? 2000000000L : iters); /* all rounds */

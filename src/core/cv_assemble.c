@@ -209,17 +209,25 @@ static inline __attribute__((always_inline)) double batch_scalar(
                                                double *Ax, double hscale, double *bad) {           \
     return batch_scalar(c, Q, d, r, e0, ne, o, g, colptr, Ax, hscale, bad);                        \
   }
+/* clang-format off: a list of definitions, one per line */
 KERNEL(kernel_2, 2, 2)
 KERNEL(kernel_3, 3, 3)
-KERNEL(kernel_4, 4, 4) KERNEL(kernel_5, 5, 5) KERNEL(kernel_2q, 2, 0) KERNEL(kernel_3q, 3, 0)
-    KERNEL(kernel_4q, 4, 0) KERNEL(kernel_5q, 5, 0) KERNEL(kernel_6q, 6, 0) KERNEL(kernel_7q, 7, 0)
-        KERNEL(kernel_8q, 8, 0) KERNEL(kernel_9q, 9, 0)
+KERNEL(kernel_4, 4, 4)
+KERNEL(kernel_5, 5, 5)
+KERNEL(kernel_2q, 2, 0)
+KERNEL(kernel_3q, 3, 0)
+KERNEL(kernel_4q, 4, 0)
+KERNEL(kernel_5q, 5, 0)
+KERNEL(kernel_6q, 6, 0)
+KERNEL(kernel_7q, 7, 0)
+KERNEL(kernel_8q, 8, 0)
+KERNEL(kernel_9q, 9, 0)
+/* clang-format on */
 #undef KERNEL
 
-            static double batch_scalar_dispatch(const cv_disc *d, const cv_rule *r, int e0, int ne,
-                                                int p, const cv_partials *o, double *g,
-                                                const int *colptr, double *Ax, double hscale,
-                                                double *bad) {
+static double batch_scalar_dispatch(const cv_disc *d, const cv_rule *r, int e0, int ne, int p,
+                                    const cv_partials *o, double *g, const int *colptr, double *Ax,
+                                    double hscale, double *bad) {
   /* constant points only up to degree 4: beyond, the fully unrolled kernel spills (p = 8
    * measured 1.5x slower than with the loop over points kept) */
   int P1 = p + 1, same = r->q == P1 && P1 <= 5;

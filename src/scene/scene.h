@@ -78,6 +78,7 @@ typedef struct scene {
   int adapt_line;
   double tol; /* [mesh] tol: automatic accuracy (hp), 0: off */
   int tol_line;
+  int tol_max_nodes;              /* --max-nodes: cap of tol on the nodes, 0: SCENE_TOL_MAX_NODES */
   double time_limit;              /* --time-limit: seconds for the rounds of tol/adapt, 0: none */
   int elements_line, degree_line; /* 0 when not given (--tol then picks its start) */
 #define SCENE_TOL_MAX_NODES      1000000 /* cap of --tol / [mesh] tol on the nodes */

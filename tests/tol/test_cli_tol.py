@@ -16,7 +16,7 @@
 # - where [exact] gives only the action: relative action error <= 10 T;
 # - T = 1e-17: exit 1, the round-off sentence; --tol with --adapt: exit 2;
 # - --time-limit: a tiny cap ends with exit 1, the cap and the estimate in the sentence;
-#   bad values exit 2;
+#   bad values exit 2; the same for --max-nodes; a noise floor of a table stops the rounds;
 # - an estimate without a bound is said so (issue 14: a reference that converged on
 #   another stationary path), and an estimate that exists is honest against an independent
 #   fine solve.
@@ -189,6 +189,34 @@ check("--time-limit without --tol exit 2", r.returncode == 2 and "automatic accu
       r.stderr, r.stderr)
 r = run(brach, "--adapt", "1e-12", "--degree", "2", "--time-limit", "1e-6")
 check("--adapt time limit exit 1", r.returncode == 1 and "time limit" in r.stderr, r.stderr)
+
+# The cap on the nodes (--max-nodes, HP-6): below what the brachistochrone at 1e-10 needs,
+# exit 1 with the cap, the option to raise it and the estimate reached; the report's mesh
+# within the cap. Bad values, and the cap without --tol: exit 2.
+r, d = solve_json(brach, "--tol", "1e-10", "--max-nodes", "60")
+msg = d.get("message", "")
+check("max-nodes exit 1", r.returncode == 1 and d.get("status") == "max_iterations",
+      "%d: %s" % (r.returncode, msg))
+check("max-nodes sentence", "cap of 60 nodes" in msg and "--max-nodes" in msg, msg)
+check("max-nodes mesh within the cap", 0 < d.get("nodes", 0) <= 60, d.get("nodes"))
+check("max-nodes estimate", isinstance(d.get("error_estimate"), float) and
+      d["error_estimate"] > 1e-10, d.get("error_estimate"))
+for v in ("1", "0", "abc", "1e3"):
+    r = run(brach, "--tol", "1e-8", "--max-nodes", v)
+    check("--max-nodes %s exit 2" % v, r.returncode == 2 and "--max-nodes" in r.stderr,
+          r.stderr)
+r = run(brach, "--max-nodes", "100")
+check("--max-nodes without --tol exit 2", r.returncode == 2 and "--tol" in r.stderr, r.stderr)
+
+# A floor of the integrand's own values (HP-6): the tabulated ridge below its spline's
+# rounding. Rounds that multiply the nodes without halving the estimate stop with a
+# sentence, long before the cap of 10^6 nodes (they used to double the mesh up to it).
+r, d = solve_json(os.path.join(examples, "height_map_path.scene"), "--tol", "1e-13")
+msg = d.get("message", "")
+check("noise floor exit 1", r.returncode == 1 and d.get("status") == "max_iterations",
+      "%d: %s" % (r.returncode, msg))
+check("noise floor sentence", "stopped decreasing" in msg and "without halving" in msg, msg)
+check("noise floor before the cap", 0 < d.get("nodes", 0) <= 250000, d.get("nodes"))
 
 # A mesh too coarse to resolve the oscillation: the enriched solve finds another Morse
 # index, and the report says there is no bound instead of giving one.
