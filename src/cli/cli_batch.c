@@ -25,7 +25,7 @@
 
 /* window = threads x this (x ranks under MPI): the threads meet once a window (and the
  * ranks, to gather it), so a window is many rows; memory depends on it only. */
-enum { ROWS_PER_THREAD = 256 };
+enum { ROWS_PER_THREAD = 1024 };
 
 static void usage(FILE *f) {
   fputs("usage: calcvar batch SCENE TABLE.csv [options]\n"

@@ -22,9 +22,9 @@ tmp = tempfile.mkdtemp(prefix="cvmpi")
 table = os.path.join(tmp, "t.csv")
 with open(table, "w") as f:
     f.write("A,B,L,c\n")
-    # windows of 2 x 256 rows with one thread per rank: both ranks get rows, and the last
+    # windows of 2 x 1024 rows with one thread per rank: both ranks get rows, and the last
     # window is partial
-    for k in range(700):
+    for k in range(2800):
         f.write("%r,%r,%r,%r\n" % (round(rng.uniform(-2, 2), 3), round(rng.uniform(-2, 2), 3),
                                    round(rng.uniform(0.2, 3), 3), round(rng.uniform(-3, 3), 3)))
 scene = os.path.join(data, "line.scene")
@@ -56,10 +56,10 @@ two = subprocess.run(cmd + [calcvar, "batch", scene, table, "--threads", "1"],
 # A bad row in the second rank's block: exit 2, its FILE:LINE said once (by that rank).
 bad = os.path.join(tmp, "bad.csv")
 with open(bad, "w") as f:
-    f.write("A,B\n" + "1,2\n" * 300 + "3,x\n" + "1,2\n" * 40 + "4,y\n")
+    f.write("A,B\n" + "1,2\n" * 1200 + "3,x\n" + "1,2\n" * 40 + "4,y\n")
 three = subprocess.run(cmd + [calcvar, "batch", scene, bad, "--threads", "1"],
                        capture_output=True, text=True, timeout=240, env=env)
-msg = "%s:302: column 'B': 'x' is not a finite number" % bad
+msg = "%s:1202: column 'B': 'x' is not a finite number" % bad
 failures = 0
 for what, ok, detail in [
         ("bad row: exit 2", three.returncode == 2, three.returncode),
@@ -68,7 +68,7 @@ for what, ok, detail in [
         ("bad row: nothing written", three.stdout == "", three.stdout[:200]),
         ("one process exit 0", one.returncode == 0, one.stderr[:300]),
         ("mpirun -np 2 exit 0", two.returncode == 0, two.stderr[:600]),
-        ("700 rows", len(strip_time(one.stdout)) == 700, len(strip_time(one.stdout))),
+        ("2800 rows", len(strip_time(one.stdout)) == 2800, len(strip_time(one.stdout))),
         ("header once", two.stdout.count("status,action") == 1, two.stdout[:200]),
         ("same table as one process", strip_time(two.stdout) == strip_time(one.stdout),
          (two.stdout[:300], one.stdout[:300]))]:

@@ -204,8 +204,8 @@ bad_case("badcount.csv", "A,B\n1,2\n3\n", 3)
 bad_case("badinterval.csv", "A,L\n1,2\n1,-1\n", 3)
 # Rows are checked by the threads, a window of rows at a time: the first bad row of the
 # file is the one named, whichever thread found it and whatever follows it.
-bad_case("badlate.csv", "A,B\n" + "1,2\n" * 700 + "3,x\n" + "1,2\n" * 400 + "4,y\n", 702)
-bad_case("badlateinterval.csv", "A,L\n" + "1,2\n" * 600 + "1,-1\n" + "1,x\n", 602)
+bad_case("badlate.csv", "A,B\n" + "1,2\n" * 2800 + "3,x\n" + "1,2\n" * 1600 + "4,y\n", 2802)
+bad_case("badlateinterval.csv", "A,L\n" + "1,2\n" * 2400 + "1,-1\n" + "1,x\n", 2402)
 bad_case("badvaluethencount.csv", "A,B\n1,2\n3,x\n1\n", 3)
 bad_case("badcountthenvalue.csv", "A,B\n1,2\n1\n3,x\n", 3)
 
