@@ -425,7 +425,12 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
   st = cv_solve_mesh(f, p);
   cv_solver_set_start(f, 0, NULL);
   if (st) {
-    cv_set_msg(msg, len, "the enriched solve for the error estimate failed: %s", f->msg);
+    cv_set_msg(msg, len,
+               "the enriched solve for the error estimate failed, so nothing confirms that this "
+               "discrete path is near a stationary path of the integral: the mesh may not "
+               "resolve it, or there may be none (ends at a conjugate point); check on a finer "
+               "mesh or with higher degrees (the enriched solve: %s)",
+               f->msg);
     goto cleanup;
   }
   if (f->morse != s->morse) {

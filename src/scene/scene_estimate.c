@@ -21,7 +21,7 @@ int cli_estimate_error(const cv_solver *sv, const cv_problem *p, double *e_all, 
 
 int cli_report_estimate(cli_report *r, const cv_solver *sv, const cv_problem *p) {
   double ea, ev;
-  char why[400] = "";
+  char why[640] = "";
   if (r->nodes <= 0 || r->st != CVAR_OK) return 0;
   if (cli_estimate_error(sv, p, &ea, &ev, why, sizeof why) < 0) return -1;
   if (isfinite(ea)) {

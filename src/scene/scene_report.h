@@ -26,7 +26,7 @@ typedef struct {
   cv_method method;
   cv_status st;
   const char *status;
-  char message[640];
+  char message[1024];
   int elements, degree, nodes, n;
   int *degrees; /* degree of each element (written with --tol), or NULL */
   int has_degrees;

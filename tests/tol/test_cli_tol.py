@@ -17,6 +17,7 @@
 # - T = 1e-17: exit 1, the round-off sentence; --tol with --adapt: exit 2;
 # - --time-limit: a tiny cap ends with exit 1, the cap and the estimate in the sentence;
 #   bad values exit 2; the same for --max-nodes; a noise floor of a table stops the rounds;
+# - a problem with no stationary path (ends at a conjugate point) is not passed off as solved;
 # - an estimate without a bound is said so (issue 14: a reference that converged on
 #   another stationary path), and an estimate that exists is honest against an independent
 #   fine solve.
@@ -26,6 +27,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 
 calcvar, tdata, problems, examples = [os.path.abspath(a) for a in sys.argv[1:5]]
 failures = 0
@@ -217,6 +219,27 @@ check("noise floor exit 1", r.returncode == 1 and d.get("status") == "max_iterat
       "%d: %s" % (r.returncode, msg))
 check("noise floor sentence", "stopped decreasing" in msg and "without halving" in msg, msg)
 check("noise floor before the cap", 0 < d.get("nodes", 0) <= 250000, d.get("nodes"))
+
+# No stationary path: y'^2/2 - pi^2 y^2/2 on [0, 1] with y(0) = 0, y(1) = 1 (x = 1 is
+# conjugate to x = 0). Linear elements put the discrete eigenvalue above pi^2, so the
+# discrete problem has a (huge) minimum and Newton converges to it; the enriched solve
+# fails, and the report must not pass that path off as the integral's: no estimate, and a
+# sentence saying nothing confirms it. Under --tol (degree 8 resolves the eigenvalue to
+# round-off) the Hessian is singular: exit 1, naming the conjugate point.
+nosol = os.path.join(tempfile.mkdtemp(prefix="cvtol"), "nosol.scene")
+with open(nosol, "w") as f:
+    f.write("[scene]\ninterval = 0, 1\nunknowns = y\nintegrand = y'^2/2 - pi^2*y^2/2\n"
+            "[boundary]\ny = 0, 1\n")
+r, d = solve_json(nosol)
+msg = d.get("message", "")
+check("no solution, p = 1: no error_estimate", "error_estimate" not in d, d.get("error_estimate"))
+check("no solution, p = 1: says nothing confirms the path",
+      "nothing confirms that this discrete path is near a stationary path" in msg, msg)
+r, d = solve_json(nosol, "--tol", "1e-8")
+check("no solution, --tol: exit 1 singular", r.returncode == 1 and d.get("status") == "singular",
+      "%d %s" % (r.returncode, d.get("status")))
+check("no solution, --tol: names the conjugate point", "conjugate point" in
+      d.get("message", ""), d.get("message"))
 
 # A mesh too coarse to resolve the oscillation: the enriched solve finds another Morse
 # index, and the report says there is no bound instead of giving one.
