@@ -73,9 +73,9 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o) {
                strcmp(name, "-h") == 0 || strcmp(name, "--all") == 0 ||
                strcmp(name, "--verbose") == 0 || strcmp(name, "-v") == 0;
     static const char *const valued[] = {
-        "--elements",   "--degree", "--method", "--tolerance", "--max-iterations",
-        "--set",        "--adapt",  "--tol",    "--continue",  "--json",
-        "--csv",        "--plot",   "--max",    "--work",      "--max-elements",
+        "--elements",   "--degree",    "--method", "--tolerance", "--max-iterations",
+        "--set",        "--adapt",     "--tol",    "--continue",  "--json",
+        "--csv",        "--plot",      "--max",    "--work",      "--max-elements",
         "--time-limit", "--max-nodes", NULL};
     int known = flag;
     for (int k = 0; valued[k]; k++) known |= strcmp(name, valued[k]) == 0;

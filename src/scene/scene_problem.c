@@ -162,7 +162,8 @@ cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_
   }
   if (st == CVAR_OK && s->tol > 0) {
     what = "tol"; /* [mesh] tol or --tol: automatic accuracy, capped at 1e6 nodes or --max-nodes */
-    st = cv_solver_set_tol(sv, s->tol, s->tol_max_nodes > 0 ? s->tol_max_nodes : SCENE_TOL_MAX_NODES);
+    st = cv_solver_set_tol(sv, s->tol,
+                           s->tol_max_nodes > 0 ? s->tol_max_nodes : SCENE_TOL_MAX_NODES);
   }
   if (st == CVAR_OK && s->time_limit > 0) {
     what = "time limit"; /* --time-limit: a cap on the rounds' wall-clock time (HP-6) */
