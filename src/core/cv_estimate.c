@@ -413,6 +413,8 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
   f->method = CVAR_METHOD_NEWTON;
   f->continuation = 0;
   f->adapt_tol = 0.0;
+  f->polish = 1; /* HP-2a */
+  f->ends_passed[0] = s->ends_ok[0], f->ends_passed[1] = s->ends_ok[1];
   if (!st) st = cv_solver_set_breakpoints(f, 0, NULL);
   if (!st) st = cv_solver_set_mesh_hp(f, Ef, t, deg);
   int nodes_f = 1;

@@ -525,6 +525,19 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
       cv_set_msg(s->msg, sizeof s->msg, "the Newton step is not finite");
       goto cleanup;
     }
+    if (s->polish && wn <= 1.0) {
+      /* HP-2a: an enriched solve's last step, within the tolerance from a start already
+       * within it: taken in full (step_norm put it in w.Yt, w.Mt) without the evaluation
+       * at its end, which would only confirm it; the action and residual reported are
+       * those of the iterate it started from */
+      double *tmp = Yc;
+      Yc = w.Yt, w.Yt = tmp;
+      tmp = Mc, Mc = w.Mt, w.Mt = tmp;
+      have_K = 0; /* no residual floor: nothing reports it */
+      st = CVAR_OK;
+      cv_set_msg(s->msg, sizeof s->msg, "converged in %d iterations", s->iterations);
+      goto cleanup;
+    }
     trial t;
     st = line_search(s, &kkt, h, &w, Yc, Mc, Ax, S, slope, phi, wn,
                      neg == 0 && !constrained && slope < 0, timed, &t);

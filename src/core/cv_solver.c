@@ -40,6 +40,7 @@ void cv_solver_drop_results(cv_solver *s) {
   s->y = s->mult = NULL;
   cv_disc_free(&s->disc); /* the factor stays: cv_newton_run checks it against the mesh */
   s->have = 0;
+  s->ends_ok[0] = s->ends_ok[1] = 0;
 }
 
 void cv_solver_free(cv_solver *s) {
