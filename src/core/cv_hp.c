@@ -202,3 +202,39 @@ cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
   *Enew = k;
   return CVAR_OK;
 }
+
+cv_status cv_hp_pilot_mesh(const cv_disc *d, const double *tail, double aim, int *Enew, double **t,
+                           int **deg) {
+  int E = d->E;
+  double total = 0.0;
+  for (int e = 0; e < E; e++) total += fmax(1.0, pow(tail[e] / aim, 1.0 / (CV_MAX_DEGREE + 1)));
+  double Mr = ceil(total - 1e-9); /* the h-rate at degree 8: tail ~ h^9 */
+  int M = !(Mr <= MAX_PIECES * (double)E) ? MAX_PIECES * E : Mr < E + 1 ? E + 1 : (int)Mr;
+  *t = cv_malloc((size_t)(M + 1) * sizeof **t);
+  *deg = cv_malloc((size_t)M * sizeof **deg);
+  if (!*t || !*deg) {
+    cv_free(*t);
+    cv_free(*deg);
+    *t = NULL;
+    *deg = NULL;
+    return CVAR_ENOMEM;
+  }
+  /* the k-th boundary where the cumulative share reaches k total / M */
+  double a = d->xe[0], L = d->xe[E] - a, cum = 0.0;
+  int k = 1, e = 0;
+  (*t)[0] = 0.0;
+  for (; e < E && k < M; e++) {
+    double r = fmax(1.0, pow(tail[e] / aim, 1.0 / (CV_MAX_DEGREE + 1)));
+    double t0 = (d->xe[e] - a) / L, t1 = (d->xe[e + 1] - a) / L;
+    while (k < M && cum + r >= total * k / M) {
+      double u = t0 + (t1 - t0) * (total * k / M - cum) / r;
+      if (u > (*t)[k - 1] && u < 1.0) (*t)[k++] = u;
+      else break; /* round-off: fewer elements */
+    }
+    cum += r;
+  }
+  (*t)[k] = 1.0;
+  for (int j = 0; j < k; j++) (*deg)[j] = CV_MAX_DEGREE;
+  *Enew = k;
+  return CVAR_OK;
+}

@@ -346,6 +346,12 @@ int cv_hp_marked(double eta, double sigma, double thresh, double target, int hp)
 cv_status cv_hp_refine(const cv_disc *d, const double *eta, const double *sigma,
                        const double *where, double thresh, double target, int hp, int *Enew,
                        double **t, int **deg);
+/* HP-7a: the pilot's mesh of degree-8 elements for a mesh of degree-8 elements with
+ * predicted tails tail[e]: element e needs r_e = max(1, (tail_e / aim)^(1/9)) pieces, and
+ * M = max(E + 1, ceil(sum r_e)) elements are laid so that each holds an equal share of
+ * sum r_e (r_e spread evenly over element e). */
+cv_status cv_hp_pilot_mesh(const cv_disc *d, const double *tail, double aim, int *Enew, double **t,
+                           int **deg);
 double cv_now(void);
 
 cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y);
