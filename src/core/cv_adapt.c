@@ -237,6 +237,20 @@ static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where
   return 1;
 }
 
+/* HP-2a: whether each end of the next mesh (t, deg) lies in the end element of s's last
+ * solve, at no lower degree, and that solve passed the near-singular end check (Q-3)
+ * there: then the next solve need not check it again (a smaller element of the same or a
+ * higher degree integrates the same integrand at least as well). */
+static void ends_inherited(cv_solver *s, int E, const double *t, const int *deg) {
+  const cv_disc *d = &s->disc;
+  s->ends_passed[0] = s->ends_passed[1] = 0;
+  if (s->rounds < 2 || !s->have || d->E < 1 || E < 1) return; /* this run's rounds only */
+  double a = d->xe[0], L = d->xe[d->E] - a;
+  s->ends_passed[0] = s->ends_ok[0] && t[1] <= (d->xe[1] - a) / L && deg[0] >= cv_disc_edeg(d, 0);
+  s->ends_passed[1] = s->ends_ok[1] && t[E - 1] >= (d->xe[d->E - 1] - a) / L &&
+                      deg[E - 1] >= cv_disc_edeg(d, d->E - 1);
+}
+
 static int cmp_desc(const void *a, const void *b) {
   double x = *(const double *)a, y = *(const double *)b;
   return (x < y) - (x > y);
@@ -287,6 +301,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     goto cleanup;
   }
   for (s->rounds = 1;; s->rounds++) {
+    ends_inherited(s, E, t, deg);
     st = cv_solver_set_mesh_hp(s, E, t, deg);
     if (!st && warm) st = cv_warm_start(s, p, warm == 1 ? f : s);
     if (st) goto cleanup;
@@ -405,6 +420,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     }
   }
 cleanup:
+  s->ends_passed[0] = s->ends_passed[1] = 0; /* the next plain solve checks its ends */
   s->iterations = (int)(iters > 2000000000L ? 2000000000L : iters); /* all rounds */
   cv_free(s->mesh.t);
   cv_free(s->mesh.degrees);

@@ -289,11 +289,13 @@ struct cv_solver {
   cv_progress_fn progress; /* cv_solver_set_progress; NULL: none */
   void *progress_user;
   int near_sing[2];         /* ends found nearly singular after a solve */
-  /* An estimate's enriched solve (HP-2a): Newton takes a step within the tolerance without
-   * evaluating the system at its end (the step is the last one and only the values are
-   * used), and end k is not checked for near-singularity (Q-3) when ends_passed[k] says
-   * the solution being estimated passed that check on a coarser end element. ends_ok[k]:
-   * the last solve's end k passed that check (cv_solve_mesh; cleared with the results). */
+  /* polish: an estimate's enriched solve (HP-2a): Newton takes a step within the tolerance
+   * without evaluating the system at its end (the step is the last one and only the values
+   * are used). ends_passed[k], set by the caller for the next solve: end k passed the
+   * near-singular end check (Q-3) on an end element containing this mesh's, of no higher
+   * degree (the solution being estimated, the previous round), so it is not checked again.
+   * ends_ok[k]: the last solve's end k passed that check (cv_solve_mesh; cleared with the
+   * results). */
   int polish, ends_passed[2], ends_ok[2];
   double search_work;       /* cv_solve_all's work limit (cv_deflation.c) */
   struct cv_pathset *paths; /* the paths of the last cv_solve_all (cv_deflation.c) */

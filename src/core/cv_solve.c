@@ -472,16 +472,13 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
       s->method == CVAR_METHOD_NEWTON && s->mesh.kind == CV_MESH_UNIFORM && !s->start && s->have &&
       !s->disc.sing_a && !s->disc.sing_b && s->maxit >= 20)
     st = graded_retry(s, p, st);
-  int checked[2] = {0, 0};
   for (int end = 0; end < 2 && st == CVAR_OK; end++)
-    if (!(s->polish && s->ends_passed[end])) { /* HP-2a: passed on a coarser end element */
+    if (!s->ends_passed[end]) /* HP-2a: passed on a coarser end element */
       un[end] = cv_start_end_unresolved(p, &s->disc, s->y, end, s->action, &rel[end]);
-      checked[end] = 1;
-    }
   if (un[0] || un[1])
     st = resolve_singular_ends(s, p, un, rel);
   else if (st == CVAR_OK)
-    s->ends_ok[0] = checked[0] && !s->disc.sing_a, s->ends_ok[1] = checked[1] && !s->disc.sing_b;
+    s->ends_ok[0] = !s->disc.sing_a, s->ends_ok[1] = !s->disc.sing_b;
   if (st == CVAR_OK && s->morse > 0) caution_tiny_end_elements(s);
   if (s->note[0]) prefix_note(s);
   s->status = st;
