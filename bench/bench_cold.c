@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include "calcvar.h"
+#include "refproblems.h"
 
 static double now(void) {
   struct timespec ts;
@@ -27,48 +28,9 @@ static double now(void) {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-/* Fish-eye ray n = 2 / (1 + x^2 + y^2) from (-1, 0) to (1, 0)... as in the tests: on
- * [-1, 1] with y(+-1) = 0, 2 elements of degree 4 (max nodal error ~1e-8). */
-static int fisheye_F(int m, const double *x, const double *y, const double *dy, unsigned need,
-                     cv_partials *o, void *user) {
-  (void)need, (void)user;
-  for (int k = 0; k < m; k++) {
-    double p = dy[k], s = sqrt(1 + p * p), r = 1 + x[k] * x[k] + y[k] * y[k];
-    double nn = 2 / r, ny = -4 * y[k] / (r * r);
-    double nyy = -4 / (r * r) + 16 * y[k] * y[k] / (r * r * r);
-    o->F[k] = nn * s;
-    if (o->Fy) {
-      o->Fy[k] = ny * s;
-      o->Fp[k] = nn * p / s;
-    }
-    if (o->Fyy) {
-      o->Fyy[k] = nyy * s;
-      o->Fyp[k] = ny * p / s;
-      o->Fpp[k] = nn / (s * s * s);
-    }
-  }
-  return 0;
-}
-
-static int catenary_F(int m, const double *x, const double *y, const double *dy, unsigned need,
-                      cv_partials *o, void *user) {
-  (void)x, (void)need, (void)user;
-  for (int k = 0; k < m; k++) {
-    double s = sqrt(1 + dy[k] * dy[k]);
-    o->F[k] = y[k] * s;
-    if (o->Fy) {
-      o->Fy[k] = s;
-      o->Fp[k] = y[k] * dy[k] / s;
-    }
-    if (o->Fyy) {
-      o->Fyy[k] = 0;
-      o->Fyp[k] = dy[k] / s;
-      o->Fpp[k] = y[k] / (s * s * s);
-    }
-  }
-  return 0;
-}
-
+/* The problems are two of the tests' reference problems (tests/core/refproblems.h, hand-
+ * derived partials): the fish-eye ray n = 2 / (1 + x^2 + y^2) on [0, 1], 2 elements of
+ * degree 4, and the catenary y sqrt(1 + y'^2) on [-1, 1], 3 elements of degree 4. */
 static long minor_faults(void) {
   struct rusage ru;
   return getrusage(RUSAGE_SELF, &ru) == 0 ? ru.ru_minflt : 0;

@@ -380,26 +380,22 @@ int cli_buf_put(cli_buf *o, const char *s, size_t len) {
 
 int cli_buf_printf(cli_buf *o, const char *fmt, ...) {
   va_list ap;
-  for (;;) {
-    size_t room = o->cap - o->len;
+  for (int pass = 0; pass < 2; pass++) { /* into the room left; else grow to fit, once */
+    size_t room = o->data ? o->cap - o->len : 0;
     va_start(ap, fmt);
-    int k = o->data ? vsnprintf(o->data + o->len, room, fmt, ap) : -1;
+    int k = vsnprintf(room ? o->data + o->len : NULL, room, fmt, ap);
     va_end(ap);
-    if (k >= 0 && (size_t)k < room) {
-      o->len += (size_t)k;
-      return 0;
-    }
-    size_t need = o->len + (k > 0 ? (size_t)k : 64) + 1;
-    size_t ncap = o->cap ? o->cap : 1024;
-    while (ncap < need) ncap *= 2;
-    char *nd = realloc(o->data, ncap);
-    if (!nd) {
+    if (k < 0) {
       o->failed = 1;
       return -1;
     }
-    o->data = nd;
-    o->cap = ncap;
+    if ((size_t)k < room) {
+      o->len += (size_t)k;
+      return 0;
+    }
+    if (reserve(o, (size_t)k) < 0) return -1;
   }
+  return -1; /* not reached: reserve left room for k bytes and the '\0' */
 }
 
 /* ---- the command -------------------------------------------------------------------- */

@@ -31,8 +31,8 @@ void cli_report_text(FILE *f, const cli_report *r) {
       fprintf(f, "  floor       %.3g: the residual is %.2g times this round-off floor (%s)\n",
               r->residual_floor, q,
               q <= 100           ? "at round-off"
-              : r->st == CVAR_OK ? "above round-off: the step test stopped Newton first; a "
-                                   "smaller tolerance takes it further"
+              : r->st == CVAR_OK ? "above round-off: Newton stopped on its step test, which "
+                                   "does not test the residual"
                                  : "above round-off");
     }
     /* Newton's convergence test is on the step, not on this number, which on fine meshes

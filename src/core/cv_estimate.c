@@ -407,8 +407,13 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
     return CVAR_ESTATE;
   }
   f->nq = 0;
-  f->rtol = s->rtol;
-  f->atol = s->atol;
+  /* The enriched solve's Newton step test: the caller's, but not below 1e-12. y+ is wanted
+   * to a fraction of the error it measures, and Newton's last step is the square of the one
+   * before, so its error is far below the test's; a smaller test asks, next to a singular
+   * end, for what round-off cannot give (the line search then fails: brachistochrone
+   * --tol 1e-10 --tolerance 1e-14) (HP-2). */
+  f->rtol = fmax(s->rtol, 1e-12);
+  f->atol = fmax(s->atol, 1e-12);
   f->maxit = s->maxit;
   f->method = CVAR_METHOD_NEWTON;
   f->continuation = 0;

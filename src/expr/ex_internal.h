@@ -42,6 +42,8 @@ typedef struct {
 } ex_function;
 /* The function called `name`, or NULL. */
 const ex_function *ex_function_find(const char *name);
+/* The grammar function nearest to a mistyped name (ex_name_close), or NULL. */
+const char *ex_function_nearest(const char *name);
 /* Name of a function as written in the grammar ("sin"), or NULL for operators. */
 const char *ex_op_name(ex_op op);
 /* Value of op applied to numbers (the pointwise semantics shared by constant folding and

@@ -24,6 +24,43 @@ const ex_function *ex_function_find(const char *name) {
   return NULL;
 }
 
+/* Edit distance between two short names (insertions, deletions, substitutions and swaps of
+ * neighbours: the usual typing slips); names longer than 31 characters count as far. */
+int ex_name_distance(const char *a, const char *b) {
+  enum { M = 32 };
+  size_t la = strlen(a), lb = strlen(b);
+  if (la >= M || lb >= M) return M;
+  int d[M + 1][M + 1];
+  for (size_t i = 0; i <= la; i++) d[i][0] = (int)i;
+  for (size_t j = 0; j <= lb; j++) d[0][j] = (int)j;
+  for (size_t i = 1; i <= la; i++)
+    for (size_t j = 1; j <= lb; j++) {
+      int c = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+      if (d[i - 1][j] + 1 < c) c = d[i - 1][j] + 1;
+      if (d[i][j - 1] + 1 < c) c = d[i][j - 1] + 1;
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] && d[i - 2][j - 2] + 1 < c)
+        c = d[i - 2][j - 2] + 1;
+      d[i][j] = c;
+    }
+  return d[la][lb];
+}
+
+int ex_name_close(const char *typed, const char *known) {
+  int dist = ex_name_distance(typed, known), len = (int)strlen(typed);
+  return dist > 0 && dist <= (len <= 4 ? 1 : 2) && dist < len;
+}
+
+const char *ex_function_nearest(const char *name) {
+  const char *best = NULL;
+  int bd = 1 << 20;
+  for (size_t i = 0; i < NUM_FUNCTIONS; i++) { /* ties: a name of the same length (cohs: cosh) */
+    int dist =
+        2 * ex_name_distance(name, functions[i].name) + (strlen(name) != strlen(functions[i].name));
+    if (ex_name_close(name, functions[i].name) && dist < bd) best = functions[i].name, bd = dist;
+  }
+  return best;
+}
+
 const char *ex_op_name(ex_op op) {
   for (size_t i = 0; i < NUM_FUNCTIONS; i++)
     if (functions[i].op == op) return functions[i].name;

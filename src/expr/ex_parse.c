@@ -234,7 +234,11 @@ static ex_id parse_name(parser *p) {
     return parse_table_call(p, table, name, at);
   if (table >= 0) return fail(p, at, "'%s' is a table: write %s(...)", name, name);
   if (p->s[p->pos] == '(' && !primes) {
-    if (!f) return fail(p, at, "unknown function '%s'", name);
+    if (!f) {
+      const char *near = ex_function_nearest(name);
+      if (near) return fail(p, at, "unknown function '%s' (did you mean '%s'?)", name, near);
+      return fail(p, at, "unknown function '%s'", name);
+    }
     return parse_call(p, f, at);
   }
   if (primes > 2 || (primes == 2 && !p->allow_second))

@@ -83,6 +83,11 @@ ex_id ex_nonfinite_const(const ex_dag *d, ex_id e);
  * function names, which no parameter or unknown may take. */
 int ex_is_identifier(const char *s);
 int ex_is_reserved(const char *s);
+/* Edit distance of two names (insert, delete, substitute, swap neighbours), and whether
+ * known is close enough to typed to suggest it in a message ("did you mean ...?"): 1 edit
+ * for names of up to 4 characters, 2 beyond, never all of them. */
+int ex_name_distance(const char *a, const char *b);
+int ex_name_close(const char *typed, const char *known);
 
 /* A value split at commas outside parentheses; off[i] is item i's offset in the value. */
 typedef struct {

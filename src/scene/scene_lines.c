@@ -10,9 +10,11 @@
  * checks section headers (inih does not report empty sections to the handler). inih then
  * receives one short canonical line per logical line (scene_ini.c).
  */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "expr/expr.h"
 #include "scene/scene_internal.h"
 
 static const char *const section_names[SEC_COUNT] = {
@@ -166,12 +168,17 @@ int sc_llines_read(sc_llines *ll, const char *text, size_t len, const char *file
         name[b - a] = '\0';
         sec = sc_section_from_name(name);
       }
-      if (sec < 0) {
+      if (sec < 0) { /* the known sections, the nearest first if one is a slip away */
+        char known[256] = "", hint[64] = "";
+        size_t kl = 0;
+        for (int k = 0; k < SEC_COUNT; k++) {
+          kl += (size_t)snprintf(known + kl, sizeof known - kl, "%s%s", k ? ", " : "",
+                                 section_names[k]);
+          if (!hint[0] && b - a < sizeof name && ex_name_close(name, section_names[k]))
+            snprintf(hint, sizeof hint, "did you mean [%s]? ", section_names[k]);
+        }
         excerpt(buf, sizeof buf, t + a, b - a);
-        sc_err(err, errlen, file, line,
-               "unknown section [%s] (known: scene, parameters, definitions, boundary, "
-               "guess, constraints, integrals, exact, report, mesh, solver)",
-               buf);
+        sc_err(err, errlen, file, line, "unknown section [%s] (%sknown: %s)", buf, hint, known);
         goto fail;
       }
       if (seen[sec]) {

@@ -41,6 +41,46 @@ static int find_item(const sc_item *it, int n, const char *name) {
   return -1;
 }
 
+/* A hint for a name that resolves to nothing: a derivative written without its prime (yp,
+ * yprime, ydot, y_x, dy, dydx: y'), or the nearest name usable here (ex_name_close: one or
+ * two typing slips); "" when there is none. */
+static void suggest(const sc_loader *L, const char *name, char *out, size_t cap) {
+  static const char *const suffix[] = {"p", "prime", "dot", "_x", NULL};
+  const scene *s = L->s;
+  size_t ln = strlen(name);
+  out[0] = '\0';
+  for (int i = 0; i < s->n; i++) {
+    const char *u = s->unknowns[i];
+    size_t lu = strlen(u);
+    int deriv =
+        name[0] == 'd' && (strcmp(name + 1, u) == 0 ||
+                           (ln == lu + 3 && strncmp(name + 1, u, lu) == 0 && name[lu + 1] == 'd' &&
+                            strcmp(name + lu + 2, s->variable) == 0));
+    for (int k = 0; suffix[k] && !deriv; k++)
+      deriv = ln > lu && strncmp(name, u, lu) == 0 && strcmp(name + lu, suffix[k]) == 0;
+    if (deriv) {
+      snprintf(out, cap, " (did you mean %s'? a derivative is written with a prime)", u);
+      return;
+    }
+  }
+  const char *best = NULL;
+  int bd = 1 << 20;
+#define TRY(c)                                                                                     \
+  do {                                                                                             \
+    const char *c_ = (c);                                                                          \
+    if (c_ && ex_name_close(name, c_) && ex_name_distance(name, c_) < bd)                          \
+      bd = ex_name_distance(name, c_), best = c_;                                                  \
+  } while (0)
+  TRY(s->variable);
+  TRY("pi");
+  for (int i = 0; i < s->n; i++) TRY(s->unknowns[i]);
+  for (int i = 0; i < s->nparams && (L->mode != SC_R_PARAM || i < L->limit); i++)
+    TRY(s->params[i].name);
+  for (int i = 0; L->mode != SC_R_PARAM && i < s->ndefs && i < L->limit; i++) TRY(s->defs[i].name);
+#undef TRY
+  if (best) snprintf(out, cap, " (did you mean '%s'?)", best);
+}
+
 /* Resolve a name for ex_parse. Parameters become their numbers and definitions their
  * nodes, so both are substituted where named (SCENES.md [definitions]). */
 static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *err,
@@ -70,11 +110,13 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
     }
     return ex_num(d, s->params[i].value);
   }
+  char hint[160];
+  suggest(L, name, hint, sizeof hint);
   if (L->mode == SC_R_PARAM) {
     snprintf(err, errlen,
              "unknown name '%s' (a parameter may use only numbers, pi and "
-             "earlier parameters)",
-             name);
+             "earlier parameters)%s",
+             name, hint);
     return -1;
   }
   if ((i = find_item(s->defs, s->ndefs, name)) >= 0) {
@@ -109,7 +151,7 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
     }
     return ex_slot(d, primes ? 1 + s->n + i : 1 + i);
   }
-  snprintf(err, errlen, "unknown name '%s'", name);
+  snprintf(err, errlen, "unknown name '%s'%s", name, hint);
   return -1;
 }
 

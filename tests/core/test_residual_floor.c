@@ -16,15 +16,7 @@
 
 #include "calcvar.h"
 
-static int fails;
-#define CHECK(c, ...)                                                                              \
-  do {                                                                                             \
-    if (!(c)) {                                                                                    \
-      fails++;                                                                                     \
-      printf("FAIL: " __VA_ARGS__);                                                                \
-      printf("\n");                                                                                \
-    }                                                                                              \
-  } while (0)
+#include "check.h"
 
 static int quad(int m, const double *x, const double *y, const double *dy, unsigned need,
                 cv_partials *o, void *user) {

@@ -16,15 +16,7 @@
 
 #include "core/cv_internal.h"
 
-static int fails;
-#define CHECK(c, ...)                                                                              \
-  do {                                                                                             \
-    if (!(c)) {                                                                                    \
-      fails++;                                                                                     \
-      printf("FAIL: " __VA_ARGS__);                                                                \
-      printf("\n");                                                                                \
-    }                                                                                              \
-  } while (0)
+#include "check.h"
 
 /* Integral of t^k over [-1, 1]. */
 static double moment(int k) { return k % 2 ? 0.0 : 2.0 / (k + 1); }

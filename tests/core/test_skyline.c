@@ -12,15 +12,7 @@
 
 #include "core/cv_internal.h"
 
-static int fails;
-#define CHECK(c, ...)                                                                              \
-  do {                                                                                             \
-    if (!(c)) {                                                                                    \
-      fails++;                                                                                     \
-      printf("FAIL: " __VA_ARGS__);                                                                \
-      printf("\n");                                                                                \
-    }                                                                                              \
-  } while (0)
+#include "check.h"
 
 static int F2(int m, const double *x, const double *y, const double *dy, unsigned need,
               cv_partials *o, void *user) {

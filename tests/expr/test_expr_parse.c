@@ -106,6 +106,8 @@ static void check_errors(void) {
       {"x * ", 0, 5, "expected a number, name or '('"},
       {"x ^", 0, 4, "expected a number"},
       {"foo(x)", 0, 1, "unknown function 'foo'"},
+      {"exq(x)", 0, 1, "unknown function 'exq' (did you mean 'exp'?)"},
+      {"1 + cohs(x)", 0, 5, "unknown function 'cohs' (did you mean 'cosh'?)"},
       {"1 + q", 0, 5, "unknown name 'q'"},
       {"x'", 0, 1, "prime is only allowed on an unknown"},
       {"2 + y''", 0, 5, "y'': only the first derivative y' may be written here"},
@@ -258,7 +260,28 @@ static void check_many_slots(void) {
   ex_dag_free(d);
 }
 
+/* The distance behind "did you mean" (insert, delete, substitute, swap neighbours), against
+ * values counted by hand, and which names are close enough to suggest. */
+static void check_name_distance(void) {
+  struct {
+    const char *a, *b;
+    int d, close;
+  } c[] = {{"sqrt", "sqrt", 0, 0},    {"sqr", "sqrt", 1, 1},
+           {"alpah", "alpha", 1, 1},  {"kitten", "sitting", 3, 0},
+           {"ab", "ba", 1, 1},        {"", "abc", 3, 0},
+           {"z", "y", 1, 0},          {"epps", "eps", 1, 1},
+           {"lambda", "lamda", 1, 1}, {"gama", "gamma", 1, 1},
+           {"omegaa", "omega", 1, 1}, {"xyz", "abc", 3, 0}};
+  for (size_t k = 0; k < sizeof c / sizeof c[0]; k++) {
+    CHECK(ex_name_distance(c[k].a, c[k].b) == c[k].d, "distance('%s', '%s') = %d, expected %d",
+          c[k].a, c[k].b, ex_name_distance(c[k].a, c[k].b), c[k].d);
+    CHECK(ex_name_close(c[k].a, c[k].b) == c[k].close, "close('%s', '%s') should be %d", c[k].a,
+          c[k].b, c[k].close);
+  }
+}
+
 int main(void) {
+  check_name_distance();
   check_values();
   check_errors();
   check_hostile();
