@@ -222,8 +222,41 @@ static void start_and_time_cap(void) {
   cv_problem_free(q);
 }
 
+/* 6. HP-7a: from a uniform degree-8 start (4 elements: 2 are too coarse for a smooth decay,
+ * sigma < 1, and get an estimated round first), the pilot lays the mesh of the final round
+ * in one go: on the oscillator at 1e-12, two rounds (the pilot's and the one it lays), at
+ * most 3 elements more than the fewest uniform degree-8 elements whose true max nodal
+ * error (against the exact solution) is within 1e-12 (the whole-element splits aimed at T
+ * before HP-7a: 18 elements against 11), and honest. */
+static void pilot_lands(void) {
+  cv_problem *q = oscillator();
+  cv_solver *s = cv_solver_new(NULL);
+  cv_solver_set_degree(s, 8);
+  int fewest = 0;
+  for (int m = 2; m <= 40 && !fewest; m++) {
+    cv_solver_set_elements(s, m);
+    CHECK(cv_solve(s, q) == CVAR_OK, "%d x p8: %s", m, cv_solver_last_error(s));
+    if (max_nodal_error(s, osc_exact) <= 1e-12) fewest = m;
+  }
+  CHECK(fewest > 2, "fewest uniform degree-8 elements for 1e-12: %d", fewest);
+  cv_solver_set_elements(s, 4);
+  cv_solver_set_tol(s, 1e-12, 100000);
+  CHECK(cv_solve(s, q) == CVAR_OK, "oscillator 1e-12: %s", cv_solver_last_error(s));
+  int E = cv_solver_get_num_elements(s), rounds = cv_solver_get_adapt_rounds(s);
+  double est = cv_solver_get_error_estimate(s), err = max_nodal_error(s, osc_exact);
+  printf("pilot (HP-7a): oscillator 1e-12 from 4 x p8: %d rounds, %d elements, %d nodes "
+         "(fewest uniform: %d x p8), estimate %.2e, true %.2e\n",
+         rounds, E, cv_solver_get_num_nodes(s), fewest, est, err);
+  CHECK(rounds == 2, "rounds %d", rounds);
+  CHECK(E <= fewest + 3, "%d elements, fewest uniform %d", E, fewest);
+  CHECK(err <= 1e-11 && est >= 0.1 * err, "true %.3g, estimate %.3g", err, est);
+  cv_solver_free(s);
+  cv_problem_free(q);
+}
+
 int main(void) {
   start_and_time_cap();
+  pilot_lands();
   same_as_uniform();
   mixed_degrees();
   morse_and_no_bound();
