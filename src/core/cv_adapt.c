@@ -198,17 +198,15 @@ static int next_size(const cv_disc *d, const double *eta, const double *sigma, d
 #define PILOT_MISS   1.0
 #define PILOT_AIM    10.0
 /* HP-7a: on a mesh of degree 8 alone, the pilot's tails are aimed at PILOT_AIM8 x tol: the
- * nodal error, which the estimate measures and compares with tol, was measured at 0.003 to
- * 0.07 of the predicted tail on the smooth reference problems once it is below 1e-9 */
-#ifndef PILOT_AIM8
+ * nodal error, which the estimate measures and compares with tol, was measured at 0.004 to
+ * 0.07 of the largest predicted tail on the smooth reference problems (tails 1e-9..1e-14) */
 #define PILOT_AIM8 10.0
-#endif
 /* HP-7: after the first solve, when every element has degree >= 4 and decays smoothly
  * (sigma >= 1) and the largest predicted next coefficient is above tol, refine by those
  * predictions (HP-4 with eta = the tail) without the estimate: the enriched solve of a mesh
  * predicted to be too coarse is skipped. 1 when it refined (E, t, deg replaced), 0 when not, -1 out of memory. */
 static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where, double tol,
-                        int *E, double **t, int **deg) {
+                        int keep_bounds, int *E, double **t, int **deg) {
   const cv_disc *d = &s->disc;
   double tmax = 0.0;
   cv_estimate_pilot(s, tail, sigma);
@@ -218,7 +216,8 @@ static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where
     where[e] = 0.0;
   }
   if (!(tmax > PILOT_MISS * tol)) return 0;
-  int En = 0, *dn = NULL, all8 = !d->sing_a && !d->sing_b;
+  /* HP-7a lays new boundaries: not with breakpoints, which must stay boundaries */
+  int En = 0, *dn = NULL, all8 = !d->sing_a && !d->sing_b && !keep_bounds;
   double *tn = NULL;
   for (long e = 0; e < d->E && all8; e++) all8 = cv_disc_edeg(d, e) == CV_MAX_DEGREE;
   if (all8 ? cv_hp_pilot_mesh(d, tail, PILOT_AIM8 * tol, &En, &tn, &dn)
@@ -328,7 +327,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       goto cleanup;
     }
     if (s->hp && s->rounds == 1) { /* HP-7: the first solve's own coefficients */
-      int r = pilot_refine(s, eta, sigma, where, tol, &E, &t, &deg);
+      int r = pilot_refine(s, eta, sigma, where, tol, spec0.nbreak > 0, &E, &t, &deg);
       if (r < 0) {
         st = CVAR_ENOMEM;
         goto cleanup;
