@@ -201,6 +201,10 @@ static int next_size(const cv_disc *d, const double *eta, const double *sigma, d
  * nodal error, which the estimate measures and compares with tol, was measured at 0.004 to
  * 0.07 of the largest predicted tail on the smooth reference problems (tails 1e-9..1e-14) */
 #define PILOT_AIM8 10.0
+/* ... and trusted from a Legendre rate of 0.75 (HP-4's smooth is 1): an oscillation of 0.85
+ * periods per degree-8 element decays at 0.96, and the h^9 of HP-7a over-states what
+ * halving such an element gains (its rate also grows by ln 2), so it is not too few */
+#define PILOT_RATE8 0.75
 /* HP-7: after the first solve, when every element has degree >= 4 and decays smoothly
  * (sigma >= 1) and the largest predicted next coefficient is above tol, refine by those
  * predictions (HP-4 with eta = the tail) without the estimate: the enriched solve of a mesh
@@ -209,17 +213,19 @@ static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where
                         int keep_bounds, int *E, double **t, int **deg) {
   const cv_disc *d = &s->disc;
   double tmax = 0.0;
-  cv_estimate_pilot(s, tail, sigma);
-  for (long e = 0; e < d->E; e++) {
-    if (cv_disc_edeg(d, e) < 4 || !(sigma[e] >= 1.0) || !isfinite(tail[e])) return 0;
-    tmax = fmax(tmax, tail[e]);
-    where[e] = 0.0;
-  }
-  if (!(tmax > PILOT_MISS * tol)) return 0;
   /* HP-7a lays new boundaries: not with breakpoints, which must stay boundaries */
   int En = 0, *dn = NULL, all8 = !d->sing_a && !d->sing_b && !keep_bounds;
   double *tn = NULL;
   for (long e = 0; e < d->E && all8; e++) all8 = cv_disc_edeg(d, e) == CV_MAX_DEGREE;
+  cv_estimate_pilot(s, tail, sigma);
+  for (long e = 0; e < d->E; e++) {
+    if (cv_disc_edeg(d, e) < 4 || !(sigma[e] >= (all8 ? PILOT_RATE8 : 1.0)) ||
+        !isfinite(tail[e]))
+      return 0;
+    tmax = fmax(tmax, tail[e]);
+    where[e] = 0.0;
+  }
+  if (!(tmax > PILOT_MISS * tol)) return 0;
   if (all8 ? cv_hp_pilot_mesh(d, tail, PILOT_AIM8 * tol, &En, &tn, &dn)
            : cv_hp_refine(d, tail, sigma, where, 0.25 * tmax, PILOT_AIM * tol, 1, &En, &tn, &dn))
     return -1;
