@@ -121,14 +121,16 @@ static int run(scene *s, const cv_problem *p, double tol, int elements, int degr
 
 int main(int argc, char **argv) {
   const char *dir = argc > 1 ? argv[1] : CV_SCENE_DIR;
-  int only = argc > 3 ? (strcmp(argv[3], "tol") == 0 ? 1 : strcmp(argv[3], "hand") == 0 ? 2 : 0)
+  int only = argc > 3 ? (strcmp(argv[3], "tol") == 0    ? 1
+                         : strcmp(argv[3], "hand") == 0 ? 2
+                                                        : 0)
                       : 0;
   if (only) profile_reps = 200;
   printf("--tol on the reference problems (timings on a shared machine: noisy; the baseline\n"
          "is measured in the same run)\n");
-  printf("%-22s %-9s %7s %-9s %6s %6s %9s %9s %9s %9s | %-10s %9s %9s %6s | %9s %6s\n",
-         "problem", "set", "tol", "status", "nodes", "rounds", "estimate", "true_max", "true_act",
-         "time_s", "hand mesh", "time_s", "true_max", "ratio", "+est_s", "ratio");
+  printf("%-22s %-9s %7s %-9s %6s %6s %9s %9s %9s %9s | %-10s %9s %9s %6s | %9s %6s\n", "problem",
+         "set", "tol", "status", "nodes", "rounds", "estimate", "true_max", "true_act", "time_s",
+         "hand mesh", "time_s", "true_max", "ratio", "+est_s", "ratio");
   for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
     const bench_case *bc = &cases[c];
     if (argc > 2 && !strstr(bc->scene, argv[2])) continue; /* only the scenes named so */

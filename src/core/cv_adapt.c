@@ -219,8 +219,7 @@ static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where
   for (long e = 0; e < d->E && all8; e++) all8 = cv_disc_edeg(d, e) == CV_MAX_DEGREE;
   cv_estimate_pilot(s, tail, sigma);
   for (long e = 0; e < d->E; e++) {
-    if (cv_disc_edeg(d, e) < 4 || !(sigma[e] >= (all8 ? PILOT_RATE8 : 1.0)) ||
-        !isfinite(tail[e]))
+    if (cv_disc_edeg(d, e) < 4 || !(sigma[e] >= (all8 ? PILOT_RATE8 : 1.0)) || !isfinite(tail[e]))
       return 0;
     tmax = fmax(tmax, tail[e]);
     where[e] = 0.0;

@@ -228,8 +228,10 @@ cv_status cv_hp_pilot_mesh(const cv_disc *d, const double *tail, double aim, int
     double t0 = (d->xe[e] - a) / L, t1 = (d->xe[e + 1] - a) / L;
     while (k < M && cum + r >= total * k / M) {
       double u = t0 + (t1 - t0) * (total * k / M - cum) / r;
-      if (u > (*t)[k - 1] && u < 1.0) (*t)[k++] = u;
-      else break; /* round-off: fewer elements */
+      if (u > (*t)[k - 1] && u < 1.0)
+        (*t)[k++] = u;
+      else
+        break; /* round-off: fewer elements */
     }
     cum += r;
   }

@@ -288,7 +288,7 @@ struct cv_solver {
   char note[640];          /* what the solver decided on its own, prefixed to msg */
   cv_progress_fn progress; /* cv_solver_set_progress; NULL: none */
   void *progress_user;
-  int near_sing[2];         /* ends found nearly singular after a solve */
+  int near_sing[2]; /* ends found nearly singular after a solve */
   /* polish: an estimate's enriched solve (HP-2a): Newton takes a step within the tolerance
    * without evaluating the system at its end (the step is the last one and only the values
    * are used). ends_passed[k], set by the caller for the next solve: end k passed the
