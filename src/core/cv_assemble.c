@@ -128,12 +128,10 @@ static cv_status call_integrand(cv_assembler *as, cv_integrand_fn Fn, void *user
  * Returns the batch's part of S; *bad collects 0 * (each entry), which is 0 unless an
  * entry is not finite. */
 static inline __attribute__((always_inline)) double batch_scalar(
-    const int P1, const int Q, const cv_disc *d, const cv_rule *r, int e0, int ne,
-    const cv_partials *o, double *restrict g, const int *restrict colptr, double *restrict Ax,
-    double hscale, double *bad) {
-  enum { MAXB = CV_MAX_QUAD * (CV_MAX_DEGREE + 1) };
+    const int P1, const int Q, double *restrict B, double *restrict D, double *restrict om,
+    const cv_disc *d, const cv_rule *r, int e0, int ne, const cv_partials *o, double *restrict g,
+    const int *restrict colptr, double *restrict Ax, double hscale, double *bad) {
   const int q = Q ? Q : r->q;
-  double B[MAXB], D[MAXB], om[CV_MAX_QUAD];
   for (int k = 0; k < q * P1; k++) B[k] = r->B[k], D[k] = r->D[k];
   for (int k = 0; k < q; k++) om[k] = r->omega[k];
   const double *restrict F = o->F, *restrict Fy = o->Fy, *restrict Fp = o->Fp;
@@ -202,12 +200,16 @@ static inline __attribute__((always_inline)) double batch_scalar(
 
 /* One function per degree (and per constant or any number of points), each contiguous in
  * the code: a solve runs one of them, so it touches the pages of one kernel and not of all
- * sixteen (the first solve in a process pays a page fault per fresh page, docs/performance.md). */
+ * sixteen (the first solve in a process pays a page fault per fresh page, docs/performance.md).
+ * The local copies of the rule (B, D, om of batch_scalar) are sized to the kernel's own
+ * points: 440 bytes at degree 4 with 5 points, not 4.6 kB for the largest rule, so the
+ * deepest frame of a solve stays within the stack pages its callers touched. */
 #define KERNEL(name, c, Q)                                                                         \
   static __attribute__((noinline)) double name(const cv_disc *d, const cv_rule *r, int e0, int ne, \
                                                const cv_partials *o, double *g, const int *colptr, \
                                                double *Ax, double hscale, double *bad) {           \
-    return batch_scalar(c, Q, d, r, e0, ne, o, g, colptr, Ax, hscale, bad);                        \
+    double B[(Q ? Q : CV_MAX_QUAD) * c], D[(Q ? Q : CV_MAX_QUAD) * c], om[Q ? Q : CV_MAX_QUAD];    \
+    return batch_scalar(c, Q, B, D, om, d, r, e0, ne, o, g, colptr, Ax, hscale, bad);              \
   }
 /* clang-format off: a list of definitions, one per line */
 KERNEL(kernel_2, 2, 2)

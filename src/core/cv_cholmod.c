@@ -149,9 +149,9 @@ void cv_ldlt_free(cv_ldlt *L) {
   cv_free(L);
 }
 
-const int *cv_ldlt_colptr(const cv_ldlt *L) { return L->sky ? L->colp : L->A->p; }
+CV_HOT const int *cv_ldlt_colptr(const cv_ldlt *L) { return L->sky ? L->colp : L->A->p; }
 
-double *cv_ldlt_values(cv_ldlt *L) { return L->sky ? L->ax : L->A->x; }
+CV_HOT double *cv_ldlt_values(cv_ldlt *L) { return L->sky ? L->ax : L->A->x; }
 
 int cv_ldlt_matches(const cv_ldlt *L, const cv_disc *d, const int *gof) {
   if (!L || !gof || L->n != d->nfree) return 0;
@@ -319,7 +319,7 @@ static inline __attribute__((always_inline)) void backward_Lt(const cv_ldlt *L, 
 
 /* The skyline factor's solves: row j of L is column j of U, so L^{-1} is a dot product per
  * row and U^{-1} an update per column. */
-static void sky_forward(const cv_ldlt *L, double *x) { /* x <- U^{-T} x */
+CV_HOT static void sky_forward(const cv_ldlt *L, double *x) { /* x <- U^{-T} x */
   const int *cp = L->colp;
   for (long j = 0; j < L->n; j++) {
     int fj = (int)j + 1 - (cp[j + 1] - cp[j]);
@@ -336,7 +336,7 @@ static void sky_forward(const cv_ldlt *L, double *x) { /* x <- U^{-T} x */
  * deflation's search follows). Row j of U lies in the columns r > j whose first row
  * f_r <= j: a range j + 1 .. e over the columns with nondecreasing f_r (the node blocks,
  * e falling with j), then every later column (an integral multiplier's, f_r = 0). */
-static void sky_backward(const cv_ldlt *L, int diag, double *x) {
+CV_HOT static void sky_backward(const cv_ldlt *L, int diag, double *x) {
   const int *cp = L->colp;
   const double *u = L->u;
   long n = L->n, mono = L->mono, e = mono - 1;

@@ -54,7 +54,7 @@ static void path_free(cv_path *q) {
   memset(q, 0, sizeof *q);
 }
 
-void cv_pathset_free(struct cv_pathset *ps) {
+CV_HOT void cv_pathset_free(struct cv_pathset *ps) {
   if (!ps) return;
   for (int k = 0; k < ps->n; k++) path_free(&ps->v[k]);
   cv_free(ps->v);

@@ -170,7 +170,7 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
 /* Per-element stride of the singular-end rules: room for the largest degree. */
 static size_t srule_stride(const cv_disc *d) { return (size_t)d->ref.qs * (2 + 2 * (d->p + 1)); }
 
-cv_rule cv_disc_rule(const cv_disc *d, long e) {
+CV_HOT cv_rule cv_disc_rule(const cv_disc *d, long e) {
   const cv_refelem *r = cv_disc_eref(d, e);
   if (d->srule) {
     int qs = r->qs, P1 = r->p + 1;
@@ -180,7 +180,7 @@ cv_rule cv_disc_rule(const cv_disc *d, long e) {
   return (cv_rule){r->q, r->tau, r->omega, r->B, r->D};
 }
 
-long cv_disc_num_qpoints(const cv_disc *d) {
+CV_HOT long cv_disc_num_qpoints(const cv_disc *d) {
   if (!d->pe) return (long)d->E * (d->srule ? d->ref.qs : d->ref.q);
   long total = 0;
   for (long e = 0; e < d->E; e++) total += d->srule ? d->refs[d->pe[e]].qs : d->refs[d->pe[e]].q;
@@ -193,7 +193,7 @@ long cv_disc_num_qpoints(const cv_disc *d) {
  * others it removes what a graded mesh leaves of the singularity (measured: a fixed
  * Gauss rule on the second element still let the discrete brachistochrone exploit it).
  * With both ends singular each element uses the nearer one. */
-cv_status cv_disc_build_singular_rules(cv_disc *d) {
+CV_HOT cv_status cv_disc_build_singular_rules(cv_disc *d) {
   size_t per = srule_stride(d);
   double t[CV_MAX_QUAD], w[CV_MAX_QUAD];
   int qlast = 0;

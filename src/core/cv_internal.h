@@ -372,5 +372,7 @@ CV_HOT void cv_disc_free(cv_disc *d);
 CV_HOT cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
                               size_t len);
 void cv_set_msg(char *msg, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+/* The same as cv_set_msg(msg, len, "converged in %d iterations", iterations). */
+CV_HOT void cv_set_msg_converged(char *msg, size_t len, int iterations);
 
 #endif /* CV_INTERNAL_H */

@@ -4,6 +4,9 @@
 
 #include "cv_memory.h"
 
+/* Called in every solve: with the solve's code in .text.hot (CV_HOT, cv_internal.h). */
+#define CV_MEM_HOT __attribute__((hot))
+
 /* Countdown to an injected failure; -1 = never. Only tests set it (single-threaded). */
 static long fail_after = -1;
 
@@ -16,12 +19,12 @@ static int should_fail(void) {
   return 0;
 }
 
-void *cv_malloc(size_t n) {
+CV_MEM_HOT void *cv_malloc(size_t n) {
   if (should_fail()) return NULL;
   return malloc(n ? n : 1);
 }
 
-void *cv_calloc(size_t count, size_t size) {
+CV_MEM_HOT void *cv_calloc(size_t count, size_t size) {
   if (should_fail()) return NULL;
   return calloc(count ? count : 1, size ? size : 1);
 }
@@ -31,4 +34,4 @@ void *cv_realloc(void *ptr, size_t n) {
   return realloc(ptr, n ? n : 1);
 }
 
-void cv_free(void *ptr) { free(ptr); }
+CV_MEM_HOT void cv_free(void *ptr) { free(ptr); }

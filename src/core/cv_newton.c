@@ -535,7 +535,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
       tmp = Mc, Mc = w.Mt, w.Mt = tmp;
       have_K = 0; /* no residual floor: nothing reports it */
       st = CVAR_OK;
-      cv_set_msg(s->msg, sizeof s->msg, "converged in %d iterations", s->iterations);
+      cv_set_msg_converged(s->msg, sizeof s->msg, s->iterations);
       goto cleanup;
     }
     trial t;
@@ -584,7 +584,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     }
     if (wn <= 1.0 && alpha == 1.0) {
       st = CVAR_OK;
-      cv_set_msg(s->msg, sizeof s->msg, "converged in %d iterations", s->iterations);
+      cv_set_msg_converged(s->msg, sizeof s->msg, s->iterations);
       goto cleanup;
     }
     if (s->iterations >= s->maxit) {

@@ -27,7 +27,7 @@ cv_solver *cv_solver_new(cv_status *why) {
   return s;
 }
 
-void cv_solver_drop_factor(cv_solver *s) {
+CV_HOT void cv_solver_drop_factor(cv_solver *s) {
   cv_ldlt_free(s->ldlt);
   cv_free(s->gof);
   s->ldlt = NULL;

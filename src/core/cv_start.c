@@ -9,7 +9,7 @@
 
 /* The default start at fraction t of the interval: the straight line between the end
  * values (a free end takes the other end's value; both free: 0). */
-static void straight_line(const cv_problem *p, double t, double *y) {
+CV_HOT static void straight_line(const cv_problem *p, double t, double *y) {
   for (int i = 0; i < p->n; i++) {
     int fa = p->fixed[2 * i], fb = p->fixed[2 * i + 1];
     double ya = p->endval[2 * i], yb = p->endval[2 * i + 1];
