@@ -285,8 +285,8 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
       long J0 = cv_disc_enode(d, e0) + (e0 > 0), J1 = cv_disc_enode(d, e0 + ne);
       int cA = cv_disc_node_first(d, J0);
       int cB = J1 == d->nodes - 1 ? d->nu0 : cv_disc_node_first(d, J1 + 1);
-      if (g) memset(g + cA, 0, (size_t)(cB - cA) * sizeof *g);
-      if (Ax) memset(Ax + colptr[cA], 0, (size_t)(colptr[cB] - colptr[cA]) * sizeof *Ax);
+      if (g) cv_dzero(g + cA, (size_t)(cB - cA));
+      if (Ax) cv_dzero(Ax + colptr[cA], (size_t)(colptr[cB] - colptr[cA]));
     }
     if (n == 1) {
       Ssum += batch_scalar_dispatch(d, r, e0, ne, p, &as->out, g, colptr, Ax, hscale, &bad);
@@ -307,8 +307,8 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
       } else {
         for (int a = 0; a < nl; a++) flp[a] = cv_disc_fidx(d, cv_disc_enode(d, e) * n + a);
       }
-      if (Ax) memset(K, 0, (size_t)nl * nl * sizeof *K);
-      if (g) memset(gl, 0, (size_t)nl * sizeof *gl);
+      if (Ax) cv_dzero(K, (size_t)nl * nl);
+      if (g) cv_dzero(gl, (size_t)nl);
       for (int k = 0; k < q; k++) {
         int idx = el * q + k;
         double wk = J * r->omega[k];

@@ -11,7 +11,10 @@
 #include "cv_internal.h"
 
 struct cv_ldlt {
-  cholmod_common c;
+  /* CHOLMOD's state (2.6 kB), allocated only for systems above cv_ldlt_skyline_max: a
+   * small solve's heap then fits in fewer pages (the first solve in a process pays a
+   * page fault per fresh page, docs/performance.md) */
+  cholmod_common *c;
   cholmod_sparse *A;
   cholmod_factor *L;
   long n;
@@ -41,7 +44,7 @@ int cv_ldlt_skyline_max = 512;
  * runs on this thread. */
 static void *analyze_main(void *arg) {
   cv_ldlt *L = arg;
-  L->L = cholmod_analyze(L->A, &L->c);
+  L->L = cholmod_analyze(L->A, L->c);
   L->analysed = 1;
   return NULL;
 }
@@ -100,20 +103,25 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
     *out = L;
     return CVAR_OK;
   }
-  cholmod_start(&L->c);
+  L->c = cv_malloc(sizeof *L->c);
+  if (!L->c) {
+    cv_ldlt_free(L);
+    return CVAR_ENOMEM;
+  }
+  cholmod_start(L->c);
   /* The Hessian is block-banded in node-major order, so the natural ordering has no
    * fill beyond the band; AMD would scramble it (DESIGN.md performance model). */
-  L->c.nmethods = 1;
-  L->c.method[0].ordering = CHOLMOD_NATURAL;
-  L->c.postorder = 0;
-  L->c.supernodal = CHOLMOD_SIMPLICIAL;
-  L->c.final_ll = 0; /* keep LDL^T: the pivots give the inertia */
-  L->c.quick_return_if_not_posdef = 0;
-  L->c.print = 0;
-  L->c.error_handler = NULL;
+  L->c->nmethods = 1;
+  L->c->method[0].ordering = CHOLMOD_NATURAL;
+  L->c->postorder = 0;
+  L->c->supernodal = CHOLMOD_SIMPLICIAL;
+  L->c->final_ll = 0; /* keep LDL^T: the pivots give the inertia */
+  L->c->quick_return_if_not_posdef = 0;
+  L->c->print = 0;
+  L->c->error_handler = NULL;
   L->n = nfree;
   size_t nz = (size_t)(nnz ? nnz : 1);
-  L->A = cholmod_allocate_sparse((size_t)nfree, (size_t)nfree, nz, 1, 1, 1, CHOLMOD_REAL, &L->c);
+  L->A = cholmod_allocate_sparse((size_t)nfree, (size_t)nfree, nz, 1, 1, 1, CHOLMOD_REAL, L->c);
   if (!L->A) {
     cv_ldlt_free(L);
     return CVAR_ENOMEM;
@@ -140,11 +148,12 @@ void cv_ldlt_free(cv_ldlt *L) {
     cv_free(L->colp);
     cv_free(L->ax);
     cv_free(L->u);
-  } else {
+  } else if (L->c) {
     join_analysis(L);
-    cholmod_free_sparse(&L->A, &L->c);
-    cholmod_free_factor(&L->L, &L->c);
-    cholmod_finish(&L->c);
+    cholmod_free_sparse(&L->A, L->c);
+    cholmod_free_factor(&L->L, L->c);
+    cholmod_finish(L->c);
+    cv_free(L->c);
   }
   cv_free(L);
 }
@@ -212,17 +221,17 @@ static void skyline_factor(cv_ldlt *L) {
 static cv_status factor_cholmod(cv_ldlt *L, char *msg, size_t len) {
   join_analysis(L);
   if (!L->analysed) {
-    L->L = cholmod_analyze(L->A, &L->c);
+    L->L = cholmod_analyze(L->A, L->c);
     L->analysed = 1;
   }
   if (!L->L) {
-    cv_set_msg(msg, len, "CHOLMOD analysis failed (status %d)", L->c.status);
-    return L->c.status == CHOLMOD_OUT_OF_MEMORY ? CVAR_ENOMEM : CVAR_EDEPENDENCY;
+    cv_set_msg(msg, len, "CHOLMOD analysis failed (status %d)", L->c->status);
+    return L->c->status == CHOLMOD_OUT_OF_MEMORY ? CVAR_ENOMEM : CVAR_EDEPENDENCY;
   }
-  int ok = cholmod_factorize(L->A, L->L, &L->c);
-  if (!ok || L->c.status < CHOLMOD_OK) {
-    cv_set_msg(msg, len, "CHOLMOD factorisation failed (status %d)", L->c.status);
-    return L->c.status == CHOLMOD_OUT_OF_MEMORY ? CVAR_ENOMEM : CVAR_EDEPENDENCY;
+  int ok = cholmod_factorize(L->A, L->L, L->c);
+  if (!ok || L->c->status < CHOLMOD_OK) {
+    cv_set_msg(msg, len, "CHOLMOD factorisation failed (status %d)", L->c->status);
+    return L->c->status == CHOLMOD_OUT_OF_MEMORY ? CVAR_ENOMEM : CVAR_EDEPENDENCY;
   }
   return CVAR_OK;
 }
@@ -268,7 +277,7 @@ cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char 
   /* CHOLMOD stops LDL^T at an exactly zero pivot and reports it as "not positive
    * definite" with L->minor < n; a TRUE return alone does not mean success (STYLE.md 4). */
   long minor = L->sky ? L->minor : (long)L->L->minor;
-  if (minor < L->n || (!L->sky && L->c.status == CHOLMOD_NOT_POSDEF)) {
+  if (minor < L->n || (!L->sky && L->c->status == CHOLMOD_NOT_POSDEF)) {
     cv_set_msg(msg, len, "zero pivot in the LDL^T factorisation at unknown %ld", minor);
     return CVAR_ESINGULAR;
   }

@@ -372,6 +372,14 @@ CV_HOT void cv_disc_free(cv_disc *d);
 CV_HOT cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg,
                               size_t len);
 void cv_set_msg(char *msg, size_t len, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+
+/* ---- short vectors without libc or libm calls (cv_vec.c; the first solve in a process
+ * binds every libc or libm symbol it calls, docs/performance.md) */
+/* v[0 .. n-1] = 0 and dst[0 .. n-1] = src[0 .. n-1] (memset, memcpy beyond 4 kB). */
+CV_HOT void cv_dzero(double *v, size_t n);
+CV_HOT void cv_dcopy(double *restrict dst, const double *restrict src, size_t n);
+/* fmax(a, b): the larger, or the one that is not NaN; inline instead of libm's call */
+static inline double cv_fmax(double a, double b) { return a > b || b != b ? a : b; }
 /* The same as cv_set_msg(msg, len, "converged in %d iterations", iterations). */
 CV_HOT void cv_set_msg_converged(char *msg, size_t len, int iterations);
 

@@ -75,7 +75,7 @@ cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len) {
       /* Scale of G near the end values: |grad G| |y| (or 1), so the test is relative. */
       double sc = 0.0;
       for (int i = 0; i < n && !st; i++) sc += fabs(Gy[i]) * fabs(Y[node * n + i]);
-      if (st || !(fabs(G[0]) <= 1e-9 * fmax(1.0, sc))) {
+      if (st || !(fabs(G[0]) <= 1e-9 * cv_fmax(1.0, sc))) {
         cv_set_msg(msg, len,
                    "pointwise constraint %d does not hold at the fixed end x = %g (G = %.3g); "
                    "choose end values on the constraint",
@@ -103,14 +103,14 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
    * rows and columns (the last ni, dense, C-3) are cleared here. */
   for (int c = d->nu0; c < nf; c++) {
     G[c] = 0.0;
-    if (Ax) memset(Ax + cp[c], 0, (size_t)(cp[c + 1] - cp[c]) * sizeof *Ax);
+    if (Ax) cv_dzero(Ax + cp[c], (size_t)(cp[c + 1] - cp[c]));
   }
-  if (dreg) memset(dreg, 0, (size_t)nf * sizeof *dreg);
+  if (dreg) cv_dzero(dreg, (size_t)nf);
   st = cv_assemble(&k->as, p->F, p->user, Y, S, G, cp, Ax, 1.0, 1);
   if (st) return st;
   double hmax = 0.0; /* largest diagonal entry of the action's Hessian, for delta */
   if (Ax && (nc > 0 || d->ni > 0))
-    for (int c = 0; c < nf; c++) hmax = fmax(hmax, fabs(Ax[cp[c + 1] - 1]));
+    for (int c = 0; c < nf; c++) hmax = cv_fmax(hmax, fabs(Ax[cp[c + 1] - 1]));
   if (!(hmax > 0)) hmax = 1.0;
 
   /* Integral constraints (C-2): row nu0+r holds I_r - c_r, column its gradient. */
@@ -118,7 +118,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
     const cv_iconstraint *ic = &p->ic[r];
     double I, nu = M[(size_t)d->nodes * nc + r];
     int row = d->nu0 + r;
-    memset(k->gK, 0, (size_t)nf * sizeof *k->gK);
+    cv_dzero(k->gK, (size_t)nf);
     st = cv_assemble(&k->as, ic->K, ic->user, Y, &I, k->gK, cp, Ax, nu, 0);
     if (st) return st;
     G[row] = I - ic->c;
@@ -191,7 +191,7 @@ cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M) {
   cv_status st = cv_assemble(&k->as, p->F, p->user, Y, &S, g, k->colptr, NULL, 0.0, 0);
   for (int r = 0; r < d->ni && !st; r++) {
     double I, num = 0.0, den = 0.0;
-    memset(k->gK, 0, (size_t)nf * sizeof *k->gK);
+    cv_dzero(k->gK, (size_t)nf);
     st = cv_assemble(&k->as, p->ic[r].K, p->ic[r].user, Y, &I, k->gK, k->colptr, NULL, 0.0, 0);
     for (int f = 0; f < d->nu0 && !st; f++) {
       double w = 1.0 / (d->mass[f] * d->mass[f]);
@@ -244,7 +244,7 @@ cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, dou
   for (int r = 0; r < d->ni && !st; r++) {
     double I;
     int row = d->nu0 + r;
-    memset(k->gK, 0, (size_t)d->nfree * sizeof *k->gK);
+    cv_dzero(k->gK, (size_t)d->nfree);
     st = cv_assemble(&k->as, p->ic[r].K, p->ic[r].user, Y, &I, jac ? k->gK : NULL, k->colptr, NULL,
                      0.0, 0);
     vals[row] = I - p->ic[r].c;

@@ -134,7 +134,7 @@ static double residual_floor(const newton_ws *w, const double *Ax, const double 
     acc[c] += sum + fabs(Ax[k0 + len - 1]) * xc;
   }
   double fl = 0.0;
-  for (int f = 0; f < nf; f++) fl = fmax(fl, acc[f] * d->imass[f]);
+  for (int f = 0; f < nf; f++) fl = cv_fmax(fl, acc[f] * d->imass[f]);
   return DBL_EPSILON * fl;
 }
 
@@ -207,13 +207,13 @@ static cv_status factor_shifted(newton_ws *w, double *Ax, int *neg, char *detail
   if (!w->dsave || !w->x0 || !w->corr) return CVAR_ENOMEM;
   for (int f = 0; f < nf; f++) {
     w->dsave[f] = Ax[w->colptr[f + 1] - 1];
-    if (w->gof[f] >= 0) lam = fmax(lam, fabs(w->dsave[f]) * d->imass[f]);
+    if (w->gof[f] >= 0) lam = cv_fmax(lam, fabs(w->dsave[f]) * d->imass[f]);
   }
   /* lam ~ c F_y'y' (p^2 / h)^2 is the top of the spectrum; lam / (E p^2)^2 is the scale
    * of its bottom (c F_y'y' / (b - a)^2); sigma is 10^-6 of that, and at least 10^3 eps
    * lam so that the shift survives the round-off of the diagonal. */
   double ep = (double)d->E * d->p * d->p;
-  double sigma = fmax(1e-6 * lam / (ep * ep), 1e3 * DBL_EPSILON * lam);
+  double sigma = cv_fmax(1e-6 * lam / (ep * ep), 1e3 * DBL_EPSILON * lam);
   if (!(sigma > 0.0) || !isfinite(sigma)) return CVAR_ESINGULAR;
   for (int k = 0; k < 2; k++) {
     double dmin, dmax;
@@ -263,7 +263,7 @@ static void residual_of(const newton_ws *w, const double *Ax, int constrained, c
  * Stops when a correction is below 4 eps of the step, or stops shrinking. */
 static cv_status solve_shifted(newton_ws *w, const double *Ax, int constrained) {
   int nf = w->d->nfree;
-  memcpy(w->x0, w->delta, (size_t)nf * sizeof *w->x0); /* b */
+  cv_dcopy(w->x0, w->delta, (size_t)nf); /* b */
   cv_status st = cv_ldlt_solve(w->L, w->delta);
   double last = INFINITY;
   for (int it = 0; it < SHIFT_REFINE_MAX && !st; it++) {
@@ -272,8 +272,8 @@ static cv_status solve_shifted(newton_ws *w, const double *Ax, int constrained) 
     double change = 0.0, size = 0.0;
     for (int f = 0; f < nf && !st; f++) {
       w->delta[f] += w->corr[f];
-      change = fmax(change, fabs(w->corr[f]));
-      size = fmax(size, fabs(w->delta[f]));
+      change = cv_fmax(change, fabs(w->corr[f]));
+      size = cv_fmax(size, fabs(w->delta[f]));
     }
     if (!st && !isfinite(size)) st = CVAR_ENONFINITE;
     if (!st && (!(change > 4 * DBL_EPSILON * size) || !(change < 0.5 * last)))
@@ -426,8 +426,8 @@ static cv_status run_init(cv_solver *s, const cv_problem *p, cv_disc *d, newton_
   *ncon = 0;
   for (int f = 0; f < nf; f++) *ncon += w->gof[f] < 0;
   /* Two buffers swap roles as iterate and trial; the trial's fixed values are set once. */
-  memcpy(w->Yt, Y, (size_t)d->ndof * sizeof *Y);
-  if (nmult) memcpy(w->Mt, M, nmult * sizeof *M);
+  cv_dcopy(w->Yt, Y, (size_t)d->ndof);
+  if (nmult) cv_dcopy(w->Mt, M, nmult);
   if (d->nc > 0) {
     st = cv_kkt_check_ends(kkt, Y, s->msg, sizeof s->msg);
     if (st) return st;
@@ -603,11 +603,11 @@ cleanup:
     s->gfloor = isfinite(fl) ? fl : NAN;                       /* 0 when every unknown is 0 */
   }
   if (w.Yt && Yc != Y) { /* the latest iterate lives in our buffer: hand it back */
-    memcpy(Y, Yc, (size_t)d->ndof * sizeof *Y);
+    cv_dcopy(Y, Yc, (size_t)d->ndof);
     w.Yt = Yc;
   }
   if (w.Mt && Mc != M) {
-    if (nmult) memcpy(M, Mc, nmult * sizeof *M);
+    if (nmult) cv_dcopy(M, Mc, nmult);
     w.Mt = Mc;
   }
   cv_kkt_free(&kkt);

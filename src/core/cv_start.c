@@ -58,7 +58,7 @@ cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, d
                  d->nodes, n);
       return CVAR_EINVAL;
     }
-    memcpy(Y, s->start, (size_t)d->ndof * sizeof *Y);
+    cv_dcopy(Y, s->start, (size_t)d->ndof);
   } else if (p->guess && !line) {
     cv_status st = guess_values(s, p, d, Y);
     if (st) return st;
@@ -241,13 +241,18 @@ CV_HOT static double rule_gap(const cv_problem *p, const cv_disc *d, const doubl
  * for an action near zero) and 100 times its neighbour's
  * (a smooth F on coarse elements has gaps of one size everywhere), or F cannot be
  * evaluated at the finer points. *rel: the end element's gap relative to the action. */
-int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
-                            double action, double *rel) {
+CV_HOT int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
+                                   double action, double *rel) {
   *rel = 0.0;
   if (end ? d->sing_b : d->sing_a) return 0;
   long e = end ? d->E - 1 : 0, e1 = end ? d->E - 2 : 1;
   int q = d->ref.qs > d->ref.q ? d->ref.qs : d->ref.q;
-  double *buf = cv_malloc((size_t)q * (2 * (size_t)p->n + 2) * sizeof *buf);
+  /* The points of one element: on the stack for one or a few unknowns (the check of every
+   * solve runs after Newton, whose deeper frames have touched these stack pages; a heap
+   * buffer was a fresh page in the first solve of a process, docs/performance.md). */
+  size_t len = (size_t)q * (2 * (size_t)p->n + 2);
+  double local[4 * CV_MAX_QUAD], *buf = len <= sizeof local / sizeof *local ? local : NULL;
+  if (!buf) buf = cv_malloc(len * sizeof *buf);
   if (!buf) return 0;
   double own, own1;
   double gap = rule_gap(p, d, Y, e, end, buf, &own), next = 0.0;
@@ -256,6 +261,6 @@ int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double 
   *rel = gap / (scale > DBL_MIN ? scale : DBL_MIN);
   /* the neighbour only when the end element's gap is large (rarely: a solve's cost) */
   if (!(*rel <= 1e-8) && d->E > 1 && isfinite(gap)) next = rule_gap(p, d, Y, e1, end, buf, &own1);
-  cv_free(buf);
+  if (buf != local) cv_free(buf);
   return !(*rel <= 1e-8) && !(gap <= 100.0 * next);
 }
