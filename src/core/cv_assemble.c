@@ -15,12 +15,15 @@ cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc
   as->prob = p;
   as->disc = d;
   size_t nl = (size_t)(d->p + 1) * n;
-  as->buf = cv_malloc((3 + 4 * n + 3 * n * n) * m * sizeof *as->buf);
-  as->K = cv_malloc((nl * nl + nl) * sizeof *as->K); /* element matrix + gradient */
-  as->fl = cv_malloc(nl * sizeof *as->fl);
-  if (!as->buf || !as->K || !as->fl) {
-    cv_assembler_free(as);
-    return CVAR_ENOMEM;
+  /* x, y, y', the integrand's outputs, and for n > 1 the element matrix and gradient and
+   * the element's free indices, in one allocation (the scalar kernels keep their element
+   * sums in registers): the first solve of a small problem touches fewer heap bytes */
+  size_t nbuf = (2 + 4 * n + 3 * n * n) * m, nK = n > 1 ? nl * nl + nl : 0;
+  as->buf = cv_malloc((nbuf + nK) * sizeof *as->buf + (n > 1 ? nl * sizeof *as->fl : 0));
+  if (!as->buf) return CVAR_ENOMEM;
+  if (n > 1) {
+    as->K = as->buf + nbuf;
+    as->fl = (int *)(as->K + nK);
   }
   double *w = as->buf;
   as->x = w, w += m;
@@ -37,9 +40,7 @@ cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc
 
 void cv_assembler_free(cv_assembler *as) {
   if (!as) return;
-  cv_free(as->buf);
-  cv_free(as->K);
-  cv_free(as->fl);
+  cv_free(as->buf); /* K and fl live in it */
   as->buf = as->K = NULL;
   as->fl = NULL;
 }
@@ -275,7 +276,6 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
           break;
         }
     int m = ne * q;
-    double *gl = as->K + nl * nl;
     fill_points(as, Y, r, e0, ne, p);
     st = call_integrand(as, Fn, user, m, need);
     if (st) return st;
@@ -292,7 +292,7 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
       Ssum += batch_scalar_dispatch(d, r, e0, ne, p, &as->out, g, colptr, Ax, hscale, &bad);
       continue; /* scattered by the kernel */
     }
-    double *F = as->out.F;
+    double *F = as->out.F, *gl = K + nl * nl;
     const double *Fy = as->out.Fy, *Fp = as->out.Fp;
     const double *Fyy = as->out.Fyy, *Fyp = as->out.Fyp, *Fpp = as->out.Fpp;
     for (int el = 0; el < ne; el++) {
