@@ -550,7 +550,10 @@ CVAR_API const char *cv_scene_get_title(const cv_scene *sc);
 CVAR_API const char *cv_scene_get_variable(const cv_scene *sc);
 /** Override a [mesh] or [solver] setting before cv_scene_problem_new and
  * cv_scene_configure_solver, as the command's options do: "elements", "degree",
- * "tolerance", "max_iterations", "adapt" (a number), "method" (a cv_method value).
+ * "tolerance", "max_iterations", "adapt", "tol" (a number; "tol" starts from the mesh
+ * `calcvar solve --tol` starts from: [mesh] or the "elements" / "degree" given, else 4
+ * elements of degree 4), "max_nodes" (the cap of "tol", default 10^6), "time_limit"
+ * (seconds for the rounds of "tol" or "adapt"), "method" (a cv_method value).
  * CVAR_EINVAL for an unknown name or a value out of range, with a sentence in err. */
 CVAR_API cv_status cv_scene_set_option(cv_scene *sc, const char *name, double value, char *err,
                                        size_t errlen);

@@ -175,16 +175,17 @@ def _progress_callback(user_fn, verbose, caught):
 
 
 def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
-          max_iterations=None, adapt=None, set=None, tol=None, all=False, max_paths=8,
-          work=None, progress=None, verbose=False):
+          max_iterations=None, adapt=None, set=None, tol=None, max_nodes=None,
+          time_limit=None, all=False, max_paths=8, work=None, progress=None, verbose=False):
     """Solve a scene as `calcvar solve` does and return a Solution.
 
     scene: a path (str or os.PathLike) or the text of a scene (any str with a newline or
     starting with '[').  Options mirror the command: elements, degree (1..8), method
     ("newton", "lbfgs", ...), tolerance (Newton step), max_iterations, adapt (target max
     nodal error at a fixed degree), tol (target max nodal error: calcvar chooses the
-    mesh and the degree of each element, as `calcvar solve --tol`), set={name: value}
-    overriding [parameters].  progress: a function called
+    mesh and the degree of each element, as `calcvar solve --tol`, from the same start),
+    max_nodes (the cap of tol, default 10**6), time_limit (seconds for the rounds of tol
+    or adapt), set={name: value} overriding [parameters].  progress: a function called
     with a dict after every Newton iteration and adaptive round (keys kind, iteration,
     residual, step, alpha, action, round, elements, estimate); returning True cancels.
     verbose=True prints those lines.
@@ -205,7 +206,8 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
     problem = solver = None
     try:
         options = {"elements": elements, "degree": degree, "tolerance": tolerance,
-                   "max_iterations": max_iterations, "adapt": adapt, "tol": tol}
+                   "max_iterations": max_iterations, "adapt": adapt, "tol": tol,
+                   "max_nodes": max_nodes, "time_limit": time_limit}
         if method is not None:
             code = ctypes.c_int()
             if not isinstance(method, str) or lib.cv_method_from_name(

@@ -237,9 +237,9 @@ int cli_apply_accuracy(const cli_opts *o, scene *s) {
   if (tol > 0) { /* automatic accuracy: the scene's or the flags' mesh is only the start */
     s->tol = tol;
     if (o->max_nodes) s->tol_max_nodes = o->max_nodes;
-    if (!o->elements && !s->elements_line && s->grading <= 0)
-      s->elements = SCENE_TOL_START_ELEMENTS;
-    if (!o->degree && !s->degree_line) s->degree = SCENE_TOL_START_DEGREE;
+    if (o->elements) s->elements_line = -1; /* given by the flags: a start of its own */
+    if (o->degree) s->degree_line = -1;
+    scene_tol_start(s);
   }
   return 0;
 }

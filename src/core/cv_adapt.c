@@ -108,9 +108,10 @@ static double value_scale(const cv_solver *s) {
 /* HP-6: the next mesh would exceed the cap on nodes (hp) or elements (--adapt). */
 static void say_cap(cv_solver *s, double est) {
   cv_set_msg(s->msg, sizeof s->msg,
-             "the next refinement would exceed the cap of %d %s after %d rounds; the "
+             "the next refinement would exceed the cap of %d %s after %d round%s; the "
              "estimated max nodal error reached is %.2g > %.2g; %s",
-             s->adapt_max, s->hp ? "nodes" : "elements", s->rounds, est, s->adapt_tol,
+             s->adapt_max, s->hp ? "nodes" : "elements", s->rounds, s->rounds == 1 ? "" : "s", est,
+             s->adapt_tol,
              s->hp ? "ask for a larger tolerance (or raise the cap: --max-nodes, or the "
                      "max_nodes argument of cv_solver_set_tol)"
                    : "use a higher degree or a looser tolerance (or raise the cap: "

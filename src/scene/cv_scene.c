@@ -128,11 +128,13 @@ cv_status cv_scene_set_option(cv_scene *sc, const char *name, double value, char
   }
   scene *s = sc->s;
   int ok = 1;
-  if (strcmp(name, "elements") == 0 && (ok = whole(value, 1, 1e9)))
+  if (strcmp(name, "elements") == 0 && (ok = whole(value, 1, 1e9))) {
     s->elements = (int)value;
-  else if (strcmp(name, "degree") == 0 && (ok = whole(value, 1, 8)))
+    if (!s->elements_line) s->elements_line = -1; /* given: tol starts from it */
+  } else if (strcmp(name, "degree") == 0 && (ok = whole(value, 1, 8))) {
     s->degree = (int)value;
-  else if (strcmp(name, "max_iterations") == 0 && (ok = whole(value, 1, 1e9)))
+    if (!s->degree_line) s->degree_line = -1;
+  } else if (strcmp(name, "max_iterations") == 0 && (ok = whole(value, 1, 1e9)))
     s->max_iterations = (int)value;
   else if (strcmp(name, "method") == 0 && (ok = whole(value, 0, CVAR_METHOD_AUGLAG)))
     s->method = (cv_method)(int)value;
@@ -140,14 +142,20 @@ cv_status cv_scene_set_option(cv_scene *sc, const char *name, double value, char
     s->tolerance = value;
   else if (strcmp(name, "adapt") == 0 && (ok = isfinite(value) && value >= 0))
     s->adapt = value;
-  else if (strcmp(name, "tol") == 0 && (ok = isfinite(value) && value >= 0))
+  else if (strcmp(name, "tol") == 0 && (ok = isfinite(value) && value >= 0)) {
     s->tol = value;
+    scene_tol_start(s); /* the start `calcvar solve --tol` takes */
+  } else if (strcmp(name, "max_nodes") == 0 && (ok = whole(value, 2, 2e8)))
+    s->tol_max_nodes = (int)value;
+  else if (strcmp(name, "time_limit") == 0 && (ok = isfinite(value) && value > 0))
+    s->time_limit = value;
   else if (ok && strcmp(name, "elements") && strcmp(name, "degree") &&
            strcmp(name, "max_iterations") && strcmp(name, "method") && strcmp(name, "tolerance") &&
-           strcmp(name, "adapt") && strcmp(name, "tol")) {
+           strcmp(name, "adapt") && strcmp(name, "tol") && strcmp(name, "max_nodes") &&
+           strcmp(name, "time_limit")) {
     say(err, errlen,
         "unknown option '%s' (known: elements, degree, tolerance, "
-        "max_iterations, adapt, tol, method)",
+        "max_iterations, adapt, tol, max_nodes, time_limit, method)",
         name);
     return CVAR_EINVAL;
   }

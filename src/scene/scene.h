@@ -80,7 +80,8 @@ typedef struct scene {
   int tol_line;
   int tol_max_nodes;              /* --max-nodes: cap of tol on the nodes, 0: SCENE_TOL_MAX_NODES */
   double time_limit;              /* --time-limit: seconds for the rounds of tol/adapt, 0: none */
-  int elements_line, degree_line; /* 0 when not given (--tol then picks its start) */
+  int elements_line, degree_line; /* 0 when not given (--tol then picks its start); -1: given
+                                     by the command's flags or cv_scene_set_option */
 #define SCENE_TOL_MAX_NODES      1000000 /* cap of --tol / [mesh] tol on the nodes */
 #define SCENE_TOL_START_ELEMENTS 4       /* --tol's starting mesh when the scene gives none */
 #define SCENE_TOL_START_DEGREE   4
@@ -161,6 +162,11 @@ unsigned scene_method_need(cv_method m);
  * CVAR_NEED_* bits the integrand and constraints compile. (A pointwise constraint that
  * fails at an end whose values are fixed was already rejected by the loader.) */
 cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size_t errlen);
+/** Automatic accuracy's start (s->tol > 0): the mesh of [mesh] (or of the caller's own
+ * elements / degree, marked by elements_line / degree_line != 0) is only where the rounds
+ * begin; where neither gave one, SCENE_TOL_START_ELEMENTS x SCENE_TOL_START_DEGREE. The
+ * command (--tol) and cv_scene_set_option ("tol") both start here. */
+void scene_tol_start(scene *s);
 /** Apply [mesh] and [solver] to a solver (elements, degree, grading, breakpoints,
  * tolerances, maximum iterations). */
 cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_t errlen);

@@ -134,6 +134,12 @@ fail:
   return NULL;
 }
 
+void scene_tol_start(scene *s) {
+  if (!(s->tol > 0)) return;
+  if (!s->elements_line && s->grading <= 0) s->elements = SCENE_TOL_START_ELEMENTS;
+  if (!s->degree_line) s->degree = SCENE_TOL_START_DEGREE;
+}
+
 cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_t errlen) {
   const char *what = "elements";
   if (err && errlen) err[0] = '\0';

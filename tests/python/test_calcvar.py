@@ -210,6 +210,30 @@ def test_tol_chooses_the_mesh():
         calcvar.solve(CATENARY, tol=1e-8, adapt=1e-8)
 
 
+def test_tol_same_as_the_command():
+    # the same start, rounds and mesh as `calcvar solve SCENE --tol T` (the harmonic
+    # oscillator has no [mesh]: both start from 4 elements of degree 4), the JSON identical
+    # but for the time
+    path = scene("harmonic_saddle.scene")
+    sol = calcvar.solve(path, tol=1e-12)
+    out = subprocess.run([EXE, "solve", path, "--tol", "1e-12", "--json", "-", "--quiet"],
+                         capture_output=True, text=True, check=True).stdout
+    cmd = json.loads(out)
+    for r in (cmd, sol.report):
+        r.pop("time_s", None)
+    assert sol.report == cmd
+    # the caps: a cap on the nodes below what 1e-12 needs ends the rounds with the
+    # estimate reached; a bad cap is refused
+    capped = calcvar.solve(path, tol=1e-12, max_nodes=30)
+    assert capped.status == "max_iterations" and capped.report["nodes"] <= 30
+    assert "cap of 30 nodes" in capped.report["message"]
+    assert capped.report["error_estimate"] > 1e-12
+    with pytest.raises(ValueError, match="max_nodes"):
+        calcvar.solve(path, tol=1e-12, max_nodes=1)
+    with pytest.raises(ValueError, match="time_limit"):
+        calcvar.solve(path, tol=1e-12, time_limit=0)
+
+
 BRATU = """[scene]
 title = Bratu
 interval = 0, 1
