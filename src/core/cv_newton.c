@@ -26,6 +26,7 @@ typedef struct {
   const int *colptr; /* the pattern, owned by L */
   cv_ldlt *L;
   double *g, *gt, *delta, *Yt, *Mt, *dreg, *corr;
+  double *block;      /* g, gt, delta, Yt and Mt live in it (they swap roles, not blocks) */
   double *dsave, *x0; /* diagonal of H and first solve of the shifted factor (N-6), lazily */
   double tau;         /* shift of the factor in L (0: L is the factor of H itself) */
   int borrowed;       /* L and gof belong to the solver (its mesh's factor) */
@@ -36,11 +37,7 @@ static void ws_free(newton_ws *w) {
     cv_free(w->gof);
     cv_ldlt_free(w->L);
   }
-  cv_free(w->g);
-  cv_free(w->gt);
-  cv_free(w->delta);
-  cv_free(w->Yt);
-  cv_free(w->Mt);
+  cv_free(w->block);
   cv_free(w->dreg);
   cv_free(w->corr);
   cv_free(w->dsave);
@@ -78,12 +75,15 @@ static cv_status ws_init(newton_ws *w, cv_solver *s, const cv_disc *d, size_t nm
     if (st) return st;
   }
   w->colptr = cv_ldlt_colptr(w->L);
-  w->g = cv_malloc(one * sizeof *w->g);
-  w->gt = cv_malloc(one * sizeof *w->gt);
-  w->delta = cv_malloc(one * sizeof *w->delta);
-  w->Yt = cv_malloc((size_t)d->ndof * sizeof *w->Yt);
-  w->Mt = cv_malloc((nmult ? nmult : 1) * sizeof *w->Mt);
-  if (!w->g || !w->gt || !w->delta || !w->Yt || !w->Mt) return CVAR_ENOMEM;
+  /* one allocation for the five: fewer calls, and fewer heap bytes for the first solve in
+   * a process to touch (docs/performance.md) */
+  w->block = cv_malloc((3 * one + (size_t)d->ndof + (nmult ? nmult : 1)) * sizeof *w->block);
+  if (!w->block) return CVAR_ENOMEM;
+  w->g = w->block;
+  w->gt = w->g + one;
+  w->delta = w->gt + one;
+  w->Yt = w->delta + one;
+  w->Mt = w->Yt + d->ndof;
   if (nmult) {
     w->dreg = cv_malloc(one * sizeof *w->dreg);
     w->corr = cv_malloc(one * sizeof *w->corr);
