@@ -123,18 +123,28 @@ static cv_status call_integrand(cv_assembler *as, cv_integrand_fn Fn, void *user
 
 /* Kernel for one unknown (n = 1) over the elements e0 .. e0+ne-1 of a batch, inlined with
  * constant P1 basis functions and Q points (Q = 0: the rule's own q, not unrolled), so the
- * loops unroll and the element gradient and matrix stay in registers. The rule is copied
- * to locals and the outputs are restrict: a store into g or Ax then cannot force the
- * tables to be reloaded. Same sums as the general loops in cv_assemble, (A-1)-(A-3).
+ * loops unroll and the element gradient and matrix stay in registers. The outputs are
+ * restrict: a store into g or Ax then cannot force the tables to be reloaded. Same sums as the general loops in cv_assemble, (A-1)-(A-3).
  * Returns the batch's part of S; *bad collects 0 * (each entry), which is 0 unless an
  * entry is not finite. */
 static inline __attribute__((always_inline)) double batch_scalar(
-    const int P1, const int Q, double *restrict B, double *restrict D, double *restrict om,
-    const cv_disc *d, const cv_rule *r, int e0, int ne, const cv_partials *o, double *restrict g,
-    const int *restrict colptr, double *restrict Ax, double hscale, double *bad) {
+    const int P1, const int Q, const cv_disc *d, const cv_rule *r, int e0, int ne,
+    const cv_partials *o, double *restrict g, const int *restrict colptr, double *restrict Ax,
+    double hscale, double *bad) {
+  enum { MAXB = CV_MAX_QUAD * (CV_MAX_DEGREE + 1) };
   const int q = Q ? Q : r->q;
-  for (int k = 0; k < q * P1; k++) B[k] = r->B[k], D[k] = r->D[k];
-  for (int k = 0; k < q; k++) om[k] = r->omega[k];
+  /* The kernels of a constant rule (degree <= 4, the default rule) read the tables in
+   * place: copied, they were a 5 kB frame, the deepest of a solve, and the first solve in a
+   * process paid a fresh stack page for it (docs/performance.md). The others copy them as
+   * before (reading them in place, GCC unrolls their loop over the points sixteen-fold:
+   * 95 kB of code at degree 8). */
+  double Bq[MAXB], Dq[MAXB], omq[CV_MAX_QUAD];
+  const double *B = r->B, *D = r->D, *om = r->omega;
+  if (!Q) {
+    for (int k = 0; k < q * P1; k++) Bq[k] = r->B[k], Dq[k] = r->D[k];
+    for (int k = 0; k < q; k++) omq[k] = r->omega[k];
+    B = Bq, D = Dq, om = omq;
+  }
   const double *restrict F = o->F, *restrict Fy = o->Fy, *restrict Fp = o->Fp;
   const double *restrict Fyy = o->Fyy, *restrict Fyp = o->Fyp, *restrict Fpp = o->Fpp;
   const double *restrict xe = d->xe;
@@ -201,16 +211,12 @@ static inline __attribute__((always_inline)) double batch_scalar(
 
 /* One function per degree (and per constant or any number of points), each contiguous in
  * the code: a solve runs one of them, so it touches the pages of one kernel and not of all
- * sixteen (the first solve in a process pays a page fault per fresh page, docs/performance.md).
- * The local copies of the rule (B, D, om of batch_scalar) are sized to the kernel's own
- * points: 440 bytes at degree 4 with 5 points, not 4.6 kB for the largest rule, so the
- * deepest frame of a solve stays within the stack pages its callers touched. */
+ * sixteen (the first solve in a process pays a page fault per fresh page, docs/performance.md). */
 #define KERNEL(name, c, Q)                                                                         \
   static __attribute__((noinline)) double name(const cv_disc *d, const cv_rule *r, int e0, int ne, \
                                                const cv_partials *o, double *g, const int *colptr, \
                                                double *Ax, double hscale, double *bad) {           \
-    double B[(Q ? Q : CV_MAX_QUAD) * c], D[(Q ? Q : CV_MAX_QUAD) * c], om[Q ? Q : CV_MAX_QUAD];    \
-    return batch_scalar(c, Q, B, D, om, d, r, e0, ne, o, g, colptr, Ax, hscale, bad);              \
+    return batch_scalar(c, Q, d, r, e0, ne, o, g, colptr, Ax, hscale, bad);                        \
   }
 /* clang-format off: a list of definitions, one per line */
 KERNEL(kernel_2, 2, 2)
