@@ -255,6 +255,84 @@ static double batch_scalar_dispatch(const cv_disc *d, const cv_rule *r, int e0, 
   return NAN; /* unreachable: 1 <= p <= 8 */
 }
 
+/* The general loops of (A-1)-(A-3) for n > 1 unknowns over the elements e0 .. e0+ne-1 of a
+ * batch; out of line, so that the code a scalar solve runs stays compact (the first solve
+ * in a process pays for every fresh page and cache line of code, docs/performance.md).
+ * Returns the batch's part of S; *bad as in batch_scalar. */
+static __attribute__((noinline)) double batch_general(cv_assembler *as, const cv_rule *r, int e0,
+                                                      int ne, int p, double *g, const int *colptr,
+                                                      double *Ax, double hscale, double *bad) {
+  const cv_disc *d = as->disc;
+  int n = d->n, P1 = p + 1, nl = P1 * n, q = r->q, m = ne * q;
+  double Ssum = 0.0, chk = 0.0, *K = as->K;
+  int *flp = as->fl;
+  double *F = as->out.F, *gl = K + nl * nl;
+  const double *Fy = as->out.Fy, *Fp = as->out.Fp;
+  const double *Fyy = as->out.Fyy, *Fyp = as->out.Fyp, *Fpp = as->out.Fpp;
+  for (int el = 0; el < ne; el++) {
+    int e = e0 + el;
+    double h = d->xe[e + 1] - d->xe[e], J = 0.5 * h, rh = 2.0 / h;
+    /* Free indices of the element's unknowns: a shift of the global ones except on the
+     * two end elements (E-2); no integer division in the common case. */
+    if (e > 0 && e < d->E - 1) {
+      int base = cv_disc_elem_first(d, e), st = d->stride;
+      for (int l = 0; l < P1; l++)
+        for (int i = 0; i < n; i++) flp[l * n + i] = base + l * st + i;
+    } else {
+      for (int a = 0; a < nl; a++) flp[a] = cv_disc_fidx(d, cv_disc_enode(d, e) * n + a);
+    }
+    if (Ax) cv_dzero(K, (size_t)nl * nl);
+    if (g) cv_dzero(gl, (size_t)nl);
+    for (int k = 0; k < q; k++) {
+      int idx = el * q + k;
+      double wk = J * r->omega[k];
+      const double *Bk = r->B + k * P1, *Dk = r->D + k * P1;
+      Ssum += wk * F[idx];
+      if (g) {
+        for (int i = 0; i < n; i++) {
+          double fy = wk * Fy[i * m + idx], fp = wk * rh * Fp[i * m + idx];
+          for (int l = 0; l < P1; l++) gl[l * n + i] += fy * Bk[l] + fp * Dk[l];
+        }
+      }
+      if (Ax) {
+        for (int i = 0; i < n; i++)
+          for (int j = 0; j < n; j++) {
+            double yy = wk * Fyy[(i * n + j) * m + idx];
+            double yp = wk * rh * Fyp[(i * n + j) * m + idx]; /* F_{y_i y'_j} */
+            double py = wk * rh * Fyp[(j * n + i) * m + idx]; /* F_{y'_i y_j} */
+            double pp = wk * rh * rh * Fpp[(i * n + j) * m + idx];
+            for (int l = 0; l < P1; l++) {
+              double bl = Bk[l], dl = Dk[l];
+              double cy = yy * bl + py * dl, cp = yp * bl + pp * dl;
+              double *Krow = K + (l * n + i) * nl + j;
+              for (int rr = 0; rr < P1; rr++) Krow[rr * n] += cy * Bk[rr] + cp * Dk[rr];
+            }
+          }
+      }
+    }
+    if (g)
+      for (int a = 0; a < nl; a++) {
+        chk += 0.0 * gl[a];
+        if (flp[a] >= 0) g[flp[a]] += gl[a];
+      }
+    if (Ax) {
+      /* Scatter the upper triangle; column c holds rows c+1-len(c) .. c (E-2). */
+      for (int bcol = 0; bcol < nl; bcol++) {
+        int fb = flp[bcol];
+        if (fb < 0) continue;
+        long c0 = colptr[fb], rs = fb + 1 - (colptr[fb + 1] - c0);
+        for (int arow = 0; arow <= bcol; arow++) {
+          int fa = flp[arow];
+          chk += 0.0 * K[arow * nl + bcol];
+          if (fa >= 0) Ax[c0 + fa - rs] += hscale * K[arow * nl + bcol];
+        }
+      }
+    }
+  }
+  *bad += chk;
+  return Ssum;
+}
+
 /* S_h = sum_e sum_k (h_e/2) w_k F(x_ek, y_ek, y'_ek)                          (A-1)
  * dS_h/dY_{l,i} = sum (h/2) w_k (F_yi phi_l + F_y'i phi_l' (2/h))             (A-2)
  * d2S_h/dY_{l,i}dY_{r,j} = sum (h/2) w_k (F_yiyj phi_l phi_r
@@ -265,14 +343,13 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
   const cv_disc *d = as->disc;
   int n = d->n;
   unsigned need = CVAR_NEED_F | (g ? CVAR_NEED_GRAD : 0u) | (Ax ? CVAR_NEED_HESS : 0u);
-  double Ssum = 0.0, bad = 0.0, *K = as->K;
-  int *flp = as->fl;
+  double Ssum = 0.0, bad = 0.0;
   cv_status st;
   for (int e0 = 0, ne; e0 < d->E; e0 += ne) {
     /* A batch: up to CV_BATCH points of elements sharing one rule (and degree, HP-1);
      * with per-element singular-end rules (Q-2) one element at a time. */
     cv_rule rule = cv_disc_rule(d, e0), *r = &rule;
-    int p = cv_disc_edeg(d, e0), P1 = p + 1, nl = P1 * n;
+    int p = cv_disc_edeg(d, e0);
     int q = r->q, nb = d->srule ? 1 : CV_BATCH / q;
     ne = d->E - e0 < nb ? d->E - e0 : nb;
     if (d->pe)
@@ -294,73 +371,10 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
       if (g) cv_dzero(g + cA, (size_t)(cB - cA));
       if (Ax) cv_dzero(Ax + colptr[cA], (size_t)(colptr[cB] - colptr[cA]));
     }
-    if (n == 1) {
+    if (n == 1)
       Ssum += batch_scalar_dispatch(d, r, e0, ne, p, &as->out, g, colptr, Ax, hscale, &bad);
-      continue; /* scattered by the kernel */
-    }
-    double *F = as->out.F, *gl = K + nl * nl;
-    const double *Fy = as->out.Fy, *Fp = as->out.Fp;
-    const double *Fyy = as->out.Fyy, *Fyp = as->out.Fyp, *Fpp = as->out.Fpp;
-    for (int el = 0; el < ne; el++) {
-      int e = e0 + el;
-      double h = d->xe[e + 1] - d->xe[e], J = 0.5 * h, rh = 2.0 / h;
-      /* Free indices of the element's unknowns: a shift of the global ones except on the
-       * two end elements (E-2); no integer division in the common case. */
-      if (e > 0 && e < d->E - 1) {
-        int base = cv_disc_elem_first(d, e), st = d->stride;
-        for (int l = 0; l < P1; l++)
-          for (int i = 0; i < n; i++) flp[l * n + i] = base + l * st + i;
-      } else {
-        for (int a = 0; a < nl; a++) flp[a] = cv_disc_fidx(d, cv_disc_enode(d, e) * n + a);
-      }
-      if (Ax) cv_dzero(K, (size_t)nl * nl);
-      if (g) cv_dzero(gl, (size_t)nl);
-      for (int k = 0; k < q; k++) {
-        int idx = el * q + k;
-        double wk = J * r->omega[k];
-        const double *Bk = r->B + k * P1, *Dk = r->D + k * P1;
-        Ssum += wk * F[idx];
-        if (g) {
-          for (int i = 0; i < n; i++) {
-            double fy = wk * Fy[i * m + idx], fp = wk * rh * Fp[i * m + idx];
-            for (int l = 0; l < P1; l++) gl[l * n + i] += fy * Bk[l] + fp * Dk[l];
-          }
-        }
-        if (Ax) {
-          for (int i = 0; i < n; i++)
-            for (int j = 0; j < n; j++) {
-              double yy = wk * Fyy[(i * n + j) * m + idx];
-              double yp = wk * rh * Fyp[(i * n + j) * m + idx]; /* F_{y_i y'_j} */
-              double py = wk * rh * Fyp[(j * n + i) * m + idx]; /* F_{y'_i y_j} */
-              double pp = wk * rh * rh * Fpp[(i * n + j) * m + idx];
-              for (int l = 0; l < P1; l++) {
-                double bl = Bk[l], dl = Dk[l];
-                double cy = yy * bl + py * dl, cp = yp * bl + pp * dl;
-                double *Krow = K + (l * n + i) * nl + j;
-                for (int rr = 0; rr < P1; rr++) Krow[rr * n] += cy * Bk[rr] + cp * Dk[rr];
-              }
-            }
-        }
-      }
-      if (g)
-        for (int a = 0; a < nl; a++) {
-          bad += 0.0 * gl[a];
-          if (flp[a] >= 0) g[flp[a]] += gl[a];
-        }
-      if (Ax) {
-        /* Scatter the upper triangle; column c holds rows c+1-len(c) .. c (E-2). */
-        for (int bcol = 0; bcol < nl; bcol++) {
-          int fb = flp[bcol];
-          if (fb < 0) continue;
-          long c0 = colptr[fb], rs = fb + 1 - (colptr[fb + 1] - c0);
-          for (int arow = 0; arow <= bcol; arow++) {
-            int fa = flp[arow];
-            bad += 0.0 * K[arow * nl + bcol];
-            if (fa >= 0) Ax[c0 + fa - rs] += hscale * K[arow * nl + bcol];
-          }
-        }
-      }
-    }
+    else
+      Ssum += batch_general(as, r, e0, ne, p, g, colptr, Ax, hscale, &bad);
   }
   /* Every requested output enters S or an element's gradient or matrix multiplied by
    * weights and basis values, and NaN or Inf survives that (0 * Inf is NaN, Inf * 0 too),
