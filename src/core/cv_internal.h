@@ -112,8 +112,8 @@ typedef struct {
   int nc, ni, stride, off0;        /* stride = n + nc; off0 = unknowns at node 0 */
   int nfree0, nfree1;              /* free y components at node 0 / at the last node */
   double a, b;
-  double *xe; /* element boundaries, E+1 */
-  cv_refelem ref;
+  double *xe;          /* element boundaries, E+1 */
+  cv_refelem ref;      /* its tables are not zeroed with the rest (cv_disc.c): fix0 follows */
   int *fix0, *fix1;    /* index of each y component at node 0 / last, or -1 */
   int lam0, lamL, nu0; /* first multiplier at node 0 / last node (-1: none), integrals */
   double *mass;        /* lumped nodal weight of each unknown (theory N-3) */
