@@ -104,7 +104,9 @@ cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, d
  * fixed Gauss rule under-integrates there and the discrete minimiser exploits it. */
 static void detect_singular_ends(const cv_problem *p, cv_disc *d, const double *Y) {
   int n = p->n;
-  double x, *buf = cv_malloc((2 * (size_t)n + 1) * sizeof *buf);
+  /* y, y' and F at one point: on the stack for up to 8 unknowns (one allocation fewer in
+   * every solve, docs/performance.md) */
+  double x, local[17], *buf = n <= 8 ? local : cv_malloc((2 * (size_t)n + 1) * sizeof *buf);
   if (!buf) return;
   for (int end = 0; end < 2; end++) {
     long node = end ? d->nodes - 1 : 0;
@@ -128,7 +130,7 @@ static void detect_singular_ends(const cv_problem *p, cv_disc *d, const double *
     else
       d->sing_a = singular;
   }
-  cv_free(buf);
+  if (buf != local) cv_free(buf);
 }
 
 /* Discretisation, starting values and singular-end detection for the current mesh spec. */
