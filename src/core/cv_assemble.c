@@ -211,26 +211,28 @@ static inline __attribute__((always_inline)) double batch_scalar(
 
 /* One function per degree (and per constant or any number of points), each contiguous in
  * the code: a solve runs one of them, so it touches the pages of one kernel and not of all
- * sixteen (the first solve in a process pays a page fault per fresh page, docs/performance.md). */
-#define KERNEL(name, c, Q)                                                                         \
-  static __attribute__((noinline)) double name(const cv_disc *d, const cv_rule *r, int e0, int ne, \
-                                               const cv_partials *o, double *g, const int *colptr, \
-                                               double *Ax, double hscale, double *bad) {           \
+ * sixteen (the first solve in a process pays a page fault per fresh page, docs/performance.md).
+ * The kernels of the default rule at degrees 1-4 (20 kB) lie with the rest of a solve's
+ * code in .text.hot; those of other rules and higher degrees (36 kB) elsewhere. */
+#define KERNEL(name, c, Q, attr)                                                                   \
+  static __attribute__((noinline)) attr double name(                                               \
+      const cv_disc *d, const cv_rule *r, int e0, int ne, const cv_partials *o, double *g,         \
+      const int *colptr, double *Ax, double hscale, double *bad) {                                 \
     return batch_scalar(c, Q, d, r, e0, ne, o, g, colptr, Ax, hscale, bad);                        \
   }
 /* clang-format off: a list of definitions, one per line */
-KERNEL(kernel_2, 2, 2)
-KERNEL(kernel_3, 3, 3)
-KERNEL(kernel_4, 4, 4)
-KERNEL(kernel_5, 5, 5)
-KERNEL(kernel_2q, 2, 0)
-KERNEL(kernel_3q, 3, 0)
-KERNEL(kernel_4q, 4, 0)
-KERNEL(kernel_5q, 5, 0)
-KERNEL(kernel_6q, 6, 0)
-KERNEL(kernel_7q, 7, 0)
-KERNEL(kernel_8q, 8, 0)
-KERNEL(kernel_9q, 9, 0)
+KERNEL(kernel_2, 2, 2, CV_HOT)
+KERNEL(kernel_3, 3, 3, CV_HOT)
+KERNEL(kernel_4, 4, 4, CV_HOT)
+KERNEL(kernel_5, 5, 5, CV_HOT)
+KERNEL(kernel_2q, 2, 0, )
+KERNEL(kernel_3q, 3, 0, )
+KERNEL(kernel_4q, 4, 0, )
+KERNEL(kernel_5q, 5, 0, )
+KERNEL(kernel_6q, 6, 0, )
+KERNEL(kernel_7q, 7, 0, )
+KERNEL(kernel_8q, 8, 0, )
+KERNEL(kernel_9q, 9, 0, )
 /* clang-format on */
 #undef KERNEL
 
