@@ -136,8 +136,8 @@ static inline __attribute__((always_inline)) double batch_scalar(
   /* The kernels of a constant rule (degree <= 4, the default rule) read the tables in
    * place: copied, they were a 5 kB frame, the deepest of a solve, and the first solve in a
    * process paid a fresh stack page for it (docs/performance.md). The others copy them as
-   * before (reading them in place, GCC unrolls their loop over the points sixteen-fold:
-   * 95 kB of code at degree 8). */
+   * before (reading them in place, GCC unrolls their loop over a variable number of
+   * points: 95 kB of code at degree 8). */
   double Bq[MAXB], Dq[MAXB], omq[CV_MAX_QUAD];
   const double *B = r->B, *D = r->D, *om = r->omega;
   if (!Q) {
