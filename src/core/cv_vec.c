@@ -14,8 +14,15 @@
 
 /* GCC turns a zeroing or copying loop back into a call of memset or memcpy (loop
  * distribution); these two loops must stay loops (glibc builds its own string functions
- * the same way). */
+ * the same way); clang's no_builtin says the same. Other compilers: plain loops, whatever
+ * they make of them. */
+#if defined(__GNUC__) && !defined(__clang__)
 #define CV_NO_LIBCALL __attribute__((optimize("no-tree-loop-distribute-patterns")))
+#elif defined(__clang__)
+#define CV_NO_LIBCALL __attribute__((no_builtin("memset", "memcpy")))
+#else
+#define CV_NO_LIBCALL
+#endif
 
 CV_HOT CV_NO_LIBCALL void cv_dzero(double *v, size_t n) {
   if (n > VEC_LOOP_MAX) {
