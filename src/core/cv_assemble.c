@@ -91,6 +91,10 @@ static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int
   fill_batch(d->n, p + 1, as, Y, r, e0, ne);
 }
 
+void cv_assembler_points(cv_assembler *as, const double *Y, const cv_rule *r, int e0, int ne) {
+  fill_points(as, Y, r, e0, ne, cv_disc_edeg(as->disc, e0));
+}
+
 /* v[0 .. len-1] = NaN by block copies (a plain loop stays scalar at -O2: 12 stores per
  * element of degree 1 were a tenth of the assembly, docs/performance.md). */
 #define NAN4  NAN, NAN, NAN, NAN
@@ -348,18 +352,9 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
   double Ssum = 0.0, bad = 0.0;
   cv_status st;
   for (int e0 = 0, ne; e0 < d->E; e0 += ne) {
-    /* A batch: up to CV_BATCH points of elements sharing one rule (and degree, HP-1);
-     * with per-element singular-end rules (Q-2) one element at a time. */
     cv_rule rule = cv_disc_rule(d, e0), *r = &rule;
-    int p = cv_disc_edeg(d, e0);
-    int q = r->q, nb = d->srule ? 1 : CV_BATCH / q;
-    ne = d->E - e0 < nb ? d->E - e0 : nb;
-    if (d->pe)
-      for (int k = 1; k < ne; k++)
-        if (d->pe[e0 + k] != p) {
-          ne = k;
-          break;
-        }
+    int p = cv_disc_edeg(d, e0), q = r->q;
+    ne = cv_assembler_batch(d, e0, q);
     int m = ne * q;
     fill_points(as, Y, r, e0, ne, p);
     st = call_integrand(as, Fn, user, m, need);

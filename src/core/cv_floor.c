@@ -14,32 +14,6 @@
 
 #include "cv_internal.h"
 
-/* x, y, y' of the quadrature points of elements e0 .. e0+ne-1 into the assembler's batch
- * buffers (the same values as cv_assemble's, theory E-3). */
-static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int e0, int ne,
-                        int P1) {
-  const cv_disc *d = as->disc;
-  int n = d->n, q = r->q, m = ne * q;
-  for (int el = 0; el < ne; el++) {
-    int e = e0 + el;
-    double x0 = d->xe[e], h = d->xe[e + 1] - x0, rh = 2.0 / h;
-    const double *Ye = Y + (size_t)cv_disc_enode(d, e) * n;
-    for (int k = 0; k < q; k++) {
-      int idx = el * q + k;
-      as->x[idx] = x0 + 0.5 * (r->tau[k] + 1.0) * h;
-      for (int i = 0; i < n; i++) {
-        double yv = 0.0, dv = 0.0;
-        for (int l = 0; l < P1; l++) {
-          yv += Ye[l * n + i] * r->B[k * P1 + l];
-          dv += Ye[l * n + i] * r->D[k * P1 + l];
-        }
-        as->y[i * m + idx] = yv;
-        as->dy[i * m + idx] = dv * rh;
-      }
-    }
-  }
-}
-
 /* acc[f] += sum over the points of f's elements of |w F_y phi_f| + |w F_y' phi_f'| (the
  * terms of the gradient's sum, A-2) for the integrand F of p. */
 static cv_status term_sums(const cv_problem *p, const cv_disc *d, const double *Y, double *acc) {
@@ -49,17 +23,10 @@ static cv_status term_sums(const cv_problem *p, const cv_disc *d, const double *
   int n = d->n;
   for (int e0 = 0, ne; e0 < d->E && !st; e0 += ne) {
     cv_rule rule = cv_disc_rule(d, e0), *r = &rule;
-    int deg = cv_disc_edeg(d, e0), P1 = deg + 1, q = r->q;
-    int nb = d->srule ? 1 : CV_BATCH / q;
-    ne = d->E - e0 < nb ? d->E - e0 : nb;
-    if (d->pe)
-      for (int k = 1; k < ne; k++)
-        if (d->pe[e0 + k] != deg) {
-          ne = k;
-          break;
-        }
+    int P1 = cv_disc_edeg(d, e0) + 1, q = r->q;
+    ne = cv_assembler_batch(d, e0, q);
     int m = ne * q;
-    fill_points(&as, Y, r, e0, ne, P1);
+    cv_assembler_points(&as, Y, r, e0, ne); /* the points cv_assemble evaluates F at */
     cv_partials o = {as.out.F, as.out.Fy, as.out.Fp, NULL, NULL, NULL};
     int rc = p->F(m, as.x, as.y, as.dy, CVAR_NEED_F | CVAR_NEED_GRAD, &o, p->user);
     if (rc != 0) {

@@ -218,6 +218,19 @@ typedef struct {
 
 CV_HOT cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc *d);
 CV_HOT void cv_assembler_free(cv_assembler *as);
+/* The elements of the batch that starts at element e0: up to CV_BATCH points of
+ * consecutive elements sharing one rule and degree (HP-1), one element at a time with
+ * per-element singular-end rules (Q-2). Returns their count; q is the rule's points. */
+static inline int cv_assembler_batch(const cv_disc *d, int e0, int q) {
+  int nb = d->srule ? 1 : CV_BATCH / q, ne = d->E - e0 < nb ? (int)d->E - e0 : nb;
+  if (d->pe)
+    for (int k = 1; k < ne; k++)
+      if (d->pe[e0 + k] != d->pe[e0]) return k;
+  return ne;
+}
+/* x, y, y' at the quadrature points of elements e0 .. e0+ne-1 of one batch (degree of
+ * e0) into the assembler's batch buffers, theory (E-3): what cv_assemble evaluates F at. */
+void cv_assembler_points(cv_assembler *as, const double *Y, const cv_rule *r, int e0, int ne);
 /* Set *S to the discrete integral of Fn (theory A-1), add its gradient (A-2) to g (rows of the
  * y unknowns; may be NULL) and hscale times its Hessian (A-3) to Ax (may be NULL; column
  * layout colptr), at nodal values Y (length nodes*n). With overwrite 0 nothing is zeroed;
