@@ -54,17 +54,12 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
   for (int i = 0; i < c->n && slot < 0; i++)
     if (strcmp(name, c->unk[i]) == 0) slot = 1 + i + (primes ? c->n : 0);
   if (slot < 0) { /* the nearest name usable here, if a slip away (ex_name_close) */
-    const char *best = ex_name_close(name, c->var) ? c->var : NULL;
-    for (int i = 0; i < c->n; i++)
-      if (ex_name_close(name, c->unk[i]) &&
-          (!best || ex_name_distance(name, c->unk[i]) < ex_name_distance(name, best)))
-        best = c->unk[i];
-    for (int i = 0; i < c->np; i++)
-      if (ex_name_close(name, c->pname[i]) &&
-          (!best || ex_name_distance(name, c->pname[i]) < ex_name_distance(name, best)))
-        best = c->pname[i];
-    if (best)
-      msg(err, errlen, "unknown name '%s' (did you mean '%s'?)", name, best);
+    ex_nearest nr = {NULL, 0};
+    ex_name_consider(&nr, name, c->var);
+    for (int i = 0; i < c->n; i++) ex_name_consider(&nr, name, c->unk[i]);
+    for (int i = 0; i < c->np; i++) ex_name_consider(&nr, name, c->pname[i]);
+    if (nr.best)
+      msg(err, errlen, "unknown name '%s' (did you mean '%s'?)", name, nr.best);
     else
       msg(err, errlen, "unknown name '%s'", name);
     return -1;

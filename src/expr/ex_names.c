@@ -50,15 +50,17 @@ int ex_name_close(const char *typed, const char *known) {
   return dist > 0 && dist <= (len <= 4 ? 1 : 2) && dist < len;
 }
 
+void ex_name_consider(ex_nearest *nr, const char *typed, const char *known) {
+  if (!known || !ex_name_close(typed, known)) return;
+  /* ties: a name of the same length first (cohs: cosh, not cos) */
+  int score = 2 * ex_name_distance(typed, known) + (strlen(typed) != strlen(known));
+  if (!nr->best || score < nr->score) nr->best = known, nr->score = score;
+}
+
 const char *ex_function_nearest(const char *name) {
-  const char *best = NULL;
-  int bd = 1 << 20;
-  for (size_t i = 0; i < NUM_FUNCTIONS; i++) { /* ties: a name of the same length (cohs: cosh) */
-    int dist =
-        2 * ex_name_distance(name, functions[i].name) + (strlen(name) != strlen(functions[i].name));
-    if (ex_name_close(name, functions[i].name) && dist < bd) best = functions[i].name, bd = dist;
-  }
-  return best;
+  ex_nearest nr = {NULL, 0};
+  for (size_t i = 0; i < NUM_FUNCTIONS; i++) ex_name_consider(&nr, name, functions[i].name);
+  return nr.best;
 }
 
 const char *ex_op_name(ex_op op) {

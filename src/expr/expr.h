@@ -88,6 +88,13 @@ int ex_is_reserved(const char *s);
  * for names of up to 4 characters, 2 beyond, never all of them. */
 int ex_name_distance(const char *a, const char *b);
 int ex_name_close(const char *typed, const char *known);
+/* The nearest close name among those offered one by one (start with {NULL, 0}): best is
+ * NULL while none is close; of two equally near, the one of typed's length. */
+typedef struct {
+  const char *best;
+  int score;
+} ex_nearest;
+void ex_name_consider(ex_nearest *nr, const char *typed, const char *known);
 
 /* A value split at commas outside parentheses; off[i] is item i's offset in the value. */
 typedef struct {

@@ -171,12 +171,13 @@ int sc_llines_read(sc_llines *ll, const char *text, size_t len, const char *file
       if (sec < 0) { /* the known sections, the nearest first if one is a slip away */
         char known[256] = "", hint[64] = "";
         size_t kl = 0;
+        ex_nearest nr = {NULL, 0};
         for (int k = 0; k < SEC_COUNT; k++) {
           kl += (size_t)snprintf(known + kl, sizeof known - kl, "%s%s", k ? ", " : "",
                                  section_names[k]);
-          if (!hint[0] && b - a < sizeof name && ex_name_close(name, section_names[k]))
-            snprintf(hint, sizeof hint, "did you mean [%s]? ", section_names[k]);
+          if (b - a < sizeof name) ex_name_consider(&nr, name, section_names[k]);
         }
+        if (nr.best) snprintf(hint, sizeof hint, "did you mean [%s]? ", nr.best);
         excerpt(buf, sizeof buf, t + a, b - a);
         sc_err(err, errlen, file, line, "unknown section [%s] (%sknown: %s)", buf, hint, known);
         goto fail;

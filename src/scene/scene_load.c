@@ -64,9 +64,9 @@ int sc_check_keys(sc_loader *L, int sec, const char *const *keys, const char *li
     int ok = 0;
     for (int k = 0; keys[k]; k++) ok |= strcmp(e->key, keys[k]) == 0;
     if (!ok) {
-      const char *near = NULL;
-      for (int k = 0; keys[k] && !near; k++)
-        if (ex_name_close(e->key, keys[k])) near = keys[k];
+      ex_nearest nr = {NULL, 0};
+      for (int k = 0; keys[k]; k++) ex_name_consider(&nr, e->key, keys[k]);
+      const char *near = nr.best;
       sc_err(L->err, L->errlen, L->file, e->line, "unknown key '%s' in [%s] (%s%s%sknown: %s)",
              e->key, sc_section_name(sec), near ? "did you mean '" : "", near ? near : "",
              near ? "'? " : "", list);

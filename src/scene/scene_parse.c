@@ -63,22 +63,15 @@ static void suggest(const sc_loader *L, const char *name, char *out, size_t cap)
       return;
     }
   }
-  const char *best = NULL;
-  int bd = 1 << 20;
-#define TRY(c)                                                                                     \
-  do {                                                                                             \
-    const char *c_ = (c);                                                                          \
-    if (c_ && ex_name_close(name, c_) && ex_name_distance(name, c_) < bd)                          \
-      bd = ex_name_distance(name, c_), best = c_;                                                  \
-  } while (0)
-  TRY(s->variable);
-  TRY("pi");
-  for (int i = 0; i < s->n; i++) TRY(s->unknowns[i]);
+  ex_nearest nr = {NULL, 0};
+  ex_name_consider(&nr, name, s->variable);
+  ex_name_consider(&nr, name, "pi");
+  for (int i = 0; i < s->n; i++) ex_name_consider(&nr, name, s->unknowns[i]);
   for (int i = 0; i < s->nparams && (L->mode != SC_R_PARAM || i < L->limit); i++)
-    TRY(s->params[i].name);
-  for (int i = 0; L->mode != SC_R_PARAM && i < s->ndefs && i < L->limit; i++) TRY(s->defs[i].name);
-#undef TRY
-  if (best) snprintf(out, cap, " (did you mean '%s'?)", best);
+    ex_name_consider(&nr, name, s->params[i].name);
+  for (int i = 0; L->mode != SC_R_PARAM && i < s->ndefs && i < L->limit; i++)
+    ex_name_consider(&nr, name, s->defs[i].name);
+  if (nr.best) snprintf(out, cap, " (did you mean '%s'?)", nr.best);
 }
 
 /* Resolve a name for ex_parse. Parameters become their numbers and definitions their
