@@ -269,6 +269,16 @@ CVAR_API cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, voi
  * releases as in cv_problem_set_integrand_owned (also on failure). */
 CVAR_API cv_status cv_problem_add_constraint_owned(cv_problem *p, cv_constraint_fn G, void *user,
                                                    cv_release_fn release, int *index);
+/** Make pointwise constraint k (from cv_problem_add_constraint*) an inequality: sense +1
+ * requires G(x, y(x)) >= 0, sense -1 requires G <= 0, 0 makes it an equality again.
+ * An obstacle: its multiplier lambda(x) is zero where the constraint is not active; where
+ * it is, lambda <= 0 for G >= 0 and lambda >= 0 for G <= 0, so that -lambda grad G, the
+ * force of the obstacle on the path, points away from it (theory OB-1). The solve
+ * determines the active set by a primal-dual active set (semismooth Newton) iteration
+ * (OB-2); the Morse index is that of the problem with the final active set fixed. */
+CVAR_API cv_status cv_problem_set_constraint_sense(cv_problem *p, int k, int sense);
+/** The sense of pointwise constraint k (0, +1, -1), or 0 when k is out of range. */
+CVAR_API int cv_problem_get_constraint_sense(const cv_problem *p, int k);
 /** cv_problem_add_integral whose `user` the problem owns (see above). */
 CVAR_API cv_status cv_problem_add_integral_owned(cv_problem *p, cv_integrand_fn K, void *user,
                                                  cv_release_fn release, double c, int *index);
@@ -286,6 +296,14 @@ CVAR_API cv_status cv_problem_add_integral_expr(cv_problem *p, const char *varia
                                                 size_t errlen);
 /** The number of pointwise constraints added so far. */
 CVAR_API int cv_problem_get_num_constraints(const cv_problem *p);
+/** Make unknown k periodic: y_k(b) = y_k(a) + D (D = 0: a closed path; D = 2 pi: an
+ * angle that winds once). Both end values of y_k become free and are found with the
+ * path; the condition is added as the integral constraint int_a^b y_k' dx = D (theory
+ * PB-1), whose number is put in *index (may be NULL): its multiplier is minus the common
+ * momentum dF/dy_k' at the two ends. When every unknown is periodic and F does not depend
+ * on x, the path can be shifted along x: pin that shift with a further integral
+ * constraint, e.g. int y . y0' dx = int y0 . y0' dx against a reference path y0 (PB-2). */
+CVAR_API cv_status cv_problem_set_periodic(cv_problem *p, int k, double D, int *index);
 /** The number of integral constraints added so far. */
 CVAR_API int cv_problem_get_num_integrals(const cv_problem *p);
 /** Energy H = sum_i y'_i dF/dy'_i - F and momenta P_i = dF/dy'_i at m >= 0 points, from

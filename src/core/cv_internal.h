@@ -24,6 +24,7 @@ typedef struct {
   cv_constraint_fn G;
   void *user;
   cv_release_fn release;
+  int sense; /* 0: G = 0; +1: G >= 0; -1: G <= 0 (an obstacle, theory OB-1) */
 } cv_pconstraint;
 
 typedef struct {
@@ -251,11 +252,32 @@ typedef struct {
   double *xn;   /* node abscissae (pointwise constraints) */
   double *cbuf; /* batch buffers of constraint calls */
   double *gK;   /* gradient of one integral constraint */
+  /* Inequalities (cv_kkt_active.c, theory OB-2): per node and constraint, 1 when the
+   * node's row imposes G = 0, 0 when it imposes lambda = 0; the weights c of the
+   * active-set rule; how many decisions the last evaluation changed. NULL without them. */
+  unsigned char *active;
+  double *cw;
+  long changed;
+  int frozen; /* 1: evaluations keep the decisions (line-search trials along one step) */
+  double eps; /* > 0: the penalised rows of the path-following (OB-3); 0: exact (OB-2) */
 } cv_kkt;
 CV_HOT cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const int *colptr);
 CV_HOT void cv_kkt_free(cv_kkt *k);
 /* Reject pointwise constraints that fail at an end whose unknowns are all fixed. */
 cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len);
+/* Inequalities (cv_kkt_active.c, theory OB-1, OB-2). 1 when the problem has any. */
+int cv_kkt_has_inequalities(const cv_problem *p);
+cv_status cv_kkt_active_init(cv_kkt *k);
+/* Re-decide every inequality row at (Y, M) by the rule of OB-2 (constraint values only, no
+ * assembly); returns how many decisions changed, or -1 when a constraint cannot be
+ * evaluated there. */
+long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M);
+/* Decide the row of inequality kc at node j from its value g, multiplier lam and the
+ * weight c (OB-2): 1 active (impose G = 0), 0 inactive (impose lambda = 0). */
+int cv_kkt_active_rule(int sense, double g, double lam, double c, double eps);
+/* The row of an inactive node (lambda = 0): residual, diagonal. */
+void cv_kkt_inactive_row(cv_kkt *k, long node, int kc, int row, double lam, double *G, double *Ax,
+                         double *dreg);
 /* Constraint values and dense Jacobian rows for the NLopt engine. */
 cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, double *jac, int ld,
                                    const int *lrow, const int *var);

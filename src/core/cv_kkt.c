@@ -25,6 +25,7 @@ cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const in
     k->gK = cv_malloc((size_t)d->nfree * sizeof *k->gK);
     if (!k->gK) return CVAR_ENOMEM;
   }
+  if (cv_kkt_has_inequalities(p)) return cv_kkt_active_init(k);
   return CVAR_OK;
 }
 
@@ -33,6 +34,8 @@ void cv_kkt_free(cv_kkt *k) {
   cv_free(k->xn);
   cv_free(k->cbuf);
   cv_free(k->gK);
+  cv_free(k->active);
+  cv_free(k->cw);
 }
 
 /* Position of entry (r, c), r <= c, in the upper-triangle column layout (E-2). */
@@ -75,16 +78,77 @@ cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len) {
       /* Scale of G near the end values: |grad G| |y| (or 1), so the test is relative. */
       double sc = 0.0;
       for (int i = 0; i < n && !st; i++) sc += fabs(Gy[i]) * fabs(Y[node * n + i]);
-      if (st || !(fabs(G[0]) <= 1e-9 * cv_fmax(1.0, sc))) {
+      int sense = k->prob->pc[kc].sense;
+      double viol = sense ? cv_fmax(0.0, -sense * (st ? NAN : G[0])) : fabs(st ? NAN : G[0]);
+      if (st || !(viol <= 1e-9 * cv_fmax(1.0, sc))) {
         cv_set_msg(msg, len,
                    "pointwise constraint %d does not hold at the fixed end x = %g (G = %.3g); "
-                   "choose end values on the constraint",
+                   "choose end values that satisfy it",
                    kc, k->xn[node], st ? NAN : G[0]);
         return CVAR_EINVAL;
       }
     }
   }
   return CVAR_OK;
+}
+
+/* The active-set decision of inequality kc at a node (OB-2), counted in k->changed when it
+ * differs from the last evaluation's. Its weight c = h / (m_j |grad G|^2), h the
+ * Hessian's diagonal along grad G, is set at the first evaluation with a Hessian (Ax: the
+ * action's part is assembled, the constraints' not yet) and kept for the run, so that
+ * every evaluation of one Newton run decides by the same rule. */
+static int decide(cv_kkt *k, const double *Ax, long node, int kc, int sense, double g,
+                  const double *gy, int m, double lam) {
+  const cv_disc *d = k->d;
+  size_t at = (size_t)node * d->nc + kc;
+  if (k->frozen) return k->active[at];
+  double c = k->cw[at];
+  if (isnan(c)) {
+    double hd = 0.0, g2 = 0.0;
+    for (int i = 0; i < d->n && Ax; i++) {
+      int fi = cv_disc_fidx(d, node * d->n + i);
+      double gi = gy[(size_t)i * m];
+      if (fi < 0) continue;
+      hd += fabs(Ax[k->colptr[fi + 1] - 1]) * gi * gi;
+      g2 += gi * gi;
+    }
+    double mj = d->mass[cv_disc_lidx(d, node, kc)];
+    /* the node's stiffness along grad G, hd / m_j ~ F_y'y' / h^2, brought to the scale of
+     * the whole interval, F_y'y' / (b - a)^2: the penalty of OB-3 at eps = 1 is then as soft
+     * as the path is stiff on the whole interval, on any mesh */
+    double L = d->b - d->a;
+    c = g2 > 0 && hd > 0 ? hd * mj / (g2 * g2 * L * L) : 1.0;
+    if (Ax) k->cw[at] = c;
+  }
+  int a = cv_kkt_active_rule(sense, g, lam, c, k->eps);
+  k->changed += a != k->active[at];
+  k->active[at] = (unsigned char)a;
+  return a;
+}
+
+long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M) {
+  const cv_disc *d = k->d;
+  int nc = d->nc;
+  long changed = 0;
+  for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
+    int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
+    for (int kc = 0; kc < nc; kc++) {
+      int sense = k->prob->pc[kc].sense;
+      double *g, *gy, *gyy;
+      if (!sense) continue;
+      if (eval_constraint(k, kc, Y, j0, m, CVAR_NEED_F, &g, &gy, &gyy)) return -1;
+      for (int t = 0; t < m; t++) {
+        long node = j0 + t;
+        if (cv_disc_lidx(d, node, kc) < 0) continue;
+        size_t at = (size_t)node * nc + kc;
+        double c = isnan(k->cw[at]) ? 1.0 : k->cw[at];
+        int a = cv_kkt_active_rule(sense, g[t], M[at], c, k->eps);
+        changed += a != k->active[at];
+        k->active[at] = (unsigned char)a;
+      }
+    }
+  }
+  return changed;
 }
 
 /* Gradient and Hessian of the discrete Lagrangian
@@ -106,6 +170,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
     if (Ax) cv_dzero(Ax + cp[c], (size_t)(cp[c + 1] - cp[c]));
   }
   if (dreg) cv_dzero(dreg, (size_t)nf);
+  k->changed = 0;
   st = cv_assemble(&k->as, p->F, p->user, Y, S, G, cp, Ax, 1.0, 1);
   if (st) return st;
   double hmax = 0.0; /* largest diagonal entry of the action's Hessian, for delta */
@@ -143,13 +208,21 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
       double *g, *gy, *gyy;
       st = eval_constraint(k, kc, Y, j0, m, need, &g, &gy, &gyy);
       if (st) return st;
+      int sense = p->pc[kc].sense;
       for (int t = 0; t < m; t++) {
         long node = j0 + t;
         int row = cv_disc_lidx(d, node, kc);
         if (row < 0) continue;
         double mj = d->mass[row], lam = M[node * nc + kc], gg = 0.0;
         if (!isfinite(g[t])) return CVAR_ENONFINITE;
-        G[row] = mj * g[t];
+        if (sense && !decide(k, Ax, node, kc, sense, g[t], gy + t, m, lam)) {
+          cv_kkt_inactive_row(k, node, kc, row, lam, G, Ax, dreg);
+          continue;
+        }
+        /* OB-3: an active row of the path-following imposes G = eps lambda / c */
+        double cw = sense ? k->cw[(size_t)node * nc + kc] : 1.0;
+        double pen = sense && k->eps > 0 ? k->eps / (isnan(cw) ? 1.0 : cw) : 0.0;
+        G[row] = mj * (g[t] - pen * lam);
         for (int i = 0; i < n; i++) {
           int fi = cv_disc_fidx(d, node * n + i);
           if (!isfinite(gy[i * m + t])) return CVAR_ENONFINITE;
@@ -167,8 +240,8 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
         }
         if (Ax) {
           double delta = 1e-12 * gg / hmax;
-          Ax[pos(cp, row, row)] = -delta;
-          if (dreg) dreg[row] = delta;
+          Ax[pos(cp, row, row)] = pen > 0 ? -mj * pen : -delta;
+          if (dreg) dreg[row] = pen > 0 ? 0.0 : delta;
         }
       }
     }
@@ -218,7 +291,8 @@ cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M) {
           num += g[fi] * gy[i * m + t];
           den += gy[i * m + t] * gy[i * m + t];
         }
-        double lam = den > 0 && isfinite(num) ? -num / (mj * den) : 0.0;
+        /* an inequality starts inactive: lambda = 0 (OB-2) */
+        double lam = den > 0 && isfinite(num) && !p->pc[kc].sense ? -num / (mj * den) : 0.0;
         M[node * nc + kc] = lam;
         for (int i = 0; i < n; i++) {
           int fi = cv_disc_fidx(d, node * n + i);

@@ -386,7 +386,7 @@ static cv_status line_search(cv_solver *s, cv_kkt *kkt, const cv_homotopy *h, ne
     double ta = timed ? cv_now() : 0.0;
     /* A step within the tolerance is the last one (taken in full below): the Hessian
      * there would not be used, so only F and the gradient are evaluated. */
-    double *Axt = wn <= 1.0 ? NULL : Ax;
+    double *Axt = wn <= 1.0 && !kkt->active ? NULL : Ax; /* OB-2: the set may change */
     cv_status ast = eval_system(kkt, h, w, w->Yt, w->Mt, &t->St, w->gt, Axt, w->dreg);
     if (timed) s->t_assemble += cv_now() - ta;
     if (ast == CVAR_ECALLBACK || ast == CVAR_ENOMEM) {
@@ -439,8 +439,8 @@ static cv_status run_init(cv_solver *s, const cv_problem *p, cv_disc *d, newton_
   return st;
 }
 
-cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M,
-                        const cv_homotopy *h) {
+static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M,
+                            const cv_homotopy *h, double eps) {
   newton_ws w;
   cv_kkt kkt;
   cv_status st;
@@ -459,6 +459,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   int have_K = 0; /* Ax holds an assembled matrix (for the residual's floor) */
   st = run_init(s, p, d, &w, &kkt, Y, M, nmult, &ncon);
   if (st) goto cleanup;
+  kkt.eps = eps;
   int constrained = ncon > 0;
   /* Absolute floor of the step tolerance: atol times the size of the solution (STYLE 8). */
   for (long i = 0; i < d->ndof; i++)
@@ -483,6 +484,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
   }
   s->action = S;
   have_K = 1;
+  kkt.frozen = kkt.active != NULL; /* OB-2: set at the start, then by cv_kkt_update_active */
   double phi = residual(d, w.g, &s->gnorm);
   /* After a step accepted on S alone the merit phi and the reported residual of the new
    * iterate are left to the next pass over g (the step norm below), not computed in a pass
@@ -525,7 +527,7 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
       cv_set_msg(s->msg, sizeof s->msg, "the Newton step is not finite");
       goto cleanup;
     }
-    if (s->polish && wn <= 1.0) {
+    if (s->polish && wn <= 1.0 && !kkt.active) {
       /* HP-2a: an enriched solve's last step, within the tolerance from a start already
        * within it: taken in full (step_norm put it in w.Yt, w.Mt) without the evaluation
        * at its end, which would only confirm it; the action and residual reported are
@@ -578,11 +580,39 @@ cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y
     S = t.St;
     s->action = S;
     if (!stale) phi = t.phit, s->gnorm = t.rnt;
-    if ((wn <= 1.0 && alpha == 1.0) || s->iterations >= s->maxit) {
+    /* With inequalities, converged also means that the last evaluation kept the active set
+     * of the one before (OB-2): the step was Newton's for the final set. */
+    int done = wn <= 1.0 && alpha == 1.0;
+    if (kkt.active) {
+      /* OB-2: the step was Newton's for the active set of the iterate it started from (the
+       * line search kept it); the new iterate decides the set again, and a changed set
+       * means a new system at the same point, and one more step at least. */
+      long ch = cv_kkt_update_active(&kkt, Yc, Mc);
+      if (ch < 0) {
+        st = CVAR_ENONFINITE;
+        cv_set_msg(s->msg, sizeof s->msg, "an inequality constraint is not finite at iteration %d",
+                   s->iterations);
+        goto cleanup;
+      }
+      if (ch > 0) {
+        done = 0;
+        kkt.frozen = 0;
+        st = eval_system(&kkt, h, &w, Yc, Mc, &S, w.g, Ax, w.dreg);
+        kkt.frozen = 1;
+        if (st) {
+          cv_set_msg(s->msg, sizeof s->msg, "%s", where_failed(st));
+          goto cleanup;
+        }
+        s->action = S;
+        phi = residual(d, w.g, &s->gnorm);
+        stale = 0;
+      }
+    }
+    if (done || s->iterations >= s->maxit) {
       phi = residual(d, w.g, &s->gnorm); /* reported */
       stale = 0;
     }
-    if (wn <= 1.0 && alpha == 1.0) {
+    if (done) {
       st = CVAR_OK;
       cv_set_msg_converged(s->msg, sizeof s->msg, s->iterations);
       goto cleanup;
@@ -613,4 +643,46 @@ cleanup:
   cv_kkt_free(&kkt);
   ws_free(&w);
   return st;
+}
+
+/* Obstacles (OB-3): the exact active-set iteration first, for a few iterations (a warm
+ * start converges in them); otherwise, from the same start, the path-following in the
+ * penalty eps -> 0, whose active set (where G is violated) moves to the contact set in a
+ * few Newton steps on any mesh, and the exact iteration from its end. The exact one alone
+ * from a poor start removes one node per iteration from a contact set that is too large. */
+#define OB_DIRECT_ITERATIONS 8
+static cv_status run_staged(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M) {
+  static const double eps[] = {1.0, 1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 0.0};
+  size_t ny = (size_t)d->ndof, nm = (size_t)d->nodes * d->nc + d->ni;
+  double *save = cv_malloc((ny + nm + 1) * sizeof *save);
+  if (!save) {
+    cv_set_msg(s->msg, sizeof s->msg, "out of memory");
+    return CVAR_ENOMEM;
+  }
+  cv_dcopy(save, Y, ny);
+  cv_dcopy(save + ny, M, nm);
+  int maxit = s->maxit, total = 0;
+  s->maxit = maxit < OB_DIRECT_ITERATIONS ? maxit : OB_DIRECT_ITERATIONS;
+  cv_status st = newton_run(s, p, d, Y, M, NULL, 0.0);
+  s->maxit = maxit;
+  total = s->iterations;
+  if (st == CVAR_EMAXITER || st == CVAR_ESTALL || st == CVAR_EDIVERGED) {
+    cv_dcopy(Y, save, ny);
+    cv_dcopy(M, save + ny, nm);
+    for (size_t k = 0; k < sizeof eps / sizeof *eps; k++) {
+      st = newton_run(s, p, d, Y, M, NULL, eps[k]);
+      total += s->iterations;
+      if (st) break;
+    }
+  }
+  cv_free(save);
+  s->iterations = total;
+  if (st == CVAR_OK) cv_set_msg_converged(s->msg, sizeof s->msg, total);
+  return st;
+}
+
+cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M,
+                        const cv_homotopy *h) {
+  if (h || !cv_kkt_has_inequalities(p)) return newton_run(s, p, d, Y, M, h, 0.0);
+  return run_staged(s, p, d, Y, M);
 }

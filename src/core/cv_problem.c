@@ -134,7 +134,7 @@ cv_status cv_problem_add_constraint_owned(cv_problem *p, cv_constraint_fn G, voi
     return CVAR_ENOMEM;
   }
   for (int k = 0; k < p->nc; k++) grown[k] = p->pc[k];
-  grown[p->nc] = (cv_pconstraint){G, user, release};
+  grown[p->nc] = (cv_pconstraint){G, user, release, 0};
   cv_free(p->pc);
   p->pc = grown;
   if (index) *index = p->nc;
@@ -173,6 +173,16 @@ cv_status cv_problem_add_integral(cv_problem *p, cv_integrand_fn K, void *user, 
 }
 
 int cv_problem_get_num_constraints(const cv_problem *p) { return p ? p->nc : 0; }
+
+cv_status cv_problem_set_constraint_sense(cv_problem *p, int k, int sense) {
+  if (!p || k < 0 || k >= p->nc || sense < -1 || sense > 1) return CVAR_EINVAL;
+  p->pc[k].sense = sense;
+  return CVAR_OK;
+}
+
+int cv_problem_get_constraint_sense(const cv_problem *p, int k) {
+  return p && k >= 0 && k < p->nc ? p->pc[k].sense : 0;
+}
 int cv_problem_get_num_integrals(const cv_problem *p) { return p ? p->ni : 0; }
 
 cv_status cv_problem_add_note(cv_problem *p, cv_note_fn fn, void *user) {

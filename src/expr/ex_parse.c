@@ -275,7 +275,9 @@ static ex_id parse_primary(parser *p) {
     if (p->s[p->pos] != ')') {
       char buf[16];
       if (p->s[p->pos] == '<' || p->s[p->pos] == '>')
-        return fail(p, p->pos, "a comparison is only allowed as the condition of if(...)");
+        return fail(p, p->pos,
+                    "a comparison is only allowed as the condition of if(...), or as "
+                    "'G >= 0' / 'G <= 0' for a whole [constraints] line");
       return fail(p, p->pos, "missing ')' to close the '(' at column %zu (found %s)", at + 1,
                   found(p, buf, sizeof buf));
     }
@@ -356,7 +358,9 @@ ex_id ex_parse(ex_dag *d, const char *src, ex_resolve_fn resolve, void *user, in
     char buf[16];
     if (c == ')') return fail(&p, p.pos, "unmatched ')'");
     if (c == '<' || c == '>')
-      return fail(&p, p.pos, "a comparison is only allowed as the condition of if(...)");
+      return fail(&p, p.pos,
+                  "a comparison is only allowed as the condition of if(...), or as "
+                  "'G >= 0' / 'G <= 0' for a whole [constraints] line");
     if (c == '\'')
       return fail(&p, p.pos, "a prime is only allowed right after the name of an unknown");
     return fail(&p, p.pos, "unexpected %s after a complete expression (missing operator?)",

@@ -38,6 +38,7 @@ typedef struct {
   ex_id expr;   /* the expression (parameters: the folded number) */
   ex_id expr2;  /* [integrals]: the constant c as a node; else -1 */
   double value; /* [parameters]: the value; [integrals]: c */
+  int sense;    /* [constraints]: 0 for G = 0, +1 for G >= 0, -1 for G <= 0 */
 } sc_item;
 
 /** End conditions of one unknown: fixed values or natural (free) ends. */
@@ -46,6 +47,8 @@ typedef struct {
   int free_end[2]; /* nonzero: natural boundary condition dF/dy' = 0 there */
   int line;
   ex_id expr[2]; /* parameters as inputs: the value as an expression of them, else -1 */
+  int periodic;  /* 'periodic [+ D]': y(b) = y(a) + shift, both ends free (theory PB-1) */
+  double shift;
 } sc_boundary;
 
 typedef struct scene {
@@ -173,6 +176,13 @@ cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_
 
 /** Whether F depends explicitly on the variable / on unknown i (not through y'_i). */
 int scene_F_depends_on_variable(const scene *s);
+/** Whether calcvar pins the shift along the variable (theory PB-2): every unknown is
+ * periodic, F does not depend on the variable, and the [guess] moves (its derivative is
+ * not identically zero); the phase condition is then an integral constraint after the
+ * scene's [integrals] and the periodic ones. */
+int scene_pins_shift(const scene *s);
+/** Expression of the phase condition's K = sum_i y_i g_i'(x) and its value c (PB-2). */
+int scene_phase_condition(const scene *s, ex_id *K, double *c);
 int scene_F_depends_on_unknown(const scene *s, int i);
 
 /* Evaluators over m points, structure of arrays like cv_solver_get_qpoints: x[k],

@@ -91,7 +91,8 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
                  : cv_problem_set_end_value(p, i, end, s->bc[i].value[end])) != CVAR_OK;
   for (int k = 0; k < s->ncons && !bad; k++) {
     ex_integrand_set_params(w->cons[k], w->pv);
-    bad = cv_problem_add_constraint(p, ex_integrand_eval_constraint, w->cons[k], NULL) != CVAR_OK;
+    bad = cv_problem_add_constraint(p, ex_integrand_eval_constraint, w->cons[k], NULL) != CVAR_OK ||
+          cv_problem_set_constraint_sense(p, k, s->cons[k].sense) != CVAR_OK;
   }
   for (int k = 0; k < s->nints && !bad; k++) {
     ex_integrand_set_params(w->ints[k], w->pv);

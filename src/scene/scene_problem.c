@@ -97,6 +97,7 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
     }
     why = cv_problem_add_constraint_owned(p, ex_integrand_eval_constraint, g, ex_integrand_release,
                                           NULL);
+    if (why == CVAR_OK) why = cv_problem_set_constraint_sense(p, k, it->sense);
     if (why == CVAR_OK && ex_integrand_has_tables(g))
       why = cv_problem_add_note(p, ex_integrand_note, g);
     if (why != CVAR_OK) {
@@ -118,6 +119,31 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
       why = cv_problem_add_note(p, ex_integrand_note, g);
     if (why != CVAR_OK) {
       sc_err(err, errlen, s->file, it->line, "[integrals] %s: %s", it->name, cv_strerror(why));
+      goto fail;
+    }
+  }
+  /* periodic unknowns (PB-1), after [integrals] so that those keep their numbers, and the
+   * phase condition that pins the shift (PB-2) */
+  for (int i = 0; i < s->n; i++)
+    if (s->bc[i].periodic && (why = cv_problem_set_periodic(p, i, s->bc[i].shift, NULL))) {
+      sc_err(err, errlen, s->file, s->bc[i].line, "[boundary] %s: %s", s->unknowns[i],
+             cv_strerror(why));
+      goto fail;
+    }
+  if (scene_pins_shift(s)) {
+    ex_id K;
+    double c;
+    ex_integrand *g = NULL;
+    if (scene_phase_condition(s, &K, &c) == 0) g = compile(s, K, max_need, msg, sizeof msg);
+    if (!g) {
+      sc_err(err, errlen, s->file, s->bc[0].line, "[boundary]: the phase condition: %s",
+             msg[0] ? msg : "out of memory");
+      goto fail;
+    }
+    why = cv_problem_add_integral_owned(p, ex_integrand_eval, g, ex_integrand_release, c, NULL);
+    if (why != CVAR_OK) {
+      sc_err(err, errlen, s->file, s->bc[0].line, "[boundary]: the phase condition: %s",
+             cv_strerror(why));
       goto fail;
     }
   }

@@ -34,6 +34,9 @@ void cli_report_free(cli_report *r) {
   cv_free(r->x);
   cv_free(r->y);
   cv_free(r->lam);
+  for (int c = 0; r->contact && r->sc && c < r->sc->ncons; c++) cv_free(r->contact[c]);
+  cv_free(r->contact);
+  cv_free(r->ncontact);
   cv_free(r->has_mu);
   cv_free(r->mu);
   cv_free(r->degrees);
@@ -257,6 +260,7 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
     for (int c = 0; c < s->ncons; c++)
       if (cv_solver_get_multiplier_field(sv, c, r->lam + (size_t)c * nn) != CVAR_OK)
         for (int j = 0; j < nn; j++) r->lam[(size_t)c * nn + j] = NAN;
+    if (cli_report_contact(r, s) < 0) return -1;
   }
   r->has_mu = cv_calloc((size_t)s->nints + 1, sizeof *r->has_mu);
   r->mu = cv_calloc((size_t)s->nints + 1, sizeof *r->mu);

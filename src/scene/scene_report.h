@@ -50,6 +50,8 @@ typedef struct {
   double *lam;   /* multiplier fields lam[c*nodes + j] of [constraints], or NULL */
   int *has_mu;   /* [integrals] multipliers */
   double *mu;
+  int *ncontact;    /* per [constraints] entry: its contact intervals (inequalities), or NULL */
+  double **contact; /* contact[c][2k], contact[c][2k + 1]: interval k of constraint c */
 } cli_report;
 
 const char *cli_status_string(cv_status st);
@@ -64,6 +66,9 @@ int cli_report_estimate(cli_report *r, const cv_solver *sv, const cv_problem *p)
 int cli_estimate_error(const cv_solver *sv, const cv_problem *p, double *e_all, double *e_vertex,
                        char *why, size_t len);
 void cli_report_free(cli_report *r);
+/* scene_contact.c: the contact intervals of the inequalities (theory OB-4) from the
+ * multiplier fields; 0, or -1 on allocation failure. */
+int cli_report_contact(cli_report *r, const scene *s);
 
 /* Collect and, without [exact], estimate the error: the rounds' own estimate when
  * `adaptive` (1: --adapt; 2: --tol, then always, with the degrees), else

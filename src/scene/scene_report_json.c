@@ -48,6 +48,14 @@ json_t *cli_report_json_object(const cli_report *r) {
   a = json_array();
   for (int i = 0; i < s->n; i++) json_array_append_new(a, json_string(s->unknowns[i]));
   json_object_set_new(o, "unknowns", a);
+  int periodic = 0;
+  for (int i = 0; i < s->n; i++) periodic |= s->bc[i].periodic;
+  if (periodic) { /* periodic paths: the period and the symmetries calcvar fixed (PB-2) */
+    set_real(o, "period", s->b - s->a);
+    json_t *pin = json_array();
+    if (scene_pins_shift(s)) json_array_append_new(pin, json_string("shift"));
+    json_object_set_new(o, "pinned", pin);
+  }
   if (r->has_action) set_real(o, "action", r->action);
   if (r->has_gradient_norm) set_real(o, "gradient_norm", r->gradient_norm);
   if (r->has_residual_floor) { /* additions (theory N-3a): the floor and the ratio to it */
@@ -83,6 +91,22 @@ json_t *cli_report_json_object(const cli_report *r) {
     json_object_set_new(o, "multipliers", mul);
   else
     json_decref(mul);
+  json_t *con = json_object(); /* inequalities: their contact intervals (OB-4) */
+  for (int c = 0; r->contact && c < s->ncons; c++) {
+    if (!s->cons[c].sense) continue;
+    json_t *list = json_array();
+    for (int k = 0; k < r->ncontact[c]; k++) {
+      json_t *iv = json_array();
+      json_array_append_new(iv, json_real(r->contact[c][2 * k]));
+      json_array_append_new(iv, json_real(r->contact[c][2 * k + 1]));
+      json_array_append_new(list, iv);
+    }
+    json_object_set_new(con, s->cons[c].name, list);
+  }
+  if (json_object_size(con) > 0)
+    json_object_set_new(o, "contact", con);
+  else
+    json_decref(con);
   json_t *rep = json_object();
   for (int k = 0; k < s->nreports; k++)
     if (r->has_rep[k]) set_real(rep, s->reports[k].name, r->rep[k]);

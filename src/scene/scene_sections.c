@@ -53,6 +53,45 @@ static int looks_like_free(const scene *s, const char *t) {
   return 1;
 }
 
+/* Does a [boundary] value start with the word 'periodic'? */
+static int is_periodic(const char *v) {
+  return strncmp(v, "periodic", 8) == 0 && !(isalnum((unsigned char)v[8]) || v[8] == '_');
+}
+
+/* 'periodic' or 'periodic + D' (D a constant expression): y(b) = y(a) + D, both end values
+ * free (SCENES.md; theory PB-1). */
+static int load_periodic(sc_loader *L, const sc_entry *e, sc_boundary *bc) {
+  const char *rest = e->value + 8;
+  while (*rest == ' ' || *rest == '\t') rest++;
+  bc->line = e->line;
+  bc->periodic = 1;
+  bc->free_end[0] = bc->free_end[1] = 1;
+  bc->shift = 0.0;
+  if (*rest == '\0') return 0;
+  char what[160];
+  snprintf(what, sizeof what, "[boundary] %s = periodic + D: D", e->key);
+  if (*rest == ',') {
+    sc_err(L->err, L->errlen, L->file, e->line,
+           "[boundary] %s: 'periodic' replaces both end values; write '%s = periodic' (or "
+           "'periodic + D' for y(b) = y(a) + D) alone on the line",
+           e->key, e->key);
+    return -1;
+  }
+  if (*rest != '+' && *rest != '-') {
+    sc_err(L->err, L->errlen, L->file, e->line,
+           "[boundary] %s: after 'periodic' only '+ D' may follow (y(b) = y(a) + D), got '%s'",
+           e->key, rest);
+    return -1;
+  }
+  int neg = *rest == '-';
+  rest++;
+  ex_id node;
+  if (sc_parse_const_node(L, e, (int)(rest - e->value), rest, what, &bc->shift, &node) < 0)
+    return -1;
+  if (neg) bc->shift = -bc->shift;
+  return 0;
+}
+
 int sc_load_boundary(sc_loader *L) {
   scene *s = L->s;
   s->bc = cv_calloc((size_t)s->n, sizeof *s->bc);
@@ -65,8 +104,21 @@ int sc_load_boundary(sc_loader *L) {
       sc_err(L->err, L->errlen, L->file, e->line, "'%s' in [boundary] is not an unknown", e->key);
       return -1;
     }
+    if (is_periodic(e->value)) {
+      if (load_periodic(L, e, &s->bc[k]) < 0) return -1;
+      continue;
+    }
     ex_list list;
     if (ex_list_split(e->value, &list) < 0) return nomem(L, e->line);
+    for (int end = 0; end < list.n; end++)
+      if (is_periodic(list.item[end])) {
+        sc_err(L->err, L->errlen, L->file, e->line,
+               "[boundary] %s: 'periodic' replaces both end values; write '%s = periodic' "
+               "(or 'periodic + D' for y(b) = y(a) + D) alone on the line",
+               e->key, e->key);
+        ex_list_free(&list);
+        return -1;
+      }
     if (list.n != 2) {
       sc_err(L->err, L->errlen, L->file, e->line,
              "[boundary] %s needs two values 'value_at_a, value_at_b', got %d", e->key, list.n);
@@ -159,6 +211,55 @@ int sc_load_guess_exact(sc_loader *L) {
   return 0;
 }
 
+/* The comparison at the top level of a [constraints] value (outside parentheses), or -1:
+ * *sense +1 for '>=', -1 for '<=', 2 for a strict '>' or '<'; *oplen its length. */
+static long top_comparison(const char *v, int *sense, int *oplen) {
+  int depth = 0;
+  for (long i = 0; v[i]; i++) {
+    char c = v[i];
+    depth += (c == '(') - (c == ')');
+    if (depth != 0 || (c != '<' && c != '>')) continue;
+    *oplen = v[i + 1] == '=' ? 2 : 1;
+    *sense = *oplen == 1 ? 2 : c == '>' ? 1 : -1;
+    return i;
+  }
+  return -1;
+}
+
+/* A [constraints] line: 'G' (an equality G = 0), 'G >= 0' or 'G <= 0' (an inequality,
+ * SCENES.md; theory OB-1). The right-hand side must be 0. */
+static int load_constraint(sc_loader *L, const sc_entry *e, sc_item *it, const char *what) {
+  int sense = 0, oplen = 0;
+  long at = top_comparison(e->value, &sense, &oplen);
+  if (at < 0) return (it->expr = sc_parse(L, e, 0, e->value, what)) < 0 ? -1 : 0;
+  if (sense == 2) {
+    sc_err(L->err, L->errlen, L->file, e->line,
+           "%s: a strict comparison cannot be imposed; write 'G >= 0' or 'G <= 0'", what);
+    return -1;
+  }
+  const char *rhs = e->value + at + oplen;
+  while (*rhs == ' ' || *rhs == '\t') rhs++;
+  double zero;
+  ex_id rnode;
+  char *lhs = cv_malloc((size_t)at + 1);
+  if (!lhs) return nomem(L, e->line);
+  memcpy(lhs, e->value, (size_t)at);
+  lhs[at] = '\0';
+  int rc = (it->expr = sc_parse(L, e, 0, lhs, what)) < 0 ? -1 : 0;
+  cv_free(lhs);
+  if (rc == 0 && sc_parse_const_node(L, e, (int)(rhs - e->value), rhs, what, &zero, &rnode) < 0)
+    rc = -1;
+  if (rc == 0 && zero != 0.0) {
+    sc_err(L->err, L->errlen, L->file, e->line,
+           "%s: an inequality is written 'G >= 0' or 'G <= 0' with 0 on the right; move '%s' "
+           "into G",
+           what, rhs);
+    rc = -1;
+  }
+  it->sense = sense;
+  return rc;
+}
+
 /* Items of [constraints], [integrals] and [report]: a name and one expression. */
 static int load_named(sc_loader *L, int sec, sc_item **out, int *nout) {
   int ne = L->raw.ne[sec];
@@ -179,6 +280,10 @@ static int load_named(sc_loader *L, int sec, sc_item **out, int *nout) {
     *nout = i + 1;
     if (!it->name) return nomem(L, e->line);
     snprintf(what, sizeof what, "[%s] %s", sc_section_name(sec), e->key);
+    if (sec == SEC_CONSTRAINTS) {
+      if (load_constraint(L, e, it, what) < 0) return -1;
+      continue;
+    }
     if (sec != SEC_INTEGRALS) {
       if ((it->expr = sc_parse(L, e, 0, e->value, what)) < 0) return -1;
       continue;
@@ -233,9 +338,13 @@ static int check_constraint_ends(sc_loader *L, const sc_item *c) {
     cv_free(outs);
     cv_free(y);
     if (rc < 0) return nomem(L, c->line);
-    if (!(fabs(g) <= 1e-8 * scale)) {
+    double viol = c->sense ? (c->sense * g < 0 ? fabs(g) : 0.0) : fabs(g);
+    if (!(viol <= 1e-8 * scale)) {
       sc_err(L->err, L->errlen, L->file, c->line,
-             "[constraints] %s does not hold at the fixed end %s = %.17g: it is %.6g there",
+             c->sense ? "[constraints] %s is violated at the fixed end %s = %.17g: it is %.6g "
+                        "there"
+                      : "[constraints] %s does not hold at the fixed end %s = %.17g: it is "
+                        "%.6g there",
              c->name, s->variable, x, g);
       return -1;
     }
@@ -265,11 +374,14 @@ int sc_load_constraints(sc_loader *L) {
     }
     if (check_constraint_ends(L, c) < 0) return -1;
   }
-  if (s->ncons >= s->n) {
-    sc_err(L->err, L->errlen, L->file, s->cons[s->n - 1].line,
-           "%d pointwise constraints on %d unknowns leave no degree of freedom", s->ncons, s->n);
-    return -1;
-  }
+  int neq = 0; /* inequalities leave the path free where they are not active */
+  for (int i = 0; i < s->ncons; i++)
+    if (!s->cons[i].sense && ++neq >= s->n) {
+      sc_err(L->err, L->errlen, L->file, s->cons[i].line,
+             "%d pointwise equality constraints on %d unknowns leave no degree of freedom", neq,
+             s->n);
+      return -1;
+    }
   return 0;
 }
 
