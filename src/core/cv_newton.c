@@ -677,7 +677,15 @@ static cv_status run_staged(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
   }
   cv_free(save);
   s->iterations = total;
-  if (st == CVAR_OK) cv_set_msg_converged(s->msg, sizeof s->msg, total);
+  if (st == CVAR_OK) {
+    cv_set_msg_converged(s->msg, sizeof s->msg, total);
+  } else if (st != CVAR_ENOMEM && st != CVAR_ECALLBACK) {
+    size_t used = strlen(s->msg);
+    cv_set_msg(s->msg + used, sizeof s->msg - used,
+               "; the path-following in the obstacles' penalty failed: the inequality "
+               "constraints may admit no path between these ends (an infeasible problem), or "
+               "the guess is far from one that meets them");
+  }
   return st;
 }
 

@@ -23,7 +23,21 @@ int cli_report_estimate(cli_report *r, const cv_solver *sv, const cv_problem *p)
   double ea, ev;
   char why[640] = "";
   if (r->nodes <= 0 || r->st != CVAR_OK) return 0;
-  if (cli_estimate_error(sv, p, &ea, &ev, why, sizeof why) < 0) return -1;
+  cv_status st = cv_solver_estimate_error(sv, p, &ea, &ev, why, sizeof why);
+  if (st == CVAR_ENOMEM) return -1;
+  if (st != CVAR_OK) ea = NAN;
+  if (st == CVAR_ESINGULAR && r->has_morse) {
+    /* the enriched solve, closer to the integral, finds the Hessian singular: a family of
+     * stationary paths (a resonance, a symmetry left unpinned), not an isolated minimum
+     * or saddle, whatever the pivots of this mesh say (theory N-5) */
+    r->kind = "degenerate";
+    snprintf(r->message, sizeof r->message,
+             "Converged in %d iterations on this mesh, but the Hessian is singular on the "
+             "enriched mesh (%s): the path is one of a family of stationary paths (degenerate), "
+             "not an isolated %s.",
+             r->iterations, why, r->morse == 0 ? "minimum" : "saddle");
+    return 0;
+  }
   if (isfinite(ea)) {
     r->has_err_est = 1;
     r->err_est = ea;

@@ -1,0 +1,130 @@
+#!/usr/bin/env python3
+# tests/obstacle/test_obstacles.py — inequality constraints (docs/obstacles.md, theory
+# OB-1 .. OB-4) through `calcvar solve --json/--csv` against closed forms:
+#  - the path over the bump y >= 1 - x^2 from (-2, 0) to (2, 0): tangent lines and the
+#    parabola, contact [sqrt(3) - 2, 2 - sqrt(3)], length 4.49071475164684, multiplier
+#    lambda = (F_y')' = -2 / (1 + 4 x^2)^(3/2) on contact and 0 off it;
+#  - the same mirrored, y <= -(1 - x^2): the multiplier has the other sign;
+#  - the detour around the unit disk, x^2 + y^2 >= 1: length 2 sqrt(3) + pi/3, contact
+#    [-1/2, 1/2];
+#  - the active-set iteration count against mesh size (mesh independence);
+#  - bad input with its line (exit 2) and an infeasible pair of obstacles (exit 1).
+# Tolerances: --tol T bounds the nodal error; the action's error is far smaller (it is
+# stationary); contact ends are placed between nodes from the gap (OB-4), so their error is
+# bounded by the node spacing next to them: measured 1.0e-5 at --tol 1e-10, bound 3e-5.
+# SPDX-License-Identifier: MIT
+import json, math, os, subprocess, sys, tempfile
+
+calcvar = os.path.abspath(sys.argv[1])
+fails = 0
+
+
+def check(what, ok, detail=""):
+    global fails
+    if not ok:
+        fails += 1
+        print("FAIL", what, detail)
+
+
+def run(text, *args):
+    with tempfile.NamedTemporaryFile("w", suffix=".scene", delete=False) as f:
+        f.write(text)
+        name = f.name
+    try:
+        p = subprocess.run([calcvar, "solve", name, *args], capture_output=True, text=True)
+        return p, name
+    finally:
+        os.unlink(name)
+
+
+BUMP = """[scene]
+title     = over a bump
+interval  = -2, 2
+unknowns  = y
+integrand = sqrt(1 + y'^2)
+[boundary]
+y = 0, 0
+[constraints]
+over = %s
+[guess]
+y = %s
+"""
+xt = math.sqrt(3) - 2
+s = 4 - 2 * math.sqrt(3)
+L_BUMP = 4.49071475164684
+
+
+def exact_bump(x):
+    if x < xt:
+        return s * (x + 2)
+    if x > -xt:
+        return s * (2 - x)
+    return 1 - x * x
+
+
+for sign, G, guess in ((1, "y - (1 - x^2) >= 0", "1.5*(1 - x^2/4)"),
+                       (-1, "y + (1 - x^2) <= 0", "-1.5*(1 - x^2/4)")):
+    p, _ = run(BUMP % (G, guess), "--tol", "1e-10", "--json", "-")
+    check("bump %d exit" % sign, p.returncode == 0, p.stderr)
+    r = json.loads(p.stdout)
+    check("bump %d converged" % sign, r["status"] == "converged", r["message"])
+    check("bump %d length" % sign, abs(r["action"] - L_BUMP) <= 1e-9, r["action"])
+    check("bump %d minimum" % sign, r["morse_index"] == 0, r["morse_index"])
+    iv = r["contact"]["over"]
+    check("bump %d one contact interval" % sign, len(iv) == 1, iv)
+    check("bump %d contact ends" % sign,
+          abs(iv[0][0] - xt) <= 3e-5 and abs(iv[0][1] + xt) <= 3e-5, iv)
+    p, _ = run(BUMP % (G, guess), "--tol", "1e-10", "--csv", "-")
+    rows = [list(map(float, l.split(","))) for l in p.stdout.split("\n")[1:] if l]
+    err = max(abs(y - sign * exact_bump(x)) for x, y, _ in rows)
+    check("bump %d path" % sign, err <= 1e-9, err)
+    for x, y, lam in rows:
+        inside = abs(x) < -xt - 0.05  # the multiplier is less accurate next to the ends
+        outside = abs(x) > -xt + 1e-3
+        want = -sign * 2 / (1 + 4 * x * x) ** 1.5
+        if inside and abs(lam - want) > 1e-4 * abs(want):  # measured 2.5e-5 relative
+            check("bump %d multiplier at %g" % (sign, x), False, (lam, want))
+            break
+        if outside and lam != 0.0:
+            check("bump %d multiplier off contact at %g" % (sign, x), False, lam)
+            break
+
+# The unit disk: the path stays outside x^2 + y^2 >= 1.
+DISK = BUMP.replace("over a bump", "around the disk") % ("x^2 + y^2 - 1 >= 0", "1.5*(1 - x^2/4)")
+p, _ = run(DISK, "--tol", "1e-10", "--json", "-")
+r = json.loads(p.stdout)
+check("disk converged", r["status"] == "converged", r["message"])
+check("disk length", abs(r["action"] - (2 * math.sqrt(3) + math.pi / 3)) <= 1e-9, r["action"])
+iv = r["contact"]["over"]
+check("disk contact", len(iv) == 1 and abs(iv[0][0] + 0.5) <= 3e-5 and abs(iv[0][1] - 0.5) <= 3e-5,
+      iv)
+
+# Mesh independence of the active-set iteration (from the guess above the bump): the
+# count may not grow by more than 2x from 100 to 100000 elements of degree 1 (measured:
+# 41 .. 57 iterations in all).
+its = {}
+for E in (100, 1000, 10000, 100000):
+    p, _ = run(BUMP % ("y - (1 - x^2) >= 0", "1.5*(1 - x^2/4)"), "--elements", str(E),
+               "--degree", "1", "--json", "-")
+    r = json.loads(p.stdout)
+    check("bump E=%d converged" % E, r["status"] == "converged", r["message"])
+    its[E] = r["iterations"]
+check("mesh independence", max(its.values()) <= 2 * min(its.values()), its)
+print("iterations against elements:", its)
+
+# Bad input: FILE:LINE and exit 2.
+for G, what in (("y - (1 - x^2) >= 0 + 1", "0 on the right"), ("y - (1 - x^2) > 0", "strict"),
+                ("y - 3 >= 0", "violated at the fixed end")):
+    p, name = run(BUMP % (G, "1"))
+    check("bad %r exit 2" % G, p.returncode == 2, p.returncode)
+    check("bad %r message" % G, (":9:" in p.stderr) and (what in p.stderr), p.stderr)
+p, _ = run((BUMP % ("y - (1 - x^2) >= 0", "1")).replace("sqrt(1 + y'^2)", "y'^2 >= 0"))
+check("comparison in the integrand", p.returncode == 2 and ":5:" in p.stderr, p.stderr)
+
+# Infeasible: above the bump and below y = 1/2 cannot both hold near x = 0.
+INF = BUMP % ("y - (1 - x^2) >= 0\ncap = y - 0.5 <= 0", "0")
+p, _ = run(INF, "--json", "-")
+check("infeasible exit 1", p.returncode == 1 and "infeasible" in p.stderr, (p.returncode, p.stderr[-300:]))
+
+print("%d failures" % fails)
+sys.exit(1 if fails else 0)
