@@ -258,8 +258,9 @@ typedef struct {
   unsigned char *active;
   double *cw;
   long changed;
-  int frozen; /* 1: evaluations keep the decisions (line-search trials along one step) */
-  double eps; /* > 0: the penalised rows of the path-following (OB-3); 0: exact (OB-2) */
+  int frozen;    /* 1: evaluations keep the decisions (line-search trials along one step) */
+  double gscale; /* OB-5: crossings smaller than this (1% of max |G| at the nodes) pass */
+  double eps;    /* > 0: the penalised rows of the path-following (OB-3); 0: exact (OB-2) */
 } cv_kkt;
 CV_HOT cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const int *colptr);
 CV_HOT void cv_kkt_free(cv_kkt *k);
@@ -272,6 +273,11 @@ cv_status cv_kkt_active_init(cv_kkt *k);
  * assembly); returns how many decisions changed, or -1 when a constraint cannot be
  * evaluated there. */
 long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M);
+/* OB-5: 1 when the step from Y to Yt takes an inactive node that satisfies an inequality
+ * (slack g > 0) further than OB_CROSS g past the obstacle: the line search shortens it, so
+ * that a path does not jump across an obstacle whose constraint gradient is small inside. */
+#define OB_CROSS 0.5
+int cv_kkt_step_crosses(cv_kkt *k, const double *Y, const double *Yt);
 /* Decide the row of inequality kc at node j from its value g, multiplier lam and the
  * weight c (OB-2): 1 active (impose G = 0), 0 inactive (impose lambda = 0). */
 int cv_kkt_active_rule(int sense, double g, double lam, double c, double eps);

@@ -126,10 +126,34 @@ static int decide(cv_kkt *k, const double *Ax, long node, int kc, int sense, dou
   return a;
 }
 
+int cv_kkt_step_crosses(cv_kkt *k, const double *Y, const double *Yt) {
+  const cv_disc *d = k->d;
+  int nc = d->nc;
+  for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
+    int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
+    for (int kc = 0; kc < nc; kc++) {
+      int sense = k->prob->pc[kc].sense;
+      double *g, *gy, *gyy, g0[CV_BATCH];
+      if (!sense) continue;
+      if (eval_constraint(k, kc, Y, j0, m, CVAR_NEED_F, &g, &gy, &gyy)) return 0;
+      cv_dcopy(g0, g, (size_t)m);
+      if (eval_constraint(k, kc, Yt, j0, m, CVAR_NEED_F, &g, &gy, &gyy)) return 0;
+      for (int t = 0; t < m; t++) {
+        long node = j0 + t;
+        if (cv_disc_lidx(d, node, kc) < 0 || k->active[(size_t)node * nc + kc]) continue;
+        double before = sense * g0[t], after = sense * g[t];
+        if (before > 0 && after < -OB_CROSS * before && after < -OB_CROSS * k->gscale) return 1;
+      }
+    }
+  }
+  return 0;
+}
+
 long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M) {
   const cv_disc *d = k->d;
   int nc = d->nc;
   long changed = 0;
+  double gmax = 0.0;
   for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
     int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
     for (int kc = 0; kc < nc; kc++) {
@@ -143,11 +167,13 @@ long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M) {
         size_t at = (size_t)node * nc + kc;
         double c = isnan(k->cw[at]) ? 1.0 : k->cw[at];
         int a = cv_kkt_active_rule(sense, g[t], M[at], c, k->eps);
+        gmax = cv_fmax(gmax, fabs(g[t]));
         changed += a != k->active[at];
         k->active[at] = (unsigned char)a;
       }
     }
   }
+  k->gscale = 1e-2 * gmax;
   return changed;
 }
 

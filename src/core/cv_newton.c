@@ -383,6 +383,10 @@ static cv_status line_search(cv_solver *s, cv_kkt *kkt, const cv_homotopy *h, ne
   t->alpha = 1.0, t->St = t->phit = t->rnt = 0.0, t->stale = 0;
   for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
     if (ls > 0) apply_step(w, Yc, Mc, t->alpha);
+    if (kkt->active && cv_kkt_step_crosses(kkt, Yc, w->Yt)) { /* OB-5 */
+      t->alpha *= 0.5;
+      continue;
+    }
     double ta = timed ? cv_now() : 0.0;
     /* A step within the tolerance is the last one (taken in full below): the Hessian
      * there would not be used, so only F and the gradient are evaluated. */
@@ -485,6 +489,7 @@ static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
   s->action = S;
   have_K = 1;
   kkt.frozen = kkt.active != NULL; /* OB-2: set at the start, then by cv_kkt_update_active */
+  if (kkt.active && cv_kkt_update_active(&kkt, Y, M) < 0) kkt.gscale = 0.0; /* its gscale */
   double phi = residual(d, w.g, &s->gnorm);
   /* After a step accepted on S alone the merit phi and the reported residual of the new
    * iterate are left to the next pass over g (the step norm below), not computed in a pass
@@ -647,12 +652,15 @@ cleanup:
 
 /* Obstacles (OB-3): the exact active-set iteration first, for a few iterations (a warm
  * start converges in them); otherwise, from the same start, the path-following in the
- * penalty eps -> 0, whose active set (where G is violated) moves to the contact set in a
- * few Newton steps on any mesh, and the exact iteration from its end. The exact one alone
- * from a poor start removes one node per iteration from a contact set that is too large. */
+ * penalty eps = 1e-3 .. 1e-9 (relative to the path's stiffness on the whole interval),
+ * whose active set (where G is violated) moves to the contact set in a few Newton steps
+ * on any mesh, and the exact iteration from its end. The exact one alone from a poor
+ * start removes one node per iteration from a contact set that is too large (measured:
+ * 2 nodes per iteration out of 3189 at 10^4 elements). A softer start (eps = 1) let a path
+ * sink through the unit disk, whose constraint gradient vanishes at its centre line. */
 #define OB_DIRECT_ITERATIONS 8
 static cv_status run_staged(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M) {
-  static const double eps[] = {1.0, 1e-2, 1e-4, 1e-6, 1e-8, 1e-10, 0.0};
+  static const double eps[] = {1e-3, 1e-6, 1e-9, 0.0};
   size_t ny = (size_t)d->ndof, nm = (size_t)d->nodes * d->nc + d->ni;
   double *save = cv_malloc((ny + nm + 1) * sizeof *save);
   if (!save) {
