@@ -310,15 +310,21 @@ cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M) {
         long node = j0 + t;
         int row = cv_disc_lidx(d, node, kc);
         if (row < 0) continue;
-        double num = 0.0, den = 0.0, mj = d->mass[row];
+        double num = 0.0, den = 0.0, mj = d->mass[row], sc = 1.0;
         for (int i = 0; i < n; i++) {
           int fi = cv_disc_fidx(d, node * n + i);
+          sc += fabs(gy[i * m + t] * Y[node * n + i]);
           if (fi < 0) continue;
           num += g[fi] * gy[i * m + t];
           den += gy[i * m + t] * gy[i * m + t];
         }
-        /* an inequality starts inactive: lambda = 0 (OB-2) */
-        double lam = den > 0 && isfinite(num) && !p->pc[kc].sense ? -num / (mj * den) : 0.0;
+        double lam = den > 0 && isfinite(num) ? -num / (mj * den) : 0.0;
+        /* OB-2: an inequality starts inactive (lambda = 0) except at a node already on its
+         * obstacle (|G| within 1e-12 of its scale: a node of a solved path), where
+         * the least-squares force is kept if it pushes away from the obstacle, so that the
+         * first evaluation finds the contact set of the path it starts from */
+        int sense = p->pc[kc].sense;
+        if (sense && !(fabs(G[t]) <= 1e-12 * sc && sense * lam <= 0)) lam = 0.0;
         M[node * nc + kc] = lam;
         for (int i = 0; i < n; i++) {
           int fi = cv_disc_fidx(d, node * n + i);

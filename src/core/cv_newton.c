@@ -658,7 +658,7 @@ cleanup:
  * start removes one node per iteration from a contact set that is too large (measured:
  * 2 nodes per iteration out of 3189 at 10^4 elements). A softer start (eps = 1) let a path
  * sink through the unit disk, whose constraint gradient vanishes at its centre line. */
-#define OB_DIRECT_ITERATIONS 8
+#define OB_DIRECT_ITERATIONS 12
 static cv_status run_staged(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M) {
   static const double eps[] = {1e-3, 1e-6, 1e-9, 0.0};
   size_t ny = (size_t)d->ndof, nm = (size_t)d->nodes * d->nc + d->ni;
