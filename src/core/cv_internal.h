@@ -259,6 +259,8 @@ typedef struct {
   double *cw;
   long changed;
   int frozen;    /* 1: evaluations keep the decisions (line-search trials along one step) */
+  double on_tol; /* OB-2: |G| <= on_tol (relative) counts as on the obstacle at the start;
+                  * 0: 1e-12 (a solved path); the NLopt engine sets its constraint tolerance */
   double gscale; /* OB-5: crossings smaller than this (1% of max |G| at the nodes) pass */
   double eps;    /* > 0: the penalised rows of the path-following (OB-3); 0: exact (OB-2) */
 } cv_kkt;

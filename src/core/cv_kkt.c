@@ -324,7 +324,8 @@ cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M) {
          * the least-squares force is kept if it pushes away from the obstacle, so that the
          * first evaluation finds the contact set of the path it starts from */
         int sense = p->pc[kc].sense;
-        if (sense && !(fabs(G[t]) <= 1e-12 * sc && sense * lam <= 0)) lam = 0.0;
+        double on = k->on_tol > 0 ? k->on_tol : 1e-12;
+        if (sense && !(fabs(G[t]) <= on * sc && sense * lam <= 0)) lam = 0.0;
         M[node * nc + kc] = lam;
         for (int i = 0; i < n; i++) {
           int fi = cv_disc_fidx(d, node * n + i);

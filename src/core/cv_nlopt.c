@@ -1,6 +1,7 @@
 /* src/core/cv_nlopt.c — the NLopt engine: minimise the discrete action over the free nodal
  * values with the exact gradient (A-2), constraints as NLopt equality (or paired
- * inequality) constraints, multipliers recovered afterwards by least squares (C-5).
+ * inequality) constraints and obstacles as inequality constraints (OB-1), multipliers
+ * recovered afterwards by least squares (C-5).
  * The only file that includes nlopt.h.
  * SPDX-License-Identifier: MIT */
 #include <math.h>
@@ -26,6 +27,10 @@ typedef struct {
   int *rows;       /* constraint row -> unknown index of its multiplier, or nu row */
   int *lrow, *var; /* unknown index -> constraint row / NLopt variable, or -1 */
   int m;           /* number of constraint rows */
+  int *rsense;     /* constraint row -> 0 (equality) or the sense of its inequality */
+  int *sel;        /* the rows of one NLopt constraint set: equalities, then inequalities */
+  int me, mi;      /* how many of each */
+  double *J;       /* scratch: the Jacobian of all m rows (m x nv), when both sets exist */
   double scale, action;
   double smin, ymax; /* smallest action and largest |y| seen (runaway diagnosis) */
   long evals;
@@ -88,13 +93,9 @@ static double objective(unsigned n, const double *x, double *grad, void *data) {
   (void)n;
   c->evals++;
   load(c, x);
-  for (int v = 0; v < c->nv; v++) {
-    if (!(fabs(c->Y[c->yof[v]]) <= RUNAWAY * c->scale)) {
-      c->stop = CVAR_ENOTMIN;
-      nlopt_force_stop(c->opt);
-      return 0.0;
-    }
-  }
+  int runaway = 0;
+  for (int v = 0; v < c->nv && !runaway; v++)
+    runaway = !(fabs(c->Y[c->yof[v]]) <= RUNAWAY * c->scale);
   memset(c->g, 0, (size_t)c->d->nfree * sizeof *c->g);
   cv_status st = cv_assemble(&c->kkt->as, c->kkt->prob->F, c->kkt->prob->user, c->Y, &S,
                              grad ? c->g : NULL, c->kkt->colptr, NULL, 0.0, 0);
@@ -104,6 +105,15 @@ static double objective(unsigned n, const double *x, double *grad, void *data) {
     return 0.0;
   }
   if (st) return HUGE_VAL; /* outside the integrand's domain: a rejected trial point */
+  /* A trial point far away is a sign of an action unbounded below only when the action
+   * has fallen far there too; otherwise (MMA's first trial steps with inequality
+   * constraints and no bounds on the variables) it is a rejected trial point. */
+  if (runaway && S < c->smin - 1e3 * (fabs(c->smin) + 1.0)) {
+    c->stop = CVAR_ENOTMIN;
+    nlopt_force_stop(c->opt);
+    return 0.0;
+  }
+  if (runaway) return HUGE_VAL;
   if (S < c->smin) c->smin = S;
   for (int v = 0; v < c->nv; v++) c->ymax = fmax(c->ymax, fabs(c->Y[c->yof[v]]));
   if (grad) {
@@ -114,27 +124,46 @@ static double objective(unsigned n, const double *x, double *grad, void *data) {
   return S;
 }
 
-/* Constraint rows: G_k(x_j, Y_j) at the nodes with multipliers, then I_r - c_r. */
-static void eq_constraints(unsigned m, double *result, unsigned n, const double *x, double *grad,
-                           void *data) {
-  nl_ctx *c = data;
-  (void)n;
+/* The m rows sel[0 .. m-1] of the constraint rows (G_k(x_j, Y_j) at the nodes with
+ * multipliers, then I_r - c_r), in NLopt's form: an equality as it is, an inequality
+ * s G >= 0 as -s G <= 0 (OB-1). All rows are evaluated (into c->J when the set is a part
+ * of them) and the set's are copied out. */
+static void constraint_set(unsigned m, double *result, const double *x, double *grad, nl_ctx *c,
+                           const int *sel) {
   load(c, x);
-  if (grad) memset(grad, 0, (size_t)m * c->nv * sizeof *grad);
-  cv_status st = cv_kkt_constraint_values(c->kkt, c->Y, c->g, grad, c->nv, c->lrow, c->var);
+  int all = (int)m == c->m;
+  double *J = grad ? (all ? grad : c->J) : NULL;
+  if (J) memset(J, 0, (size_t)c->m * c->nv * sizeof *J);
+  cv_status st = cv_kkt_constraint_values(c->kkt, c->Y, c->g, J, c->nv, c->lrow, c->var);
   if (st) {
     c->stop = st;
     nlopt_force_stop(c->opt);
   }
-  for (unsigned i = 0; i < m; i++) result[i] = st ? 0.0 : c->g[c->rows[i]];
-  if (!grad) return;
-  /* Each Jacobian row from y to z (NL-1): row <- |D|^{-1/2} L^{-1} row. */
   for (unsigned i = 0; i < m; i++) {
+    int r = sel[i], sg = c->rsense[r] ? -c->rsense[r] : 1;
+    result[i] = st ? 0.0 : sg * c->g[c->rows[r]];
+    if (!grad) continue;
     double *row = grad + (size_t)i * c->nv;
+    if (!all) memcpy(row, J + (size_t)r * c->nv, (size_t)c->nv * sizeof *row);
+    /* the Jacobian row from y to z (NL-1): row <- |D|^{-1/2} L^{-1} row */
     memset(c->w, 0, (size_t)c->d->nfree * sizeof *c->w);
-    for (int v = 0; v < c->nv; v++) c->w[c->fof[v]] = row[v];
+    for (int v = 0; v < c->nv; v++) c->w[c->fof[v]] = sg * row[v];
     to_z(c, c->w, row);
   }
+}
+
+static void eq_constraints(unsigned m, double *result, unsigned n, const double *x, double *grad,
+                           void *data) {
+  nl_ctx *c = data;
+  (void)n;
+  constraint_set(m, result, x, grad, c, c->sel);
+}
+
+static void ineq_constraints(unsigned m, double *result, unsigned n, const double *x, double *grad,
+                             void *data) {
+  nl_ctx *c = data;
+  (void)n;
+  constraint_set(m, result, x, grad, c, c->sel + c->me);
 }
 
 static nlopt_algorithm algorithm(cv_method m) {
@@ -203,10 +232,17 @@ static void index_unknowns(nl_ctx *c, const cv_disc *d) {
     }
     for (int k = 0; k < d->nc; k++) {
       int f = cv_disc_lidx(d, j, k);
-      if (f >= 0) c->lrow[f] = c->m, c->rows[c->m++] = f;
+      if (f >= 0)
+        c->lrow[f] = c->m, c->rsense[c->m] = c->kkt->prob->pc[k].sense, c->rows[c->m++] = f;
     }
   }
-  for (int r = 0; r < d->ni; r++) c->lrow[d->nu0 + r] = c->m, c->rows[c->m++] = d->nu0 + r;
+  for (int r = 0; r < d->ni; r++)
+    c->lrow[d->nu0 + r] = c->m, c->rsense[c->m] = 0, c->rows[c->m++] = d->nu0 + r;
+  c->me = c->mi = 0; /* sel: the equality rows, then the inequality rows */
+  for (int r = 0; r < c->m; r++)
+    if (!c->rsense[r]) c->sel[c->me++] = r;
+  for (int r = 0; r < c->m; r++)
+    if (c->rsense[r]) c->sel[c->me + c->mi++] = r;
 }
 
 /* The NLopt object for s->method with the objective, tolerances and constraints (NL-2).
@@ -215,7 +251,7 @@ static void index_unknowns(nl_ctx *c, const cv_disc *d) {
  * AUGLAG_EQ: the equalities go to an augmented Lagrangian whose subproblems MMA or CCSAQ
  * solve. *local: the subsidiary optimiser, if any (the caller destroys it). */
 static cv_status make_optimizer(nl_ctx *c, cv_solver *s, nlopt_opt *local, const double *tol) {
-  int eq_wrap = c->m > 0 && (s->method == CVAR_METHOD_MMA || s->method == CVAR_METHOD_CCSAQ);
+  int eq_wrap = c->me > 0 && (s->method == CVAR_METHOD_MMA || s->method == CVAR_METHOD_CCSAQ);
   c->opt = nlopt_create(eq_wrap ? NLOPT_AUGLAG_EQ : algorithm(s->method), (unsigned)c->nv);
   if (!c->opt) return CVAR_ENOMEM;
   if (s->method == CVAR_METHOD_AUGLAG || eq_wrap) {
@@ -231,8 +267,11 @@ static cv_status make_optimizer(nl_ctx *c, cv_solver *s, nlopt_opt *local, const
   /* Evaluations, not Newton iterations: a quasi-Newton method needs many more. */
   nlopt_set_maxeval(c->opt, 200 * s->maxit);
   if (c->m > 0) {
-    nlopt_result r;
-    r = nlopt_add_equality_mconstraint(c->opt, (unsigned)c->m, eq_constraints, c, tol);
+    nlopt_result r = NLOPT_SUCCESS;
+    if (c->me > 0)
+      r = nlopt_add_equality_mconstraint(c->opt, (unsigned)c->me, eq_constraints, c, tol);
+    if (r >= 0 && c->mi > 0) /* MMA, CCSAQ, SLSQP and AUGLAG take inequalities natively */
+      r = nlopt_add_inequality_mconstraint(c->opt, (unsigned)c->mi, ineq_constraints, c, tol);
     if (r < 0) {
       cv_set_msg(s->msg, sizeof s->msg, "NLopt refused the constraints (%s)",
                  nlopt_result_to_string(r));
@@ -315,7 +354,9 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
   c.rows = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.rows);
   c.lrow = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.lrow);
   c.var = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.var);
-  if (!c.g || !c.yof || !c.fof || !c.rows || !c.lrow || !c.var) {
+  c.rsense = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.rsense);
+  c.sel = cv_malloc((size_t)(d->nfree ? d->nfree : 1) * sizeof *c.sel);
+  if (!c.g || !c.yof || !c.fof || !c.rows || !c.lrow || !c.var || !c.rsense || !c.sel) {
     st = CVAR_ENOMEM;
     goto cleanup;
   }
@@ -325,6 +366,10 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
     st = cv_kkt_check_ends(&kkt, Y, s->msg, sizeof s->msg);
     if (st) goto cleanup;
   }
+  c.kkt = &kkt;
+  /* OB-2: multipliers recovered where NLopt's answer is within 1e-6 of an obstacle (at a
+   * free node the stationarity residual, and so the least-squares multiplier, is ~0) */
+  kkt.on_tol = 1e-6;
   index_unknowns(&c, d);
   if ((double)c.m * c.nv > MAX_DENSE_JACOBIAN) {
     st = CVAR_EINVAL;
@@ -351,7 +396,8 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
   if (c.scale == 0) c.scale = 1;
   x = cv_malloc((size_t)(c.nv ? c.nv : 1) * sizeof *x);
   tol = cv_malloc((size_t)(c.m ? c.m : 1) * sizeof *tol);
-  if (!x || !tol) {
+  if (c.me > 0 && c.mi > 0) c.J = cv_malloc((size_t)c.m * c.nv * sizeof *c.J);
+  if (!x || !tol || (c.me > 0 && c.mi > 0 && !c.J)) {
     st = CVAR_ENOMEM;
     goto cleanup;
   }
@@ -411,6 +457,9 @@ cleanup:
   cv_free(c.rows);
   cv_free(c.lrow);
   cv_free(c.var);
+  cv_free(c.rsense);
+  cv_free(c.sel);
+  cv_free(c.J);
   cv_free(c.Y0);
   cv_free(c.w);
   cv_free(c.dinv);

@@ -115,6 +115,22 @@ for E in (100, 1000, 10000, 100000):
 check("mesh independence", max(its.values()) <= 70, its)
 print("iterations against elements:", its)
 
+# The NLopt engines take the inequality natively (OB-1): CCSAQ and AUGLAG reach the
+# discrete minimum Newton reaches on the same mesh (40 elements of degree 2), whose error
+# against the exact path is 3.0e-4; their answer must be within 2e-5 of Newton's action.
+p, _ = run(BUMP % ("y - (1 - x^2) >= 0", "1.5*(1 - x^2/4)"), "--elements", "40", "--degree", "2",
+           "--json", "-")
+ref = json.loads(p.stdout)["action"]
+for m in ("ccsaq", "auglag"):
+    p, _ = run(BUMP % ("y - (1 - x^2) >= 0", "1.5*(1 - x^2/4)"), "--elements", "40", "--degree",
+               "2", "--method", m, "--json", "-")
+    r = json.loads(p.stdout)
+    check("%s converged" % m, r["status"] == "converged", r["message"])
+    check("%s action" % m, abs(r["action"] - ref) <= 2e-5,
+          (r["action"], ref))
+p, _ = run(BUMP % ("y - (1 - x^2) >= 0", "1"), "--method", "lbfgs")
+check("lbfgs refuses constraints", p.returncode == 2 and "cannot impose" in p.stderr, p.stderr)
+
 # Bad input: FILE:LINE and exit 2.
 for G, what in (("y - (1 - x^2) >= 0 + 1", "0 on the right"), ("y - (1 - x^2) > 0", "strict"),
                 ("y - 3 >= 0", "violated at the fixed end")):
