@@ -105,10 +105,11 @@ static double objective(unsigned n, const double *x, double *grad, void *data) {
     return 0.0;
   }
   if (st) return HUGE_VAL; /* outside the integrand's domain: a rejected trial point */
-  /* A trial point far away is a sign of an action unbounded below only when the action
-   * has fallen far there too; otherwise (MMA's first trial steps with inequality
-   * constraints and no bounds on the variables) it is a rejected trial point. */
-  if (runaway && S < c->smin - 1e3 * (fabs(c->smin) + 1.0)) {
+  /* A trial point far away is a sign of an action unbounded below when the action is
+   * lower there than anywhere before; otherwise (MMA's first trial steps with inequality
+   * constraints and no bounds on the variables: the length of a wild path) it is a
+   * rejected trial point. */
+  if (runaway && S < c->smin) {
     c->stop = CVAR_ENOTMIN;
     nlopt_force_stop(c->opt);
     return 0.0;
