@@ -280,6 +280,13 @@ static double dorfler_threshold(const double *eta, int E, double frac) {
   return th;
 }
 
+/* Prefix a sentence to s's message (truncated to its buffer). */
+static void prefix_msg(cv_solver *s, const char *pre) {
+  char m[sizeof s->msg];
+  cv_set_msg(m, sizeof m, "%s%s", pre, s->msg);
+  memcpy(s->msg, m, sizeof m);
+}
+
 /* Rounds (HP-1): solve on the current mesh warm-started from the last enriched solution,
  * estimate, refine. Ends with s holding the last round's solution and s->err_est. */
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
@@ -291,6 +298,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   double tol = s->adapt_tol, best = INFINITY, t0 = cv_now();
   cv_meshspec spec0 = s->mesh;
   int degree0 = s->degree;
+  char rescued[400] = ""; /* what the rescues of failed rounds did (HP-9) */
   if (!f) return CVAR_ENOMEM;
   st = start_mesh(s, p, &E, &t, &deg);
   if (st) {
@@ -313,14 +321,22 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     st = cv_solve_mesh(s, p);
     cv_solver_set_start(s, 0, NULL);
     iters += s->iterations;
-    if (st) {
-      char why[400];
+    if (st) { /* HP-9: from the guess, on this mesh and on finer uniform ones */
+      char why[400], add[400];
+      int E0 = E, nodes = s->disc.nodes;
       memcpy(why, s->msg, sizeof why);
       why[sizeof why - 1] = '\0';
-      cv_set_msg(s->msg, sizeof s->msg, "%s, round %d (%d elements, %d nodes): %s",
-                 s->hp ? "automatic accuracy" : "adaptive refinement", s->rounds, E, s->disc.nodes,
-                 why);
-      goto cleanup;
+      cv_rescue r = {&spec0, degree0, warm, t0, &iters};
+      st = cv_adapt_rescue(s, p, &r, st, &E, &t, &deg, add, sizeof add);
+      if (st == CVAR_OK) {
+        size_t ln = strlen(rescued);
+        cv_set_msg(rescued + ln, sizeof rescued - ln, "%s", add);
+      } else {
+        cv_set_msg(s->msg, sizeof s->msg, "%s, round %d (%d elements, %d nodes): %s%s",
+                   s->hp ? "automatic accuracy" : "adaptive refinement", s->rounds, E0, nodes, why,
+                   add);
+        goto cleanup;
+      }
     }
     cv_free(eta);
     cv_free(sigma);
@@ -425,6 +441,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     }
   }
 cleanup:
+  if (rescued[0]) prefix_msg(s, rescued);
   s->ends_passed[0] = s->ends_passed[1] = 0; /* the next plain solve checks its ends */
   s->iterations = (int)(iters > 2000000000L ? 2000000000L : iters); /* all rounds */
   cv_free(s->mesh.t);
