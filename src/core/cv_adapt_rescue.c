@@ -78,8 +78,7 @@ cv_status cv_adapt_rescue(cv_solver *s, const cv_problem *p, const cv_rescue *r,
   const cv_meshspec *spec0 = r->spec0;
   int tried = 0, Elast = 0;
   if (spec0->kind != CV_MESH_USER && spec0->elements > 0)
-    for (long Ek = spec0->elements; tried < RESCUE_MESHES && Ek < 100000000L;
-         Ek *= RESCUE_GROWTH) {
+    for (long Ek = spec0->elements; tried < RESCUE_MESHES && Ek < 100000000L; Ek *= RESCUE_GROWTH) {
       long nodes = Ek * r->degree0 + 1;
       if (nodes < nodes0) continue;
       if (nodes > s->adapt_max) break;
