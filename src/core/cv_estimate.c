@@ -385,11 +385,13 @@ static cv_status enriched_start(cv_solver *f, const cv_solver *s, int nodes_f) {
 
 /* HP-3: the enriched solution f is of the same kind as s when the number of directions of
  * negative curvature agrees (the Morse index) or that of positive curvature does (the
- * co-index, free directions minus Morse index). The enriched mesh has more free directions,
+ * co-index, free directions minus Morse index), or s's is not known (an NLopt answer: then
+ * only the distance moved decides). The enriched mesh has more free directions,
  * so a maximum (co-index 0) has a larger Morse index there than on s's mesh, and a path of
  * small co-index likewise; a minimum or saddle of small index keeps its Morse index. */
 static int same_kind(const cv_solver *s, const cv_solver *f) {
-  if (f->morse == s->morse) return 1;
+  if (f->morse == s->morse || s->morse < 0)
+    return 1; /* < 0: not known (NLopt): the distance decides */
   int cs = cv_solver_get_num_free(s) - s->morse, cf = cv_solver_get_num_free(f) - f->morse;
   return s->morse >= 0 && f->morse >= 0 && cs == cf;
 }
