@@ -118,20 +118,38 @@ static void say_cap(cv_solver *s, double est) {
                      "--max-elements, or the max_elements argument of cv_solver_set_adapt)");
 }
 
+/* Where a floor that refinement does not lower comes from (HP-6): a table's rounding when
+ * the integrand reads tables, else round-off amplified by the conditioning. */
+static const char *floor_cause(int tables) {
+  return tables ? "noise in the integrand's values, such as a table's rounding"
+                : "round-off amplified by the conditioning of the problem: a nearly singular "
+                  "Hessian, as next to a conjugate point, multiplies the round-off of the "
+                  "equations";
+}
+
 /* HP-6: why the rounds must stop before reaching tol, as a sentence in s->msg, or 0 to go
  * on. best: smallest estimate so far; floor_: the estimate's round-off part (HP-2);
- * stalled: rounds since the best last halved, at halved_nodes nodes. */
+ * stalled: rounds since the best last halved, at halved_nodes nodes; tables: the integrand
+ * reads tables. */
 static int stop_rule(cv_solver *s, double est, double best, double floor_, int stalled,
-                     int halved_nodes, int next_size, double elapsed) {
+                     int halved_nodes, int next_size, double elapsed, int tables) {
   double tol = s->adapt_tol;
   if ((best <= floor_ && tol < floor_) ||
       (stalled >= STALL_ROUNDS_FLOOR && best <= 10.0 * floor_)) {
-    cv_set_msg(s->msg, sizeof s->msg,
-               "the error estimate reached %.2g > %.2g and can go no lower: that is the "
-               "round-off floor of double precision for this solution (about %.1g, from "
-               "values of size %.2g and the slope times the spacing of doubles at the "
-               "nodes); ask for a larger tolerance",
-               est, tol, floor_, value_scale(s));
+    if (est <= 10.0 * floor_)
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "the error estimate reached %.2g > %.2g and can go no lower: that is the "
+                 "round-off floor of double precision for this solution (about %.1g, from "
+                 "values of size %.2g and the slope times the spacing of doubles at the "
+                 "nodes); ask for a larger tolerance",
+                 est, tol, floor_, value_scale(s));
+    else /* the last estimate is far above the floor the best one reached (HP-6) */
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "the error estimate stopped decreasing: its smallest, %.2g, was within 10 "
+                 "times the round-off floor of the values (about %.1g, values of size %.2g), "
+                 "and the last rounds gave up to %.2g > %.2g, above that floor: %s; ask for a "
+                 "larger tolerance",
+                 best, floor_, value_scale(s), est, tol, floor_cause(tables));
     return 1;
   }
   if (s->hp && stalled >= STALL_ROUNDS_FLOOR &&
@@ -139,10 +157,9 @@ static int stop_rule(cv_solver *s, double est, double best, double floor_, int s
     cv_set_msg(s->msg, sizeof s->msg,
                "the error estimate stopped decreasing at %.2g > %.2g: %d rounds multiplied the "
                "nodes by %.0f (%d to %d) without halving it, a floor that refinement does not "
-               "lower (noise in the integrand's values, such as a table's rounding); ask for "
-               "a larger tolerance",
+               "lower (%s); ask for a larger tolerance",
                best, tol, stalled, (double)s->disc.nodes / halved_nodes, halved_nodes,
-               s->disc.nodes);
+               s->disc.nodes, floor_cause(tables));
     return 1;
   }
   if (stalled >= STALL_ROUNDS) {
@@ -423,7 +440,8 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       if (td > thresh) thresh = td;
     }
     if (stop_rule(s, est, best, floor_, stalled, halved_nodes,
-                  next_size(&s->disc, eta, sigma, thresh, tol, s->hp), cv_now() - t0)) {
+                  next_size(&s->disc, eta, sigma, thresh, tol, s->hp), cv_now() - t0,
+                  p->nnotes > 0)) {
       st = CVAR_EMAXITER;
       goto cleanup;
     }
