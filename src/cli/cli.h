@@ -129,6 +129,7 @@ typedef struct {
   int estimated;
   int has_err, has_err_v, has_order, has_order_v;
   double err, err_v, order, order_v;
+  int no_est_at; /* where r.message says why there is no estimate (HP-3), or -1 */
 } cli_conv_row;
 int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_converge_json(FILE *f, const cli_conv_row *rows, int nrows);

@@ -105,7 +105,9 @@ int cli_continue_solve(const cli_opts *o, scene *s0, cv_batch **bp, const scene 
     } else {
       cv_solver_free(sv2);
       failures++;
-      step *= 0.5;
+      /* half the step that failed (it may have been cut short at the target): the next
+       * value lies between the last accepted one and the failed one, never past `to` */
+      step = 0.5 * (v - done_at);
       if (fabs(step) < fabs(to - from) * MIN_FRACTION) break;
       v = done_at + step;
     }

@@ -179,7 +179,8 @@ static int solve_row(scene *s, const cv_problem *p, int any_exact, cli_conv_row 
   if (!best) return -1;
   int rc = cli_report_collect(&row->r, s, p, best, s->method, st);
   double ea = NAN, ev = NAN;
-  char why[400];
+  char why[640] = "";
+  row->no_est_at = -1;
   if (rc == 0 && !any_exact && row->r.nodes > 0 && st == CVAR_OK)
     rc = cli_estimate_error(best, p, &ea, &ev, why, sizeof why);
   cv_solver_free(best);
@@ -201,6 +202,12 @@ static int solve_row(scene *s, const cv_problem *p, int any_exact, cli_conv_row 
     row->err_v = ev;
     row->r.has_err_est = row->has_err;
     row->r.err_est = ea;
+    if (!row->has_err && why[0]) { /* HP-3: say why, as solve does */
+      size_t used = strlen(row->r.message);
+      row->no_est_at = (int)(used + (used ? 1 : 0));
+      snprintf(row->r.message + used, sizeof row->r.message - used, "%sno error estimate: %s.",
+               used ? " " : "", why);
+    }
   }
   return 0;
 }

@@ -84,6 +84,8 @@ int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows) {
     num(f, r->has_time, r->time_s, "%*.3e", 10);
     if (r->st != CVAR_OK) fprintf(f, "  %s", r->status);
     fputc('\n', f);
+    if (row->no_est_at >= 0 && row->no_est_at < (int)sizeof r->message)
+      fprintf(f, "%9s %s\n", "", r->message + row->no_est_at); /* why the row has "-" */
   }
   return ferror(f) ? -1 : 0;
 }

@@ -53,8 +53,9 @@ void cli_report_text(FILE *f, const cli_report *r) {
     fprintf(f, "  estimate    %.3g max nodal error (from a solve with higher degrees)\n",
             r->err_est);
   if (r->has_energy)
-    fprintf(f, "  energy      H from %.15g to %.15g (drift %.3g)\n", r->emin, r->emax,
-            r->emax - r->emin);
+    fprintf(f, "  energy      H from %.15g to %.15g (drift %.3g%s)\n", r->emin, r->emax,
+            r->emax - r->emin,
+            r->e_skipped > 0 ? "; elements where y' is not known left out, see status" : "");
   for (int i = 0; i < s->n; i++)
     if (r->has_mom[i])
       fprintf(f, "  momentum    dF/d%s' from %.15g to %.15g (%s is cyclic)\n", s->unknowns[i],

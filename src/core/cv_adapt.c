@@ -118,20 +118,38 @@ static void say_cap(cv_solver *s, double est) {
                      "--max-elements, or the max_elements argument of cv_solver_set_adapt)");
 }
 
+/* Where a floor that refinement does not lower comes from (HP-6): a table's rounding when
+ * the integrand reads tables, else round-off amplified by the conditioning. */
+static const char *floor_cause(int tables) {
+  return tables ? "noise in the integrand's values, such as a table's rounding"
+                : "round-off amplified by the conditioning of the problem: a nearly singular "
+                  "Hessian, as next to a conjugate point, multiplies the round-off of the "
+                  "equations";
+}
+
 /* HP-6: why the rounds must stop before reaching tol, as a sentence in s->msg, or 0 to go
  * on. best: smallest estimate so far; floor_: the estimate's round-off part (HP-2);
- * stalled: rounds since the best last halved, at halved_nodes nodes. */
+ * stalled: rounds since the best last halved, at halved_nodes nodes; tables: the integrand
+ * reads tables. */
 static int stop_rule(cv_solver *s, double est, double best, double floor_, int stalled,
-                     int halved_nodes, int next_size, double elapsed) {
+                     int halved_nodes, int next_size, double elapsed, int tables) {
   double tol = s->adapt_tol;
   if ((best <= floor_ && tol < floor_) ||
       (stalled >= STALL_ROUNDS_FLOOR && best <= 10.0 * floor_)) {
-    cv_set_msg(s->msg, sizeof s->msg,
-               "the error estimate reached %.2g > %.2g and can go no lower: that is the "
-               "round-off floor of double precision for this solution (about %.1g, from "
-               "values of size %.2g and the slope times the spacing of doubles at the "
-               "nodes); ask for a larger tolerance",
-               est, tol, floor_, value_scale(s));
+    if (est <= 10.0 * floor_)
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "the error estimate reached %.2g > %.2g and can go no lower: that is the "
+                 "round-off floor of double precision for this solution (about %.1g, from "
+                 "values of size %.2g and the slope times the spacing of doubles at the "
+                 "nodes); ask for a larger tolerance",
+                 est, tol, floor_, value_scale(s));
+    else /* the last estimate is far above the floor the best one reached (HP-6) */
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "the error estimate stopped decreasing: its smallest, %.2g, was within 10 "
+                 "times the round-off floor of the values (about %.1g, values of size %.2g), "
+                 "and the last rounds gave up to %.2g > %.2g, above that floor: %s; ask for a "
+                 "larger tolerance",
+                 best, floor_, value_scale(s), est, tol, floor_cause(tables));
     return 1;
   }
   if (s->hp && stalled >= STALL_ROUNDS_FLOOR &&
@@ -139,10 +157,9 @@ static int stop_rule(cv_solver *s, double est, double best, double floor_, int s
     cv_set_msg(s->msg, sizeof s->msg,
                "the error estimate stopped decreasing at %.2g > %.2g: %d rounds multiplied the "
                "nodes by %.0f (%d to %d) without halving it, a floor that refinement does not "
-               "lower (noise in the integrand's values, such as a table's rounding); ask for "
-               "a larger tolerance",
+               "lower (%s); ask for a larger tolerance",
                best, tol, stalled, (double)s->disc.nodes / halved_nodes, halved_nodes,
-               s->disc.nodes);
+               s->disc.nodes, floor_cause(tables));
     return 1;
   }
   if (stalled >= STALL_ROUNDS) {
@@ -280,6 +297,13 @@ static double dorfler_threshold(const double *eta, int E, double frac) {
   return th;
 }
 
+/* Prefix a sentence to s's message (truncated to its buffer). */
+static void prefix_msg(cv_solver *s, const char *pre) {
+  char m[sizeof s->msg];
+  cv_set_msg(m, sizeof m, "%s%s", pre, s->msg);
+  memcpy(s->msg, m, sizeof m);
+}
+
 /* Rounds (HP-1): solve on the current mesh warm-started from the last enriched solution,
  * estimate, refine. Ends with s holding the last round's solution and s->err_est. */
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
@@ -291,6 +315,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   double tol = s->adapt_tol, best = INFINITY, t0 = cv_now();
   cv_meshspec spec0 = s->mesh;
   int degree0 = s->degree;
+  char rescued[400] = ""; /* what the rescues of failed rounds did (HP-9) */
   if (!f) return CVAR_ENOMEM;
   st = start_mesh(s, p, &E, &t, &deg);
   if (st) {
@@ -313,14 +338,22 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     st = cv_solve_mesh(s, p);
     cv_solver_set_start(s, 0, NULL);
     iters += s->iterations;
-    if (st) {
-      char why[400];
+    if (st) { /* HP-9: from the guess, on this mesh and on finer uniform ones */
+      char why[400], add[400];
+      int E0 = E, nodes = s->disc.nodes;
       memcpy(why, s->msg, sizeof why);
       why[sizeof why - 1] = '\0';
-      cv_set_msg(s->msg, sizeof s->msg, "%s, round %d (%d elements, %d nodes): %s",
-                 s->hp ? "automatic accuracy" : "adaptive refinement", s->rounds, E, s->disc.nodes,
-                 why);
-      goto cleanup;
+      cv_rescue r = {&spec0, degree0, warm, t0, &iters};
+      st = cv_adapt_rescue(s, p, &r, st, &E, &t, &deg, add, sizeof add);
+      if (st == CVAR_OK) {
+        size_t ln = strlen(rescued);
+        cv_set_msg(rescued + ln, sizeof rescued - ln, "%s", add);
+      } else {
+        cv_set_msg(s->msg, sizeof s->msg, "%s, round %d (%d elements, %d nodes): %s%s",
+                   s->hp ? "automatic accuracy" : "adaptive refinement", s->rounds, E0, nodes, why,
+                   add);
+        goto cleanup;
+      }
     }
     cv_free(eta);
     cv_free(sigma);
@@ -407,7 +440,8 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       if (td > thresh) thresh = td;
     }
     if (stop_rule(s, est, best, floor_, stalled, halved_nodes,
-                  next_size(&s->disc, eta, sigma, thresh, tol, s->hp), cv_now() - t0)) {
+                  next_size(&s->disc, eta, sigma, thresh, tol, s->hp), cv_now() - t0,
+                  p->nnotes > 0)) {
       st = CVAR_EMAXITER;
       goto cleanup;
     }
@@ -425,6 +459,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     }
   }
 cleanup:
+  if (rescued[0]) prefix_msg(s, rescued);
   s->ends_passed[0] = s->ends_passed[1] = 0; /* the next plain solve checks its ends */
   s->iterations = (int)(iters > 2000000000L ? 2000000000L : iters); /* all rounds */
   cv_free(s->mesh.t);

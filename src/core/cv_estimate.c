@@ -383,6 +383,19 @@ static cv_status enriched_start(cv_solver *f, const cv_solver *s, int nodes_f) {
   return st;
 }
 
+/* HP-3: the enriched solution f is of the same kind as s when the number of directions of
+ * negative curvature agrees (the Morse index) or that of positive curvature does (the
+ * co-index, free directions minus Morse index), or s's is not known (an NLopt answer: then
+ * only the distance moved decides). The enriched mesh has more free directions,
+ * so a maximum (co-index 0) has a larger Morse index there than on s's mesh, and a path of
+ * small co-index likewise; a minimum or saddle of small index keeps its Morse index. */
+static int same_kind(const cv_solver *s, const cv_solver *f) {
+  if (f->morse == s->morse || s->morse < 0)
+    return 1; /* < 0: not known (NLopt): the distance decides */
+  int cs = cv_solver_get_num_free(s) - s->morse, cf = cv_solver_get_num_free(f) - f->morse;
+  return s->morse >= 0 && f->morse >= 0 && cs == cf;
+}
+
 /* (HP-2, HP-3) Solve on the enriched mesh of s's last solution, warm-started from it, into
  * f (configured like s, continuation off); est = max over s's nodes of |y_s - y_f|. With
  * eta and sigma (E entries each, may be NULL) the indicators of HP-4. CVAR_OK, or an error
@@ -440,12 +453,12 @@ cv_status cv_estimate_enriched(const cv_solver *s, const cv_problem *p, cv_solve
                f->msg);
     goto cleanup;
   }
-  if (f->morse != s->morse) {
+  if (!same_kind(s, f)) {
     st = CVAR_EDIVERGED;
     cv_set_msg(msg, len,
                "the enriched solve for the error estimate stopped on another stationary path "
-               "(Morse index %d, this one %d): no error bound",
-               f->morse, s->morse);
+               "(Morse index %d of %d free directions, this one %d of %d): no error bound",
+               f->morse, cv_solver_get_num_free(f), s->morse, cv_solver_get_num_free(s));
     goto cleanup;
   }
   yf = cv_malloc((size_t)NF * n * sizeof *yf);

@@ -58,7 +58,9 @@ static double piece_start(const cv_disc *d, double x0, double x1, int j, int m) 
   double a = d->xe[0], b = d->xe[d->E];
   if ((d->sing_a || d->sing_b) && x0 > a && x1 < b) {
     int at_a = d->sing_a && (!d->sing_b || x0 - a <= b - x1);
-    double d0 = at_a ? x0 - a : b - x1, d1 = at_a ? x1 - a : b - x0;
+    /* distances from the end of the piece starts, left to right: growing from a,
+     * shrinking towards b (from b - x0 at j = 0 to b - x1 at j = m) */
+    double d0 = at_a ? x0 - a : b - x0, d1 = at_a ? x1 - a : b - x1;
     double u = d0 * pow(d1 / d0, (double)j / m);
     return at_a ? a + u : b - u;
   }

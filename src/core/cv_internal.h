@@ -367,6 +367,20 @@ CV_HOT int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const 
 /* The paths found by cv_solve_all (cv_deflation.c); NULL is a no-op. */
 void cv_pathset_free(struct cv_pathset *ps);
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p);
+/* HP-9: what a failed round of cv_adapt_run knows: the caller's mesh and degree, whether
+ * the round was warm-started, when the rounds began, and their Newton iterations. */
+typedef struct {
+  const cv_meshspec *spec0;
+  int degree0, warm;
+  double t0;
+  long *iters;
+} cv_rescue;
+/* HP-9: after a round's solve failed with `first` on the mesh (E, t, deg): from the guess on
+ * that mesh (when it was warm-started), then on finer uniform meshes of the caller's kind.
+ * CVAR_OK with s solved and (E, t, deg) its mesh, note the sentence to prefix; else
+ * `first`, with note a sentence to append to the failure (may be empty). */
+cv_status cv_adapt_rescue(cv_solver *s, const cv_problem *p, const cv_rescue *r, cv_status first,
+                          int *E, double **t, int **deg, char *note, size_t len);
 /* ---- error estimate and hp decisions (cv_estimate.c, cv_hp.c) ---- */
 /* Start s (mesh set) from `from` interpolated at its nodes. */
 cv_status cv_warm_start(cv_solver *s, const cv_problem *p, const cv_solver *from);

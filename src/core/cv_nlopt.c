@@ -16,6 +16,8 @@
 #define MAX_DENSE_JACOBIAN 2.5e7
 /* Iterates beyond this multiple of the starting size mean the action is unbounded below. */
 #define RUNAWAY 1e8
+/* ... with the action below its start by this multiple of (|S0| + 1) (NL-3) */
+#define RUNAWAY_FALL 1e3
 
 typedef struct {
   cv_solver *s;
@@ -33,6 +35,7 @@ typedef struct {
   double *J;       /* scratch: the Jacobian of all m rows (m x nv), when both sets exist */
   double scale, action;
   double smin, ymax; /* smallest action and largest |y| seen (runaway diagnosis) */
+  double S0;         /* the action at the start (NAN before it is known) */
   long evals;
   cv_status stop; /* status stored before a forced stop */
   nlopt_opt opt;
@@ -93,28 +96,26 @@ static double objective(unsigned n, const double *x, double *grad, void *data) {
   (void)n;
   c->evals++;
   load(c, x);
-  int runaway = 0;
-  for (int v = 0; v < c->nv && !runaway; v++)
-    runaway = !(fabs(c->Y[c->yof[v]]) <= RUNAWAY * c->scale);
+  int far = 0;
+  for (int v = 0; v < c->nv && !far; v++) far = !(fabs(c->Y[c->yof[v]]) <= RUNAWAY * c->scale);
   memset(c->g, 0, (size_t)c->d->nfree * sizeof *c->g);
   cv_status st = cv_assemble(&c->kkt->as, c->kkt->prob->F, c->kkt->prob->user, c->Y, &S,
-                             grad ? c->g : NULL, c->kkt->colptr, NULL, 0.0, 0);
+                             grad && !far ? c->g : NULL, c->kkt->colptr, NULL, 0.0, 0);
   if (st == CVAR_ECALLBACK || st == CVAR_ENOMEM) {
     c->stop = st;
     nlopt_force_stop(c->opt);
     return 0.0;
   }
-  if (st) return HUGE_VAL; /* outside the integrand's domain: a rejected trial point */
-  /* A trial point far away is a sign of an action unbounded below when the action is
-   * lower there than anywhere before; otherwise (MMA's first trial steps with inequality
-   * constraints and no bounds on the variables: the length of a wild path) it is a
-   * rejected trial point. */
-  if (runaway && S < c->smin) {
+  /* A trial point beyond RUNAWAY x the data is evidence of an action unbounded below only
+   * if the action fell with it (NL-3): a truncated-Newton step along a direction where F
+   * is flat in y (a medium in layers: F_y = 0 between the interfaces) goes as far without
+   * any fall, and is a rejected trial point like one outside the integrand's domain. */
+  if (far && st == CVAR_OK && S < c->S0 - RUNAWAY_FALL * (fabs(c->S0) + 1.0)) {
     c->stop = CVAR_ENOTMIN;
     nlopt_force_stop(c->opt);
     return 0.0;
   }
-  if (runaway) return HUGE_VAL;
+  if (st || far) return HUGE_VAL; /* outside the integrand's domain: a rejected trial point */
   if (S < c->smin) c->smin = S;
   for (int v = 0; v < c->nv; v++) c->ymax = fmax(c->ymax, fabs(c->Y[c->yof[v]]));
   if (grad) {
@@ -290,7 +291,7 @@ static cv_status make_optimizer(nl_ctx *c, cv_solver *s, nlopt_opt *local, const
 static cv_status result_status(const nl_ctx *c, cv_solver *s, nlopt_result r, double S0,
                                int *roundoff) {
   cv_status st;
-  int runaway = c->ymax > 1e3 * c->scale && c->smin < S0 - 1e3 * (fabs(S0) + 1.0);
+  int runaway = c->ymax > 1e3 * c->scale && c->smin < S0 - RUNAWAY_FALL * (fabs(S0) + 1.0);
   if ((r == NLOPT_FORCED_STOP && c->stop == CVAR_ENOTMIN) || (r < 0 && runaway)) {
     st = CVAR_ENOTMIN;
     cv_set_msg(s->msg, sizeof s->msg,
@@ -415,7 +416,9 @@ cv_status cv_nlopt_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y)
   st = make_optimizer(&c, s, &local, tol);
   if (st) goto cleanup;
   double fmin = 0.0, S0 = 0.0;
+  c.S0 = NAN; /* the start is never taken for a runaway (NAN compares false) */
   S0 = objective((unsigned)c.nv, x, NULL, &c);
+  c.S0 = S0;
   if (!isfinite(S0)) {
     st = CVAR_ENONFINITE;
     cv_set_msg(s->msg, sizeof s->msg, "the integrand is not finite at the initial guess");

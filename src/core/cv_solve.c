@@ -368,12 +368,16 @@ done:
  * solution can have a discrete one (a conjugate point at the end: a huge multiple of the
  * nearly null direction). Its answer is kept only if the same retry on twice the elements
  * gives an action within 1e-2 of it (a real solution converges: the Poincare geodesic at
- * degree 1 moves by 2e-4; the artefact scales with the inverse of an O(h^2p) eigenvalue). */
+ * degree 1 moves by 2e-4; the artefact scales with the inverse of an O(h^2p) eigenvalue).
+ * When that solve from the guess fails, s's elements halved are solved from s's own path
+ * (HC-3a): a failed search is no refutation. Returns 1 (agrees), 0 (another action: *dev),
+ * or -1 (no path on twice the elements: not confirmed, and not refuted either). */
+static int halved_from_path(const cv_solver *s, const cv_problem *p, cv_solver *t, double *dev);
 static int twice_agrees(const cv_solver *s, const cv_problem *p, double *dev) {
   cv_solver *t = cv_solver_new(NULL);
-  int ok = 0;
+  int ok = -1;
   *dev = INFINITY;
-  if (!t) return 0;
+  if (!t) return -1;
   t->degree = s->degree, t->nq = s->nq, t->maxit = s->maxit;
   t->rtol = s->rtol, t->atol = s->atol, t->continuation = s->continuation;
   t->mesh.elements = 2 * s->mesh.elements;
@@ -383,9 +387,34 @@ static int twice_agrees(const cv_solver *s, const cv_problem *p, double *dev) {
     if (solve_once(t, p) == CVAR_OK) {
       *dev = fabs(t->action - s->action) / fmax(fabs(s->action), DBL_MIN);
       ok = *dev <= 1e-2;
+    } else {
+      ok = halved_from_path(s, p, t, dev);
     }
   }
   cv_solver_free(t);
+  return ok;
+}
+
+/* HC-3a: s's elements halved, both ends integrated as singular, Newton from s's path. */
+static int halved_from_path(const cv_solver *s, const cv_problem *p, cv_solver *t, double *dev) {
+  const cv_disc *d = &s->disc;
+  int E2 = 2 * d->E, ok = -1;
+  double *tt = cv_malloc((size_t)(E2 + 1) * sizeof *tt), a = d->xe[0], L = d->xe[d->E] - a;
+  if (!tt) return -1;
+  for (long e = 0; e < d->E; e++) {
+    tt[2 * e] = (d->xe[e] - a) / L;
+    tt[2 * e + 1] = (0.5 * (d->xe[e] + d->xe[e + 1]) - a) / L;
+  }
+  tt[0] = 0.0, tt[E2] = 1.0;
+  if (cv_solver_set_mesh(t, E2, tt) == CVAR_OK && cv_solver_set_degree(t, d->p) == CVAR_OK &&
+      cv_warm_start(t, p, s) == CVAR_OK) {
+    t->near_sing[0] = t->near_sing[1] = 1;
+    if (solve_once(t, p) == CVAR_OK) {
+      *dev = fabs(t->action - s->action) / fmax(fabs(s->action), DBL_MIN);
+      ok = *dev <= 1e-2;
+    }
+  }
+  cv_free(tt);
   return ok;
 }
 
@@ -400,17 +429,21 @@ static __attribute__((noinline, cold)) cv_status graded_retry(cv_solver *s, cons
   cv_status st2 = solve_once(s, p);
   s->near_sing[0] = s->near_sing[1] = 0;
   double dev = 0.0;
-  if (st2 == CVAR_OK && !twice_agrees(s, p, &dev)) {
+  int agrees = st2 == CVAR_OK ? twice_agrees(s, p, &dev) : 1;
+  if (agrees == 0) {
     st2 = CVAR_ESTALL;
-    if (isfinite(dev))
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "a stationary path of this mesh was found, but twice the elements moved its "
-                 "action by %.1e of itself: it is an artefact of the mesh, not a solution",
-                 dev);
-    else
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "a stationary path of this mesh was found, but none on twice the elements: "
-                 "it is an artefact of the mesh, not a solution");
+    cv_set_msg(s->msg, sizeof s->msg,
+               "a stationary path of this mesh was found, but twice the elements moved its "
+               "action by %.1e of itself: it is an artefact of the mesh, not a solution",
+               dev);
+  } else if (agrees < 0) { /* HC-3a: a confirmation that failed refutes nothing */
+    st2 = CVAR_ESTALL;
+    cv_set_msg(s->msg, sizeof s->msg,
+               "a stationary path of this mesh was found (action %.15g), but its confirmation "
+               "failed: on twice the elements Newton found no path, neither from the guess "
+               "nor from this one, so it is neither confirmed nor refuted; solve on a finer "
+               "or graded mesh (or with --tol) to settle it",
+               s->action);
   }
   if (st2 == CVAR_OK) {
     char keep[sizeof s->note];

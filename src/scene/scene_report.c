@@ -84,27 +84,32 @@ static int nodal_error(cli_report *r, const scene *s) {
 }
 
 /* min and max over the elements of the element average of v (quadrature weights w; the
- * nq points come element by element, nq / E per element). The discrete Euler-Lagrange
+ * nq points come element by element, in increasing x; element e holds those between its
+ * boundaries xb[e] and xb[e + 1], E + 1 of them: the number of points differs between
+ * elements of different degrees). The discrete Euler-Lagrange
  * equation of a cyclic unknown makes exactly these averages of its momentum equal
  * (discrete Noether, docs/theory.md), whereas inside an element the momentum varies by
  * O(h^p); energy averages drift at O(h^2p) on smooth problems (docs/cli.md). */
-static int elem_avg_range(const double *v, const double *w, int nq, int E, double *lo, double *hi) {
-  if (E <= 0 || nq % E != 0) return range(v, nq, lo, hi);
-  int q = nq / E;
+static int elem_avg_range(const double *v, const double *w, const double *x, int nq,
+                          const double *xb, const unsigned char *skip, int E, double *lo,
+                          double *hi) {
+  if (E <= 0) return range(v, nq, lo, hi);
   *lo = INFINITY;
   *hi = -INFINITY;
+  int k = 0;
   for (int e = 0; e < E; e++) {
     double sv = 0.0, sw = 0.0;
-    for (int k = e * q; k < (e + 1) * q; k++) {
+    for (; k < nq && (e == E - 1 || x[k] < xb[e + 1]); k++) {
       sv += w[k] * v[k];
       sw += w[k];
     }
+    if (!(sw > 0) || (skip && skip[e])) continue; /* no point in it, or not meaningful */
     double a = sv / sw;
     if (!isfinite(a)) return -1;
     *lo = a < *lo ? a : *lo;
     *hi = a > *hi ? a : *hi;
   }
-  return 0;
+  return isfinite(*lo) ? 0 : -1;
 }
 
 /* Whether any [constraints] or [integrals] expression depends on the slot. */
@@ -114,6 +119,54 @@ static int constraints_depend_on(const scene *s, int slot) {
   for (int k = 0; k < s->nints; k++)
     if (ex_depends_on(s->dag, s->ints[k].expr, slot)) return 1;
   return 0;
+}
+
+/* The element boundaries xb[0..E] of the report's mesh, from its nodes and degrees; 0 when
+ * they do not add up. */
+static int element_bounds(const cli_report *r, double *xb) {
+  long j = 0;
+  if (!r->degrees || r->elements <= 0) return 0;
+  for (int e = 0; e <= r->elements; e++) {
+    if (j >= r->nodes) return 0;
+    xb[e] = r->x[j];
+    if (e < r->elements) j += r->degrees[e];
+  }
+  return j == r->nodes - 1;
+}
+
+/* P-6a: the elements on which y' (so H and the momenta) is not known: where the estimated
+ * max nodal error est of the rounds exceeds MEANINGFUL times the change of y across the
+ * element (y' there is the change over the width, known only to est / change). Next to a
+ * singular end the rounds make elements of 1e-13 of the interval whose values change by
+ * less than 1e-8: their averages of H were off by O(1) (brachistochrone --tol 1e-10: H
+ * from -24.4 to -0.68). Sets skip[e], r->e_skipped and the extent of the skipped elements;
+ * none when there is no estimate, and never every element. */
+#define MEANINGFUL 1e-3
+static void unknown_slopes(cli_report *r, const cv_solver *sv, const double *xb,
+                           unsigned char *skip) {
+  double est = cv_solver_get_error_estimate(sv);
+  int n = r->n, E = r->elements, count = 0;
+  long j = 0;
+  r->e_skipped = 0;
+  if (!(est > 0) || !isfinite(est)) return;
+  for (int e = 0; e < E; e++) {
+    long j1 = j + r->degrees[e];
+    double change = 0.0;
+    for (int i = 0; i < n; i++)
+      change = fmax(change, fabs(r->y[(size_t)j1 * n + i] - r->y[(size_t)j * n + i]));
+    skip[e] = est > MEANINGFUL * change;
+    count += skip[e];
+    j = j1;
+  }
+  if (count == E) {
+    for (int e = 0; e < E; e++) skip[e] = 0;
+    return;
+  }
+  r->e_skipped = count;
+  r->e_skip_lo = INFINITY, r->e_skip_hi = -INFINITY;
+  for (int e = 0; e < E; e++)
+    if (skip[e])
+      r->e_skip_lo = fmin(r->e_skip_lo, xb[e]), r->e_skip_hi = fmax(r->e_skip_hi, xb[e + 1]);
 }
 
 /* Energy, momenta and report integrals at the quadrature points. Energy and momenta come
@@ -127,11 +180,14 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
   size_t nv = q * (size_t)(n > s->nreports ? n : s->nreports);
   double *v = cv_malloc((nv > q ? nv : q) * sizeof *v);
   double *H = cv_malloc(q * sizeof *H), *mom = cv_malloc(q * n * sizeof *mom);
-  if (!x || !w || !y || !dy || !v || !H || !mom) goto done;
-  if (cv_solver_get_qpoints(sv, x, w, y, dy) != CVAR_OK) {
+  double *xb = cv_malloc(((size_t)r->elements + 1) * sizeof *xb);
+  unsigned char *skip = cv_calloc((size_t)r->elements + 1, 1);
+  if (!x || !w || !y || !dy || !v || !H || !mom || !xb || !skip) goto done;
+  if (!element_bounds(r, xb) || cv_solver_get_qpoints(sv, x, w, y, dy) != CVAR_OK) {
     rc = 0; /* nothing to evaluate on: leave the keys out */
     goto done;
   }
+  unknown_slopes(r, sv, xb, skip);
   /* With constraints, H of F alone is conserved only when no constraint depends on the
    * variable and there is no integral constraint (whose multiplier enters the conserved
    * quantity); a momentum only when no constraint involves that unknown (docs/cli.md). */
@@ -140,11 +196,11 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
   /* A callback that fails here leaves energy and momenta out, as non-finite values do. */
   int have = st == CVAR_OK;
   if (have && !scene_F_depends_on_variable(s) && s->nints == 0 && !constraints_depend_on(s, 0))
-    r->has_energy = elem_avg_range(H, w, nq, r->elements, &r->emin, &r->emax) == 0;
+    r->has_energy = elem_avg_range(H, w, x, nq, xb, skip, r->elements, &r->emin, &r->emax) == 0;
   for (int i = 0; i < n && have; i++)
     if (!scene_F_depends_on_unknown(s, i) && !constraints_depend_on(s, 1 + i))
-      r->has_mom[i] = elem_avg_range(mom + (size_t)i * q, w, nq, r->elements, &r->mom_min[i],
-                                     &r->mom_max[i]) == 0;
+      r->has_mom[i] = elem_avg_range(mom + (size_t)i * q, w, x, nq, xb, skip, r->elements,
+                                     &r->mom_min[i], &r->mom_max[i]) == 0;
   if (s->nreports > 0 && scene_eval_reports(s, nq, x, y, dy, v) < 0) goto done;
   for (int k = 0; k < s->nreports; k++) {
     double sum = 0;
@@ -154,6 +210,8 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
   }
   rc = 0;
 done:
+  cv_free(xb);
+  cv_free(skip);
   cv_free(x);
   cv_free(w);
   cv_free(y);
@@ -190,6 +248,13 @@ static void compose_message(cli_report *r, cv_solver *sv) {
       used + 2 < sizeof r->message)
     snprintf(r->message + used, sizeof r->message - used, " %c%s.",
              detail[0] >= 'a' && detail[0] <= 'z' ? detail[0] - 'a' + 'A' : detail[0], detail + 1);
+  used = strlen(r->message);
+  if (r->e_skipped > 0 && used + 2 < sizeof r->message) /* P-6a */
+    snprintf(r->message + used, sizeof r->message - used,
+             " The energy and momenta leave out %d element%s in [%.3g, %.3g], where the "
+             "estimated nodal error is above %g of the change of the values across the "
+             "element, so that y' (and H) are not known there.",
+             r->e_skipped, r->e_skipped == 1 ? "" : "s", r->e_skip_lo, r->e_skip_hi, MEANINGFUL);
 }
 
 /* Fill r after cv_solve returned st. Returns 0, or -1 on allocation failure. */

@@ -42,6 +42,8 @@ typedef struct {
   double err_nodal, err_action, err_est;
   int has_energy;
   double emin, emax;
+  int e_skipped;               /* elements left out of energy and momenta (theory P-6a) */
+  double e_skip_lo, e_skip_hi; /* the extent of those elements */
   int *has_mom;
   double *mom_min, *mom_max;
   int *has_rep;
