@@ -424,13 +424,15 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
   if (!s) return CVAR_EINVAL;
   cv_pathset_free(s->paths);
   s->paths = NULL;
-  if (!p || max < 1 || s->method != CVAR_METHOD_NEWTON) {
+  if (!p || max < 1 || s->method != CVAR_METHOD_NEWTON || cv_ends_moving(p)) {
     s->status = CVAR_EINVAL;
     cv_set_msg(s->msg, sizeof s->msg, "%s",
-               !p        ? "problem is NULL"
-               : max < 1 ? "the number of paths to find must be at least 1"
-                         : "the search for every stationary path needs the Newton engine "
-                           "(the minimisers find minima only)");
+               !p                  ? "problem is NULL"
+               : max < 1           ? "the number of paths to find must be at least 1"
+               : cv_ends_moving(p) ? "the search for every stationary path does not move ends "
+                                     "yet: solve a moving end one start at a time"
+                                   : "the search for every stationary path needs the Newton "
+                                     "engine (the minimisers find minima only)");
     return CVAR_EINVAL;
   }
   double t0 = cv_now();

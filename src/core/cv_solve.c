@@ -485,6 +485,10 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
   return st;
 }
 
+cv_status cv_solve_interval(cv_solver *s, const cv_problem *p) {
+  return s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
+}
+
 /* The integrand's own explanation of a failure before the engine's (out of line). */
 static __attribute__((noinline, cold)) void prefix_failure_note(cv_solver *s, const char *note) {
   char m[2 * sizeof s->msg];
@@ -502,7 +506,8 @@ CV_HOT cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   s->rounds = 0;
   for (int k = 0; p && k < p->nnotes; k++) p->notes[k].fn(p->notes[k].user, 1);
   if (p && p->smooth) p->smooth(p->smooth_user, 0.0); /* the integrand as written (HC-4) */
-  cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
+  cv_ends_state_free(s); /* the moving ends of the last solve (cv_ends.c) */
+  cv_status st = cv_ends_moving(p) ? cv_ends_run(s, p) : cv_solve_interval(s, p);
   s->status = st;
   /* A failure the integrand can explain (a table's grid left): the cause first, then what
    * the engine saw. */
