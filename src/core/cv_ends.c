@@ -29,8 +29,8 @@ typedef struct {
   const cv_problem *p;
   struct cv_ends_state *st;
   int end, kind, k, n;
-  double L0;  /* the starting interval's length */
-  double *y;  /* the n values at the moving end (the curve's argument) */
+  double L0;          /* the starting interval's length */
+  double *y;          /* the n values at the moving end (the curve's argument) */
   double *P, *v, *ye; /* end data (n each) */
   /* the warm start of the next inner solve: the last converged mesh on [0, 1], its degrees
    * and nodal values */
@@ -235,8 +235,8 @@ static cv_status curve_start(ends_run *R, double *x) {
  * last two points, inside the bracket once phi' changed sign (else its midpoint), at most
  * 4 times the last step and half the interval, and shortening the interval by at most
  * half. */
-static double next_step(const double *hs, const double *hr, int nh, double lo, double hi,
-                        double L, double tx, int end) {
+static double next_step(const double *hs, const double *hr, int nh, double lo, double hi, double L,
+                        double tx, int end) {
   double s = hs[nh - 1], r = hr[nh - 1], ds;
   if (nh == 1) {
     ds = (r > 0 ? -0.1 : 0.1) * L;
@@ -284,7 +284,7 @@ static cv_status iterate(ends_run *R, double x, double yk) {
     if (st == CVAR_ENOMEM || st == CVAR_ECANCELLED || st == CVAR_ECALLBACK) return st;
     if (st != CVAR_OK) {
       if (!good) return st; /* the start's own failure: said as it is */
-      step *= 0.5; /* back towards the last good point */
+      step *= 0.5;          /* back towards the last good point */
       if (fabs(step) <= stol) return st;
       x = gx, yk = gy, sc = gs;
       if (R->k >= 0) R->y[R->k] = yk;
@@ -354,8 +354,9 @@ cv_status cv_ends_run(cv_solver *s, const cv_problem *p) {
   memset(&R, 0, sizeof R);
   R.s = s, R.p = p, R.n = p->n, R.k = -1;
   if (p->move[0].kind != CV_END_FIXED && p->move[1].kind != CV_END_FIXED) {
-    cv_set_msg(s->msg, sizeof s->msg, "both ends of the interval move; one moving end at a time "
-                                      "is supported");
+    cv_set_msg(s->msg, sizeof s->msg,
+               "both ends of the interval move; one moving end at a time "
+               "is supported");
     return s->status = CVAR_EINVAL;
   }
   if (p->nc > 0 || p->ni > 0) {

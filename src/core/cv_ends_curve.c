@@ -58,8 +58,8 @@ cv_status cv_ends_project(cv_end_curve_fn G, void *user, int n, int k, double *x
       break;
     }
     if (!(nn > 0.0)) {
-      cv_set_msg(msg, len, "the end curve has a zero gradient at (%.6g, %.6g), where G = %.3g",
-                 *x, k >= 0 ? y[k] : 0.0, g);
+      cv_set_msg(msg, len, "the end curve has a zero gradient at (%.6g, %.6g), where G = %.3g", *x,
+                 k >= 0 ? y[k] : 0.0, g);
       break;
     }
     double dx = -g * gx / nn, dy = -g * gk / nn; /* the minimum-norm Newton step */

@@ -131,7 +131,7 @@ cv_status cv_ends_end_data(const cv_solver *s, const cv_problem *q, int end, int
   if (mode == 0) {
     st = end_reaction(s, q, end, R, buf);
     for (int i = 0; i < n && !st; i++)
-      P[i] = !q->fixed[2 * i + end] ? 0.0 : end ? R[i] : -R[i]; /* free: natural */
+      P[i] = !q->fixed[2 * i + end] ? 0.0 : end ? R[i] : -R[i];       /* free: natural */
     if (!st && slope_from_momenta(q, x, y, P, v, buf) != 0) mode = 1; /* the element's y' */
   }
   double *F = buf, *Fy = F + 1, *Fp = Fy + n;

@@ -121,6 +121,7 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
       goto fail;
     }
   }
+  if (scene_problem_set_ends(s, p, err, errlen) < 0) goto fail;
   int any_guess = 0;
   for (int i = 0; i < s->n; i++) any_guess |= s->guess[i] >= 0;
   /* Without [guess] the core's default is the same as ours (SCENES.md). */

@@ -157,8 +157,8 @@ static void brachistochrone_to_line(int elements, int degree, double tol, double
   double err = max_nodal_error(s, cycloid_y);
   printf("brachistochrone to x + y = pi/2, E=%d p=%d tol=%g: %s; b - b* = %.2e, time error "
          "%.2e, nodal %.2e, Morse %d\n  %s\n",
-         elements, degree, tol, cv_strerror(st), b - (PI / 2 - 1), cv_solver_get_action(s) - T,
-         err, cv_solver_get_morse_index(s), cv_solver_last_error(s));
+         elements, degree, tol, cv_strerror(st), b - (PI / 2 - 1), cv_solver_get_action(s) - T, err,
+         cv_solver_get_morse_index(s), cv_solver_last_error(s));
   CHECK(st == CVAR_OK, "brachistochrone to a line: %s", cv_solver_last_error(s));
   CHECK_NEAR("brachistochrone to a line: end", b, PI / 2 - 1, bound);
   CHECK_NEAR("brachistochrone to a line: time", cv_solver_get_action(s), T, bound);
