@@ -273,7 +273,7 @@ static cv_status iterate(ends_run *R, double x, double yk) {
   cv_solver *s = R->s;
   double hs[MAX_HIST], hr[MAX_HIST], lo = NAN, hi = NAN, sc = 0.0, tx = 1.0, ty = 0.0;
   double gx = x, gy = yk, gs = 0.0, gtx = 1.0, gty = 0.0, step = 0.0, r = NAN, scale = 0.0;
-  double stol = fmax(s->rtol, 1e-13) * R->L0;
+  double stol = fmax(1e-2 * s->rtol, 1e-14) * R->L0;
   int nh = 0, good = 0;
   cv_status st = CVAR_OK;
   const cv_end_motion *m = &R->p->move[R->end];
@@ -304,7 +304,11 @@ static cv_status iterate(ends_run *R, double x, double yk) {
     double L = R->st->q.b - R->st->q.a;
     if (fabs(r) <= 8e-16 * scale) break; /* stationary to round-off */
     step = next_step(hs, hr, nh, lo, hi, L, tx, R->end);
-    if (fabs(step) <= stol && nh > 1) break;
+    /* done when the step is below the tolerance, or below what the residual's round-off
+     * (some 1e3 eps of its terms) can resolve at the secant's slope */
+    double slope = nh > 1 ? fabs((r - hr[nh - 2]) / (sc - hs[nh - 2])) : 0.0;
+    double noise = slope > 0 ? 1e3 * 2.2e-16 * scale / slope : 0.0;
+    if (nh > 1 && fabs(step) <= fmax(stol, noise)) break;
     if (L < 1e-8 * R->L0 || L > 1e8 * R->L0) {
       cv_set_msg(s->msg, sizeof s->msg,
                  "no stationary end point: the interval %s (length %.3g from %.3g) while the "
