@@ -171,8 +171,8 @@ int sc_load_ends(sc_loader *L) {
     const sc_entry *en = &L->raw.e[SEC_ENDS][i];
     int end = strcmp(en->key, "end") == 0;
     if (seen[end]) {
-      sc_err(L->err, L->errlen, L->file, en->line, "[ends] has a second '%s' line (first on line %d)",
-             en->key, seen[end]);
+      sc_err(L->err, L->errlen, L->file, en->line,
+             "[ends] has a second '%s' line (first on line %d)", en->key, seen[end]);
       return -1;
     }
     seen[end] = en->line;
