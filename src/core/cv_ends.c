@@ -19,6 +19,7 @@ struct cv_ends_state {
   cv_problem q;          /* its fixed-interval problem at the solved end (shares src's data) */
   int *fixed;            /* q's own end conditions */
   double *endval;
+  int end, k; /* the moving end; the unknown whose end value follows the curve (-1: none) */
 };
 
 enum { MAX_OUTER = 60, MAX_HIST = MAX_OUTER + 4 };
@@ -60,7 +61,15 @@ void cv_ends_state_free(cv_solver *s) {
 }
 
 const cv_problem *cv_ends_solved(const cv_solver *s, const cv_problem *p) {
-  return s && s->ends && s->ends->src == p ? &s->ends->q : p;
+  if (!s || !s->ends || s->ends->src != p) return p;
+  struct cv_ends_state *st = s->ends;
+  if (s->have) { /* the interval and end value of the path the solver holds (cv_solve_all) */
+    st->q.a = s->disc.a, st->q.b = s->disc.b;
+    if (st->k >= 0)
+      st->endval[2 * st->k + st->end] =
+          s->y[(size_t)(st->end ? s->disc.nodes - 1 : 0) * p->n + st->k];
+  }
+  return &st->q;
 }
 
 /* The fixed-interval problem: p's integrand, guess and end conditions, no moving end. */
@@ -390,6 +399,7 @@ cv_status cv_ends_run(cv_solver *s, const cv_problem *p) {
   }
   if (R.kind == CV_END_CURVE && (st = curve_start(&R, &x))) goto done;
   if (R.k >= 0) R.st->fixed[2 * R.k + R.end] = 1; /* the curve sets it (ME-3) */
+  R.st->end = R.end, R.st->k = R.k;
   if (R.kind == CV_END_CURVE && R.k < 0) {
     st = solve_at(&R, x, 0.0); /* the curve fixes the end's position alone */
   } else {

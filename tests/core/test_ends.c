@@ -188,8 +188,54 @@ static void collapse(void) {
   cv_problem_free(p);
 }
 
+/* Internal (src/core/cv_ends_data.c, in the core library this test links): the end data
+ * the transversality condition uses (ME-2). */
+cv_status cv_ends_end_data(const cv_solver *s, const cv_problem *q, int end, int mode, double *H,
+                           double *P, double *y, double *v);
+
+/* Which end data are accurate (ME-2): on the fixed interval [0, 3/2] with y(0) = 0,
+ * y(3/2) = 1 the timed trajectory is y = sinh t / sinh(3/2), with H = 1/(2 sinh^2(3/2)) - 1/2
+ * everywhere. The reaction of the fixed end value gives H to O(h^2p), like the action; the
+ * end element's y' only to O(h^p). Measured (E = 8, 16): p = 1 reaction 1.3e-3, 3.1e-4
+ * (order 2.0), element 9.2e-2, 4.9e-2 (order 0.9); p = 2 reaction 1.4e-6, 8.5e-8 (order 4.0),
+ * element 3.3e-3, 8.6e-4 (order 1.9). */
+static void end_data_orders(void) {
+  double T = 1.5, Hx = 1 / (2 * sinh(T) * sinh(T)) - 0.5;
+  cv_problem *p = cv_problem_new(1, 0, T, NULL);
+  cv_problem_set_integrand(p, timed_F, NULL);
+  cv_problem_set_dirichlet(p, 0, 0.0, 1.0);
+  for (int deg = 1; deg <= 2; deg++) {
+    double prev[2] = {NAN, NAN};
+    for (int E = 4; E <= 16; E *= 2) {
+      cv_solver *s = cv_solver_new(NULL);
+      cv_solver_set_elements(s, E);
+      cv_solver_set_degree(s, deg);
+      CHECK(cv_solve(s, p) == CVAR_OK, "fixed interval: %s", cv_solver_last_error(s));
+      double err[2];
+      for (int mode = 0; mode < 2; mode++) {
+        double H = NAN, P, y, v;
+        CHECK(cv_ends_end_data(s, p, 1, mode, &H, &P, &y, &v) == CVAR_OK, "end data");
+        err[mode] = fabs(H - Hx);
+        if (E > 4) {
+          double order = log2(prev[mode] / err[mode]), want = mode == 0 ? 2 * deg : deg;
+          printf("  p=%d E=%2d %s: H error %.2e, order %.2f\n", deg, E,
+                 mode ? "end element" : "reaction   ", err[mode], order);
+          CHECK(order >= want - 0.3, "p=%d E=%d %s: order %.2f < %g", deg, E,
+                mode ? "end element" : "reaction", order, want);
+        }
+        prev[mode] = err[mode];
+      }
+      CHECK(err[0] < err[1], "p=%d E=%d: the reaction (%.2e) is not the more accurate (%.2e)", deg,
+            E, err[0], err[1]);
+      cv_solver_free(s);
+    }
+  }
+  cv_problem_free(p);
+}
+
 int main(void) {
   setvbuf(stdout, NULL, _IONBF, 0);
+  end_data_orders();
   point_to_circle(20, 4, 0, 1e-10);
   point_to_circle(4, 4, 1e-10, 1e-9);
   free_final_time(20, 4, 0, 1e-10);
