@@ -44,6 +44,7 @@ typedef struct {
   int start_len0;
   long iters;
   int solves;
+  double otx, oty; /* the last tangent, so that its orientation stays continuous */
 } ends_run;
 
 int cv_ends_moving(const cv_problem *p) {
@@ -165,8 +166,8 @@ static cv_status solve_at(ends_run *R, double x, double yk) {
  * the first variation of the action under a move (dx, dy_k) of the end point is
  * -H dx + P_k dy_k at b and H dx - P_k dy_k at a. *scale: the size of its terms. */
 static cv_status outer_residual(ends_run *R, double tx, double ty, double *r, double *scale) {
-  double H;
-  cv_status st = cv_ends_end_data(R->s, &R->st->q, R->end, 0, &H, R->P, R->ye, R->v);
+  double H, size;
+  cv_status st = cv_ends_end_data(R->s, &R->st->q, R->end, 0, &H, R->P, R->ye, R->v, &size);
   if (st) {
     cv_set_msg(R->s->msg, sizeof R->s->msg,
                "the integrand cannot be evaluated at the moving end of the solution (%s)",
@@ -175,8 +176,18 @@ static cv_status outer_residual(ends_run *R, double tx, double ty, double *r, do
   }
   double sg = R->end ? -1.0 : 1.0, pk = R->k >= 0 ? R->P[R->k] : 0.0;
   *r = sg * (tx * H - ty * pk);
-  *scale = fabs(H) + fabs(pk);
+  *scale = size + fabs(pk);
   return CVAR_OK;
+}
+
+/* The unit tangent of the motion at (x, R->y), oriented as the last one (a closed curve is
+ * followed round, not back and forth at its vertical tangents). 0, or -1 without one. */
+static int tangent(ends_run *R, double x, double *tx, double *ty) {
+  const cv_end_motion *m = &R->p->move[R->end];
+  if (cv_ends_tangent(m->G, m->user, R->n, R->k, x, R->y, tx, ty) != 0) return -1;
+  if (*tx * R->otx + *ty * R->oty < 0) *tx = -*tx, *ty = -*ty;
+  R->otx = *tx, R->oty = *ty;
+  return 0;
 }
 
 /* The point a step ds along the motion from (x, yk): on the curve, the tangent step then
@@ -285,7 +296,6 @@ static cv_status iterate(ends_run *R, double x, double yk) {
   double stol = fmax(1e-2 * s->rtol, 1e-14) * R->L0;
   int nh = 0, good = 0;
   cv_status st = CVAR_OK;
-  const cv_end_motion *m = &R->p->move[R->end];
   if (s->adapt_tol > 0) stol = fmin(stol, 1e-2 * s->adapt_tol);
   for (int it = 0; it < MAX_OUTER; it++) {
     if (R->k >= 0) R->y[R->k] = yk;
@@ -301,7 +311,7 @@ static cv_status iterate(ends_run *R, double x, double yk) {
       sc += step;
       continue;
     }
-    if (cv_ends_tangent(m->G, m->user, R->n, R->k, x, R->y, &tx, &ty) != 0) {
+    if (tangent(R, x, &tx, &ty) != 0) {
       cv_set_msg(s->msg, sizeof s->msg, "the end curve has no tangent at (%.6g, %.6g)", x, yk);
       return CVAR_ESINGULAR;
     }
@@ -317,7 +327,15 @@ static cv_status iterate(ends_run *R, double x, double yk) {
      * (some 1e3 eps of its terms) can resolve at the secant's slope */
     double slope = nh > 1 ? fabs((r - hr[nh - 2]) / (sc - hs[nh - 2])) : 0.0;
     double noise = slope > 0 ? 1e3 * 2.2e-16 * scale / slope : 0.0;
-    if (nh > 1 && fabs(step) <= fmax(stol, noise)) break;
+    if (nh > 1 && fabs(step) <= fmax(stol, noise)) {
+      if (fabs(r) <= 1e-6 * scale) break;
+      /* the end stopped moving where the residual does not vanish: a jump of phi' */
+      cv_set_msg(s->msg, sizeof s->msg,
+                 "no stationary end point found: the end stopped moving at x = %.10g, where "
+                 "the transversality residual is still %.3g (of terms of size %.3g)",
+                 x, r, scale);
+      return CVAR_ESTALL;
+    }
     if (L < 1e-8 * R->L0 || L > 1e8 * R->L0) {
       cv_set_msg(s->msg, sizeof s->msg,
                  "no stationary end point: the interval %s (length %.3g from %.3g) while the "
@@ -361,7 +379,28 @@ static cv_status iterate(ends_run *R, double x, double yk) {
   return CVAR_OK;
 }
 
-cv_status cv_ends_run(cv_solver *s, const cv_problem *p) {
+/* The start point moved `shift` along the motion, in steps of at most a tenth of the
+ * interval so that a curve is followed (cv_solve_all's starts). */
+static cv_status shift_start(ends_run *R, double *x, double shift) {
+  double yk = R->k >= 0 ? R->y[R->k] : 0.0, left = shift, tx = 1.0, ty = 0.0;
+  while (fabs(left) > 1e-12 * R->L0) {
+    double ds = fabs(left) > 0.1 * R->L0 ? copysign(0.1 * R->L0, left) : left;
+    left -= ds;
+    if (tangent(R, *x, &tx, &ty) != 0) return CVAR_EINVAL;
+    cv_status st = move_along(R, x, &yk, tx, ty, &ds);
+    if (st) return st;
+    if (R->k >= 0) R->y[R->k] = yk;
+  }
+  double other = R->end ? R->p->a : R->p->b;
+  if (!(fabs(*x - other) > 0.05 * R->L0) || (R->end ? *x < other : *x > other)) {
+    cv_set_msg(R->s->msg, sizeof R->s->msg,
+               "a start moved %.3g along the end's motion leaves no interval", shift);
+    return CVAR_EINVAL;
+  }
+  return CVAR_OK;
+}
+
+cv_status cv_ends_run(cv_solver *s, const cv_problem *p, double shift) {
   cv_status st = CVAR_OK;
   ends_run R;
   memset(&R, 0, sizeof R);
@@ -400,6 +439,7 @@ cv_status cv_ends_run(cv_solver *s, const cv_problem *p) {
   if (R.kind == CV_END_CURVE && (st = curve_start(&R, &x))) goto done;
   if (R.k >= 0) R.st->fixed[2 * R.k + R.end] = 1; /* the curve sets it (ME-3) */
   R.st->end = R.end, R.st->k = R.k;
+  if (shift != 0.0 && (st = shift_start(&R, &x, shift))) goto done;
   if (R.kind == CV_END_CURVE && R.k < 0) {
     st = solve_at(&R, x, 0.0); /* the curve fixes the end's position alone */
   } else {

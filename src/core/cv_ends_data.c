@@ -109,7 +109,7 @@ static int slope_from_momenta(const cv_problem *q, double x, const double *y, co
 }
 
 cv_status cv_ends_end_data(const cv_solver *s, const cv_problem *q, int end, int mode, double *H,
-                           double *P, double *y, double *v) {
+                           double *P, double *y, double *v, double *size) {
   const cv_disc *d = &s->disc;
   int n = q->n;
   long e = end ? d->E - 1 : 0, node = end ? d->nodes - 1 : 0;
@@ -138,12 +138,14 @@ cv_status cv_ends_end_data(const cv_solver *s, const cv_problem *q, int end, int
   cv_partials o = {F, Fy, Fp, NULL, NULL, NULL};
   if (!st && eval_point(q, x, y, v, CVAR_NEED_F | CVAR_NEED_GRAD, &o) != 0) st = CVAR_ENONFINITE;
   if (!st) {
-    double sum = -F[0];
+    double sum = -F[0], mag = fabs(F[0]);
     for (int i = 0; i < n; i++) {
       if (mode == 1) P[i] = Fp[i];
       sum += v[i] * P[i];
+      mag += fabs(v[i] * P[i]);
     }
     *H = sum;
+    *size = mag;
     if (!isfinite(sum)) st = CVAR_ENONFINITE;
   }
   cv_free(buf);

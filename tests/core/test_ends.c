@@ -191,7 +191,7 @@ static void collapse(void) {
 /* Internal (src/core/cv_ends_data.c, in the core library this test links): the end data
  * the transversality condition uses (ME-2). */
 cv_status cv_ends_end_data(const cv_solver *s, const cv_problem *q, int end, int mode, double *H,
-                           double *P, double *y, double *v);
+                           double *P, double *y, double *v, double *size);
 
 /* Which end data are accurate (ME-2): on the fixed interval [0, 3/2] with y(0) = 0,
  * y(3/2) = 1 the timed trajectory is y = sinh t / sinh(3/2), with H = 1/(2 sinh^2(3/2)) - 1/2
@@ -213,8 +213,8 @@ static void end_data_orders(void) {
       CHECK(cv_solve(s, p) == CVAR_OK, "fixed interval: %s", cv_solver_last_error(s));
       double err[2];
       for (int mode = 0; mode < 2; mode++) {
-        double H = NAN, P, y, v;
-        CHECK(cv_ends_end_data(s, p, 1, mode, &H, &P, &y, &v) == CVAR_OK, "end data");
+        double H = NAN, P, y, v, size;
+        CHECK(cv_ends_end_data(s, p, 1, mode, &H, &P, &y, &v, &size) == CVAR_OK, "end data");
         err[mode] = fabs(H - Hx);
         if (E > 4) {
           double order = log2(prev[mode] / err[mode]), want = mode == 0 ? 2 * deg : deg;

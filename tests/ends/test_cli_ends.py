@@ -135,6 +135,26 @@ common("brachistochrone_wall --tol 1e-10", j, rows, [(0, 0), (math.pi, 1e-15)],
 if rows[1:]:
     near("brachistochrone_wall end value", float(rows[-1][1]), 2.0, 1e-9)
 
+# --all: the near and the far side of the circle, the far one a saddle (the length has a
+# maximum along the circle there: Morse index 1 = inner 0 + 1, ME-4, ME-5).
+for flags in [(), ("--tol", "1e-8")]:
+    j, rows = solve("point_to_circle.scene", "--all", *flags)
+    what = "point_to_circle --all " + " ".join(flags)
+    sols = j.get("solutions", [])
+    check(what + " two paths", len(sols) == 2, 2, len(sols))
+    far = 3 * (1 + 1 / math.sqrt(13))
+    for k, (b, act, morse, kind) in enumerate([(b_circle, length, 0, "minimum"),
+                                                (far, math.sqrt(13) + 1, 1, "saddle")]):
+        s = sols[k] if k < len(sols) else {}
+        near(what + " path %d end" % (k + 1), s.get("interval", [0, None])[1], b, 1e-10)
+        near(what + " path %d length" % (k + 1), s.get("action"), act, 1e-10)
+        check(what + " path %d morse_index" % (k + 1), s.get("morse_index") == morse, morse,
+              s.get("morse_index"))
+        check(what + " path %d kind" % (k + 1), s.get("stationary_kind") == kind, kind,
+              s.get("stationary_kind"))
+        check(what + " path %d max_nodal" % (k + 1),
+              s.get("error", {}).get("max_nodal", 1) <= 1e-10, 1e-10, s.get("error"))
+
 # No stationary end point: exit 1 and a sentence, never a converged report.
 j, rows = solve("collapse.scene", expect_rc=1)
 check("collapse status", j.get("status") not in (None, "converged"), "not converged",
