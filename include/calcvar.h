@@ -193,6 +193,36 @@ CVAR_API cv_status cv_problem_set_end_value(cv_problem *p, int k, int end, doubl
 /** Leave unknown k free at one end (0 = a, 1 = b): the natural boundary condition
  * dF/dy'_k = 0 holds there at the solution. */
 CVAR_API cv_status cv_problem_set_free_end(cv_problem *p, int k, int end);
+/** \name Moving ends (docs/moving-ends.md; theory ME-1 .. ME-4)
+ * An end of the interval may itself be unknown: free, or constrained to a curve
+ * G(x, y) = 0. The solve then also finds where that end lies, from the transversality
+ * condition, which calcvar derives and imposes itself: the interval given to
+ * cv_problem_new is where the search starts, and cv_solver_get_interval gives the solved
+ * one. At most one end may move; the problem may have no pointwise or integral constraints
+ * (cv_solve returns CVAR_EINVAL with a sentence otherwise). */
+/**@{*/
+/** An end curve at one point: *G = G(x, y), *Gx = dG/dx and Gy[i] = dG/dy_i (n values).
+ * Return 0 on success, nonzero when G cannot be evaluated there. */
+typedef int (*cv_end_curve_fn)(double x, const double *y, double *G, double *Gx, double *Gy,
+                               void *user);
+/** Make end `end` of the interval (0 = a, 1 = b) free: its position is found with the path,
+ * from the condition F - sum_i y'_i dF/dy'_i = 0 there (ME-1); the end values stay as set
+ * (fixed, or free with their natural condition). */
+CVAR_API cv_status cv_problem_set_end_free(cv_problem *p, int end);
+/** Make end `end` (0 = a, 1 = b) move along the curve G(x, y) = 0: the end point lies on it
+ * and the transversality condition along the curve holds there (ME-3). The values the
+ * problem leaves free at that end may move with it; G may depend on at most one of them (at
+ * the start point; CVAR_EINVAL from cv_solve otherwise). */
+CVAR_API cv_status cv_problem_set_end_curve(cv_problem *p, int end, cv_end_curve_fn G, void *user);
+/** cv_problem_set_end_curve whose `user` the problem owns and releases as in
+ * cv_problem_set_integrand_owned (also on failure). */
+CVAR_API cv_status cv_problem_set_end_curve_owned(cv_problem *p, int end, cv_end_curve_fn G,
+                                                  void *user, cv_release_fn release);
+/** Fix end `end` again (the default): the interval's end is where cv_problem_new put it. */
+CVAR_API cv_status cv_problem_set_end_fixed(cv_problem *p, int end);
+/** What end `end` does: 0 fixed, 1 free, 2 on a curve; -1 for bad arguments. */
+CVAR_API int cv_problem_get_end_kind(const cv_problem *p, int end);
+/**@}*/
 /** Initial guess (default: the straight line between the end values; with a free end,
  * the constant fixed value; with both ends free, 0). NULL restores the default. */
 CVAR_API cv_status cv_problem_set_guess(cv_problem *p, cv_guess_fn g, void *user);
@@ -486,6 +516,9 @@ CVAR_API int cv_solver_get_degree(const cv_solver *s);
 /** Number of elements of the last solve; with degrees != NULL also writes the degree of
  * each element (0 before any solve). */
 CVAR_API int cv_solver_get_degrees(const cv_solver *s, int *degrees);
+/** The interval [a, b] of the last solve: the solved one when an end moved (a or b may be
+ * NULL). CVAR_ESTATE before any solve. */
+CVAR_API cv_status cv_solver_get_interval(const cv_solver *s, double *a, double *b);
 /** x[j] of node j, length cv_solver_get_num_nodes(). */
 CVAR_API cv_status cv_solver_get_nodes(const cv_solver *s, double *x);
 /** Nodal values, node-major: y[j*n + i] is unknown i at node j; length nodes*n. */

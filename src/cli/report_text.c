@@ -19,6 +19,8 @@ void cli_report_text(FILE *f, const cli_report *r) {
   else if (r->nodes > 0)
     fprintf(f, "  mesh        %d elements of degree %d, %d nodes\n", r->elements, r->degree,
             r->nodes);
+  if (r->has_interval) /* a moving end: the solved interval */
+    fprintf(f, "  interval    [%.15g, %.15g] (an end moved)\n", r->interval[0], r->interval[1]);
   if (r->has_action) fprintf(f, "  action      %.15g\n", r->action);
   if (r->has_gradient_norm) {
     fprintf(f, "  residual    %.3g (max-norm of the scaled Euler-Lagrange residual)\n",

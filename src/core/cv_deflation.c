@@ -420,6 +420,88 @@ static int keep_path(cv_solver *s, struct cv_pathset *ps, defl *w, double *xs, d
   return 1;
 }
 
+/* The end point (x and the n end values) of the solver's current path at its moving end. */
+static void end_point(const cv_solver *s, int end, double *pt) {
+  const cv_disc *d = &s->disc;
+  long node = end ? d->nodes - 1 : 0;
+  pt[0] = end ? d->b : d->a;
+  for (int i = 0; i < d->n; i++) pt[1 + i] = s->y[node * d->n + i];
+}
+
+/* Every stationary path of a problem with a moving end (theory ME-5): the moving-end solve
+ * from the start's end point and from points moved +-1/2, +-1, ... +-2 intervals along the
+ * end's motion (the free end or the curve); paths are one when their end points agree to
+ * 1e-6 of the interval (the fixed-interval path through an end point is found from there). */
+static cv_status all_moving_ends(cv_solver *s, const cv_problem *p, int max) {
+  static const double shifts[] = {0.0, 0.5, -0.5, 1.0, -1.0, 1.5, -1.5, 2.0, -2.0};
+  int nshift = (int)(sizeof shifts / sizeof shifts[0]), n = p->n;
+  int end = p->move[1].kind != CV_END_FIXED;
+  double t0 = cv_now(), L0 = p->b - p->a;
+  struct cv_pathset *ps = cv_calloc(1, sizeof *ps);
+  cv_path *v = cv_calloc((size_t)max, sizeof *v);
+  double *pts = cv_malloc((size_t)max * (n + 1) * sizeof *pts);
+  double *pt = cv_malloc(((size_t)n + 1) * sizeof *pt);
+  cv_status st = CVAR_OK, first = CVAR_OK;
+  char msg0[sizeof s->msg] = "";
+  if (!ps || !v || !pts || !pt) {
+    cv_free(ps), cv_free(v), cv_free(pts), cv_free(pt);
+    cv_set_msg(s->msg, sizeof s->msg, "out of memory for the list of paths");
+    return s->status = CVAR_ENOMEM;
+  }
+  ps->v = v;
+  cv_search_info *info = &ps->info;
+  for (int k = 0; k < nshift && ps->n < max; k++) {
+    info->starts++;
+    st = cv_solve_at(s, p, shifts[k] * L0);
+    if (k == 0) first = st, memcpy(msg0, s->msg, sizeof msg0);
+    if (st == CVAR_ENOMEM || st == CVAR_ECANCELLED || st == CVAR_ECALLBACK) break;
+    if (st != CVAR_OK) {
+      info->failed++;
+      continue;
+    }
+    end_point(s, end, pt);
+    int same = 0;
+    for (int j = 0; j < ps->n && !same; j++) {
+      double dist = 0.0;
+      for (int i = 0; i <= n; i++) dist = fmax(dist, fabs(pt[i] - pts[(size_t)j * (n + 1) + i]));
+      same = dist <= 1e-6 * L0;
+    }
+    if (same) {
+      info->duplicates++;
+      continue;
+    }
+    memcpy(pts + (size_t)ps->n * (n + 1), pt, ((size_t)n + 1) * sizeof *pt);
+    path_take(&ps->v[ps->n++], s);
+  }
+  if (st == CVAR_ENOMEM || st == CVAR_ECANCELLED || st == CVAR_ECALLBACK)
+    cv_set_msg(info->stop, sizeof info->stop, "the search stopped: %s", s->msg);
+  else if (ps->n >= max)
+    cv_set_msg(info->stop, sizeof info->stop, "found the %d path%s asked for", max,
+               max == 1 ? "" : "s");
+  else
+    cv_set_msg(info->stop, sizeof info->stop,
+               "every start was tried (the start's end point and %d points along the end's "
+               "motion)",
+               nshift - 1);
+  info->found = ps->n;
+  if (ps->n > 0) {
+    qsort(ps->v, (size_t)ps->n, sizeof *ps->v, by_action);
+    ps->sel = 0;
+    path_give(s, &ps->v[0]);
+    s->ends_dim = 1;
+    st = CVAR_OK;
+  } else if (st == CVAR_OK || st == first) {
+    st = first == CVAR_OK ? CVAR_EMAXITER : first;
+    memcpy(s->msg, msg0, sizeof s->msg);
+  }
+  cv_free(pts);
+  cv_free(pt);
+  s->paths = ps;
+  s->status = st;
+  s->time = cv_now() - t0;
+  return st;
+}
+
 cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
   if (!s) return CVAR_EINVAL;
   cv_pathset_free(s->paths);
@@ -433,6 +515,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
                            "(the minimisers find minima only)");
     return CVAR_EINVAL;
   }
+  if (cv_ends_moving(p)) return all_moving_ends(s, p, max);
   double t0 = cv_now();
   struct cv_pathset *ps = cv_calloc(1, sizeof *ps);
   cv_path *v = cv_calloc((size_t)max, sizeof *v);

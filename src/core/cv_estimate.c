@@ -526,6 +526,7 @@ cleanup:
 cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p, double *est,
                                    double *est_vertex, char *msg, size_t len) {
   if (!s || !p || !est) return CVAR_EINVAL;
+  p = cv_ends_solved(s, p); /* a moving end: the interval solved last (ME-1) */
   *est = NAN;
   if (est_vertex) *est_vertex = NAN;
   if (!s->have || s->status != CVAR_OK) {

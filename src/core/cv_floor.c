@@ -57,6 +57,7 @@ static cv_status term_sums(const cv_problem *p, const cv_disc *d, const double *
 cv_status cv_solver_residual_floor(const cv_solver *s, const cv_problem *p, double *floor) {
   if (floor) *floor = NAN;
   if (!s || !p || !floor) return CVAR_EINVAL;
+  p = cv_ends_solved(s, p); /* a moving end: the interval solved last (ME-1) */
   if (!s->have || !s->y || !(s->gfloor >= 0.0) || p->n != s->disc.n) return CVAR_ESTATE;
   const cv_disc *d = &s->disc;
   double *acc = cv_calloc((size_t)(d->nfree > 0 ? d->nfree : 1), sizeof *acc);

@@ -34,9 +34,19 @@ typedef struct {
   double c;
 } cv_iconstraint;
 
+/* A moving end of the interval (cv_problem_ends.c, cv_ends.c; theory ME-1 .. ME-4). */
+enum { CV_END_FIXED = 0, CV_END_FREE = 1, CV_END_CURVE = 2 };
+typedef struct {
+  int kind;          /* CV_END_* */
+  cv_end_curve_fn G; /* CV_END_CURVE: the curve G(x, y) = 0 */
+  void *user;
+  cv_release_fn release;
+} cv_end_motion;
+
 struct cv_problem {
   int n;
-  int nc, ni; /* pointwise and integral constraints */
+  cv_end_motion move[2]; /* what each end of the interval does (0 = a, 1 = b) */
+  int nc, ni;            /* pointwise and integral constraints */
   cv_pconstraint *pc;
   cv_iconstraint *ic;
   double a, b;
@@ -347,8 +357,36 @@ struct cv_solver {
    * reused by the next ones on it (retries, continuation steps); dropped with the mesh. */
   struct cv_ldlt *ldlt;
   int *gof;
+  /* A moving end (cv_ends.c): the fixed-interval problem of the last solve, for the calls
+   * that take the problem after it (error estimate, residual floor), and the outer
+   * dimension the Morse index and the free count include (0: no end moved). */
+  struct cv_ends_state *ends;
+  int ends_dim;
 };
 CV_HOT cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
+/* One solve of p on its fixed interval: adaptive (--adapt, --tol) or on the mesh set. */
+cv_status cv_solve_interval(cv_solver *s, const cv_problem *p);
+/* Moving ends (cv_ends.c): does p move an end; the solve that finds the ends (ME-1..ME-4)
+ * from the start's end point moved `shift` along the end's motion;
+ * the problem of the last solve of s when it moved the ends of p (else p); release the
+ * state. cv_problem_ends_release (cv_problem_ends.c) releases the curves' user data. */
+int cv_ends_moving(const cv_problem *p);
+cv_status cv_ends_run(cv_solver *s, const cv_problem *p, double shift);
+/* cv_solve with a moving end's start point moved `shift` along its motion (cv_solve_all's
+ * starts, cv_deflation.c); shift = 0 is cv_solve. */
+cv_status cv_solve_at(cv_solver *s, const cv_problem *p, double shift);
+const cv_problem *cv_ends_solved(const cv_solver *s, const cv_problem *p);
+void cv_ends_state_free(cv_solver *s);
+void cv_problem_ends_release(cv_problem *p);
+/* At end `end` (0 = a, 1 = b) of the last solve of s on the fixed-interval problem q
+ * (cv_ends_data.c, theory ME-2): the end values y, the slopes v = y', the momenta P and the
+ * energy *H = sum_i v_i P_i - F (n values each), and *size = |F| + sum_i |v_i P_i|. mode 0: the momentum of a value q fixes
+ * there is its reaction (the derivative of the discrete action with respect to it), of a
+ * free one 0, and v solves F_y'(x, y, v) = P; mode 1: v of the end element, P = F_y'. */
+cv_status cv_ends_end_data(const cv_solver *s, const cv_problem *q, int end, int mode, double *H,
+                           double *P, double *y, double *v, double *size);
+/* The default start at fraction t of the interval (cv_start.c): y[0 .. n-1]. */
+void cv_start_line(const cv_problem *p, double t, double *y);
 /* Release the solver's factor of its mesh (before the mesh changes). */
 void cv_solver_drop_factor(cv_solver *s);
 /* Release the last solve's mesh, nodal values and multipliers (not the factor). */

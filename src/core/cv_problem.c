@@ -51,6 +51,7 @@ static void release_integrand(cv_problem *p) {
 void cv_problem_free(cv_problem *p) {
   if (!p) return;
   release_integrand(p);
+  cv_problem_ends_release(p);
   for (int k = 0; k < p->nc; k++)
     if (p->pc[k].release) p->pc[k].release(p->pc[k].user);
   for (int k = 0; k < p->ni; k++)

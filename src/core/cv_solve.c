@@ -518,6 +518,10 @@ cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p) {
   return st;
 }
 
+cv_status cv_solve_interval(cv_solver *s, const cv_problem *p) {
+  return s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
+}
+
 /* The integrand's own explanation of a failure before the engine's (out of line). */
 static __attribute__((noinline, cold)) void prefix_failure_note(cv_solver *s, const char *note) {
   char m[2 * sizeof s->msg];
@@ -526,7 +530,9 @@ static __attribute__((noinline, cold)) void prefix_failure_note(cv_solver *s, co
   s->msg[sizeof s->msg - 1] = '\0';
 }
 
-CV_HOT cv_status cv_solve(cv_solver *s, const cv_problem *p) {
+CV_HOT cv_status cv_solve(cv_solver *s, const cv_problem *p) { return cv_solve_at(s, p, 0.0); }
+
+cv_status cv_solve_at(cv_solver *s, const cv_problem *p, double shift) {
   if (!s) return CVAR_EINVAL;
   double t0 = cv_now();
   cv_pathset_free(s->paths); /* a plain solve forgets the paths of cv_solve_all */
@@ -535,7 +541,8 @@ CV_HOT cv_status cv_solve(cv_solver *s, const cv_problem *p) {
   s->rounds = 0;
   for (int k = 0; p && k < p->nnotes; k++) p->notes[k].fn(p->notes[k].user, 1);
   if (p && p->smooth) p->smooth(p->smooth_user, 0.0); /* the integrand as written (HC-4) */
-  cv_status st = s->adapt_tol > 0 && p ? cv_adapt_run(s, p) : cv_solve_mesh(s, p);
+  cv_ends_state_free(s); /* the moving ends of the last solve (cv_ends.c) */
+  cv_status st = cv_ends_moving(p) ? cv_ends_run(s, p, shift) : cv_solve_interval(s, p);
   s->status = st;
   /* A failure the integrand can explain (a table's grid left): the cause first, then what
    * the engine saw. */

@@ -52,6 +52,7 @@ void cv_solver_free(cv_solver *s) {
   cv_free(s->start);
   cv_solver_drop_results(s);
   cv_pathset_free(s->paths);
+  cv_ends_state_free(s);
   cv_free(s);
 }
 
@@ -220,7 +221,14 @@ int cv_solver_get_num_free(const cv_solver *s) {
   const cv_disc *d = &s->disc;
   long rows = d->ni; /* constraint rows: one per multiplier */
   for (long j = 0; j < d->nodes && d->nc > 0; j++) rows += cv_disc_lidx(d, j, 0) >= 0 ? d->nc : 0;
-  return (int)(d->nfree - 2 * rows); /* free y unknowns minus constraints */
+  /* free y unknowns minus constraints, and a moving end's position (ME-4) */
+  return (int)(d->nfree - 2 * rows) + s->ends_dim;
+}
+cv_status cv_solver_get_interval(const cv_solver *s, double *a, double *b) {
+  if (!s || !s->have) return s ? CVAR_ESTATE : CVAR_EINVAL;
+  if (a) *a = s->disc.a;
+  if (b) *b = s->disc.b;
+  return CVAR_OK;
 }
 double cv_solver_get_action(const cv_solver *s) { return s ? s->action : NAN; }
 double cv_solver_get_gradient_norm(const cv_solver *s) { return s ? s->gnorm : NAN; }

@@ -9,7 +9,7 @@
 
 /* The default start at fraction t of the interval: the straight line between the end
  * values (a free end takes the other end's value; both free: 0). */
-CV_HOT static void straight_line(const cv_problem *p, double t, double *y) {
+CV_HOT void cv_start_line(const cv_problem *p, double t, double *y) {
   for (int i = 0; i < p->n; i++) {
     int fa = p->fixed[2 * i], fb = p->fixed[2 * i + 1];
     double ya = p->endval[2 * i], yb = p->endval[2 * i + 1];
@@ -71,10 +71,10 @@ cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, d
       const double *xi = cv_disc_eref(d, e)->xi;
       for (int l = 0, pe = cv_disc_edeg(d, e); l < pe; l++) {
         double x = l ? x0 + 0.5 * (xi[l] + 1.0) * h : x0;
-        straight_line(p, (x - d->a) * rl, Y + (cv_disc_enode(d, e) + l) * n);
+        cv_start_line(p, (x - d->a) * rl, Y + (cv_disc_enode(d, e) + l) * n);
       }
     }
-    straight_line(p, 1.0, Y + (d->nodes - 1) * n);
+    cv_start_line(p, 1.0, Y + (d->nodes - 1) * n);
     for (int i = 0; i < n; i++) { /* exactly, so that no blend below is needed */
       if (p->fixed[2 * i]) Y[i] = p->endval[2 * i];
       if (p->fixed[2 * i + 1]) Y[(d->nodes - 1) * n + i] = p->endval[2 * i + 1];

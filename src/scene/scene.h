@@ -41,6 +41,15 @@ typedef struct {
   int sense;    /* [constraints]: 0 for G = 0, +1 for G >= 0, -1 for G <= 0 */
 } sc_item;
 
+/** A moving end of the interval ([ends], docs/scenes.md): free, or on the curve G = 0. */
+typedef struct {
+  int kind; /* 0: fixed (no line), 1: free, 2: on a curve (the core's CV_END_* values) */
+  int line; /* the [ends] line, 0 when none */
+  ex_id G;  /* the curve G(x, y), its dG/dx and dG/dy_i (Gy: n of them), or -1 */
+  ex_id Gx;
+  ex_id *Gy;
+} sc_end;
+
 /** End conditions of one unknown: fixed values or natural (free) ends. */
 typedef struct {
   double value[2]; /* at a and at b; meaningful where not free */
@@ -64,6 +73,7 @@ typedef struct scene {
   int F_line;
 
   sc_boundary *bc; /* [n] */
+  sc_end ends[2];  /* [ends]: what each end of the interval does (0 = a, 1 = b) */
   ex_id *guess;    /* [n]: expression of the variable, or -1 for the default */
   ex_id *exact;    /* [n]: expression of the variable, or -1 when not given */
   int has_exact_action;
@@ -173,6 +183,12 @@ void scene_tol_start(scene *s);
 /** Apply [mesh] and [solver] to a solver (elements, degree, grading, breakpoints,
  * tolerances, maximum iterations). */
 cv_status scene_solver_configure(const scene *s, cv_solver *sv, char *err, size_t errlen);
+
+/** The scene's [ends] on a problem made by scene_problem_new (scene_ends.c): 0, or -1 with
+ * "FILE:LINE: what is wrong" in err. */
+int scene_problem_set_ends(const scene *s, cv_problem *p, char *err, size_t errlen);
+/** Whether the scene moves an end of its interval. */
+int scene_has_moving_end(const scene *s);
 
 /** Whether F depends explicitly on the variable / on unknown i (not through y'_i). */
 int scene_F_depends_on_variable(const scene *s);

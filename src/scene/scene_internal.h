@@ -42,6 +42,7 @@ typedef enum {
   SEC_SOLVER,
   SEC_TABLES,
   SEC_PLOT,
+  SEC_ENDS,
   SEC_COUNT
 } sc_section;
 

@@ -19,7 +19,7 @@
 
 static const char *const section_names[SEC_COUNT] = {
     "scene", "parameters", "definitions", "boundary", "guess",  "constraints", "integrals",
-    "exact", "report",     "mesh",        "solver",   "tables", "plot"};
+    "exact", "report",     "mesh",        "solver",   "tables", "plot",        "ends"};
 
 /* Longest key passed to inih: its reader hands out at most INI_MAX_LINE = 200 bytes per
  * line, and "KEY = @INDEX\n" must fit. No legitimate name comes close. */

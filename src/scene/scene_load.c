@@ -17,6 +17,7 @@ int sc_load_report(sc_loader *L);
 int sc_load_mesh(sc_loader *L);
 int sc_load_solver(sc_loader *L);
 int sc_load_plot(sc_loader *L);
+int sc_load_ends(sc_loader *L);
 
 static void items_free(sc_item *it, int n) {
   for (int i = 0; i < n; i++) cv_free(it[i].name);
@@ -39,6 +40,8 @@ void scene_free(scene *s) {
   cv_free(s->unknowns);
   cv_free(s->plot_down);
   cv_free(s->bc);
+  cv_free(s->ends[0].Gy);
+  cv_free(s->ends[1].Gy);
   cv_free(s->guess);
   cv_free(s->exact);
   items_free(s->params, s->nparams);
@@ -314,8 +317,9 @@ static scene *load_buffer(const char *text, size_t len, const char *name, int ns
   }
   if (load_scene_section(&L) < 0 || sc_load_tables(&L) < 0 || load_parameters(&L, nset, set) < 0 ||
       load_definitions(&L) < 0 || load_interval_integrand(&L) < 0 || sc_load_boundary(&L) < 0 ||
-      sc_load_guess_exact(&L) < 0 || sc_load_constraints(&L) < 0 || sc_load_report(&L) < 0 ||
-      sc_load_mesh(&L) < 0 || sc_load_solver(&L) < 0 || sc_load_plot(&L) < 0) {
+      sc_load_guess_exact(&L) < 0 || sc_load_constraints(&L) < 0 || sc_load_ends(&L) < 0 ||
+      sc_load_report(&L) < 0 || sc_load_mesh(&L) < 0 || sc_load_solver(&L) < 0 ||
+      sc_load_plot(&L) < 0) {
     sc_raw_free(&L.raw);
     scene_free(s);
     return NULL;

@@ -275,6 +275,8 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
     if (!r->degrees) return -1;
     cv_solver_get_degrees(sv, r->degrees);
   }
+  r->has_interval = scene_has_moving_end(s) && r->nodes > 0 &&
+                    cv_solver_get_interval(sv, &r->interval[0], &r->interval[1]) == CVAR_OK;
   r->iterations = cv_solver_get_num_iterations(sv);
   r->action = cv_solver_get_action(sv);
   r->has_action = isfinite(r->action);

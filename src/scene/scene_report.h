@@ -30,6 +30,8 @@ typedef struct {
   int elements, degree, nodes, n;
   int *degrees; /* degree of each element (written with --tol), or NULL */
   int has_degrees;
+  int has_interval; /* a moving end ([ends]): the solved interval */
+  double interval[2];
   int has_action, has_gradient_norm, has_time;
   double action, gradient_norm, time_s;
   int has_residual_floor; /* Newton: the residual's round-off floor (theory N-3a) */

@@ -45,6 +45,12 @@ json_t *cli_report_json_object(const cli_report *r) {
       json_object_set_new(o, "degrees", d);
     }
   }
+  if (r->has_interval && isfinite(r->interval[0]) && isfinite(r->interval[1])) {
+    json_t *iv = json_array(); /* a moving end: the solved [a, b] */
+    json_array_append_new(iv, json_real(r->interval[0]));
+    json_array_append_new(iv, json_real(r->interval[1]));
+    json_object_set_new(o, "interval", iv);
+  }
   a = json_array();
   for (int i = 0; i < s->n; i++) json_array_append_new(a, json_string(s->unknowns[i]));
   json_object_set_new(o, "unknowns", a);
