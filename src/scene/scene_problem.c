@@ -122,7 +122,6 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
       goto fail;
     }
   }
-<<<<<<< HEAD
   /* periodic unknowns (PB-1), after [integrals] so that those keep their numbers, and the
    * phase condition that pins the shift (PB-2) */
   for (int i = 0; i < s->n; i++)
@@ -148,9 +147,7 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
       goto fail;
     }
   }
-=======
   if (scene_problem_set_ends(s, p, err, errlen) < 0) goto fail;
->>>>>>> wip/23e
   int any_guess = 0;
   for (int i = 0; i < s->n; i++) any_guess |= s->guess[i] >= 0;
   /* Without [guess] the core's default is the same as ours (SCENES.md). */
