@@ -36,7 +36,8 @@ static void invert(int nb, double *A, double *C) {
     for (int i = 0; i < nb; i++) {
       double f = A[i * nb + c];
       if (i == c || f == 0.0) continue;
-      for (int j = 0; j < nb; j++) A[i * nb + j] -= f * A[c * nb + j], C[i * nb + j] -= f * C[c * nb + j];
+      for (int j = 0; j < nb; j++)
+        A[i * nb + j] -= f * A[c * nb + j], C[i * nb + j] -= f * C[c * nb + j];
     }
   }
 }

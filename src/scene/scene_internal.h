@@ -104,6 +104,7 @@ typedef struct {
   size_t errlen;
   sc_rmode mode; /* what names resolve: parameters only, or everything */
   int limit;     /* parameters (SC_R_PARAM) or definitions (SC_R_FULL) usable: index < limit */
+  int second;    /* the value being parsed may use y'' (sc_parse) */
 } sc_loader;
 
 /* scene_parse.c */
@@ -119,6 +120,13 @@ int sc_parse_const_node(sc_loader *L, const sc_entry *e, int off, const char *te
 int sc_eval_params(const scene *s, ex_id e, double *value);
 const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap);
 int sc_first_slot(const scene *s, ex_id e, int from, int to);
+
+/* scene_order2.c: which unknowns are second order; slope lines checked against them. */
+int sc_load_order2(sc_loader *L);
+/* A slope line `y' = a, b` of [boundary] (entry e, unknown k): parsed into s->sbc[k]. */
+int sc_load_slope_line(sc_loader *L, const sc_entry *e, int k);
+/* Whether e reads some y''; the first such unknown's index in *which (may be NULL). */
+int sc_uses_second(const scene *s, ex_id e, int *which);
 
 /* scene_load.c: a new name (identifier, not reserved, not taken; `role` for the message). */
 int sc_check_new_name(sc_loader *L, int line, const char *name, const char *role);
