@@ -196,5 +196,8 @@ int scene_eval_guess(const scene *s, int m, const double *x, double *y);
 /** K_r at m points: out[r*m + k] for each [report] entry r. */
 int scene_eval_reports(scene *s, int m, const double *x, const double *y, const double *dy,
                        double *out);
+/** The same with y'' (d2y[i*m + k]), for a scene with second derivatives. */
+int scene_eval_reports2(scene *s, int m, const double *x, const double *y, const double *dy,
+                        const double *d2y, double *out);
 
 #endif /* CV_SCENE_H */

@@ -137,6 +137,9 @@ int sc_load_tables(sc_loader *L);
 struct cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t errlen);
 
 /* scene_eval.c */
+/* The same with y'' (d2y[i*m + k]; NULL where no expression reads it). */
+int sc_eval_exprs2(const scene *s, int nout, const ex_id *outs, int m, const double *x,
+                   const double *y, const double *dy, const double *d2y, double *out);
 int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const double *x,
                   const double *y, const double *dy, double *out);
 

@@ -34,6 +34,7 @@ void cli_report_free(cli_report *r) {
   cv_free(r->x);
   cv_free(r->y);
   cv_free(r->lam);
+  cv_free(r->dy);
   cv_free(r->has_mu);
   cv_free(r->mu);
   cv_free(r->degrees);
@@ -124,15 +125,18 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
   size_t nv = q * (size_t)(n > s->nreports ? n : s->nreports);
   double *v = cv_malloc((nv > q ? nv : q) * sizeof *v);
   double *H = cv_malloc(q * sizeof *H), *mom = cv_malloc(q * n * sizeof *mom);
-  if (!x || !w || !y || !dy || !v || !H || !mom) goto done;
-  if (cv_solver_get_qpoints(sv, x, w, y, dy) != CVAR_OK) {
+  double *d2y = s->c1 ? cv_malloc(q * n * sizeof *d2y) : NULL;
+  if (!x || !w || !y || !dy || !v || !H || !mom || (s->c1 && !d2y)) goto done;
+  if (cv_solver_get_qpoints2(sv, x, w, y, dy, d2y) != CVAR_OK) {
     rc = 0; /* nothing to evaluate on: leave the keys out */
     goto done;
   }
   /* With constraints, H of F alone is conserved only when no constraint depends on the
    * variable and there is no integral constraint (whose multiplier enters the conserved
    * quantity); a momentum only when no constraint involves that unknown (docs/cli.md). */
-  cv_status st = cv_problem_eval_energy(p, nq, x, y, dy, H, mom);
+  /* y'' in F: the first-order energy and momenta do not apply (Ostrogradsky's are in
+   * `equations`), so their keys are left out */
+  cv_status st = s->c1 ? CVAR_EINVAL : cv_problem_eval_energy(p, nq, x, y, dy, H, mom);
   if (st == CVAR_ENOMEM) goto done;
   /* A callback that fails here leaves energy and momenta out, as non-finite values do. */
   int have = st == CVAR_OK;
@@ -142,7 +146,7 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
     if (!scene_F_depends_on_unknown(s, i) && !constraints_depend_on(s, 1 + i))
       r->has_mom[i] = elem_avg_range(mom + (size_t)i * q, w, nq, r->elements, &r->mom_min[i],
                                      &r->mom_max[i]) == 0;
-  if (s->nreports > 0 && scene_eval_reports(s, nq, x, y, dy, v) < 0) goto done;
+  if (s->nreports > 0 && scene_eval_reports2(s, nq, x, y, dy, d2y, v) < 0) goto done;
   for (int k = 0; k < s->nreports; k++) {
     double sum = 0;
     for (int j = 0; j < nq; j++) sum += w[j] * v[(size_t)k * q + j];
@@ -158,6 +162,7 @@ done:
   cv_free(v);
   cv_free(H);
   cv_free(mom);
+  cv_free(d2y);
   return rc;
 }
 
@@ -250,6 +255,13 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
     }
   }
   if (nn > 0 && nodal_error(r, s) < 0) return -1;
+  if (nn > 0 && s->c1) { /* the slopes are unknowns of the C^1 elements (CSV NAME') */
+    if (!(r->dy = cv_malloc((size_t)nn * n * sizeof *r->dy))) return -1;
+    if (cv_solver_get_slopes(sv, r->dy) != CVAR_OK) {
+      cv_free(r->dy);
+      r->dy = NULL;
+    }
+  }
   /* Multiplier fields (CSV lambda_NAME) and integral multipliers (JSON multipliers). */
   if (nn > 0 && s->ncons > 0) {
     r->lam = cv_malloc((size_t)nn * s->ncons * sizeof *r->lam);
