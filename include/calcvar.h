@@ -346,6 +346,14 @@ typedef struct {
 CVAR_API cv_status cv_problem_check_derivatives(const cv_problem *p, int m, const double *x,
                                                 const double *y, const double *dy,
                                                 cv_derivcheck *report);
+/** The same for a second-order problem (cv_problem_set_second_order), with y''[i*m+k] in
+ * d2y: every first partial in (y, y', y'') against central differences of F, every second
+ * partial against those of the first ones; the names are "Fq[i]", "Fyq[i][j]", ... (the
+ * stored block, e.g. d2F/dy''_1 dy_0 is "Fyq[0][1]"). CVAR_EINVAL for a first-order
+ * problem or more than 64 unknowns. */
+CVAR_API cv_status cv_problem_check_derivatives2(const cv_problem *p, int m, const double *x,
+                                                 const double *y, const double *dy,
+                                                 const double *d2y, cv_derivcheck *report);
 /**@}*/
 
 /** \name Solver: discretisation, options, results */
