@@ -49,6 +49,11 @@ cv_status cv_hermite_qpoints(const cv_solver *s, double *x, double *w, double *y
                              double *d2y);
 cv_status cv_hermite_eval(const cv_solver *s, int m, const double *x, double *y, double *dy);
 
+/* ---- error estimate (cv_hermite_estimate.c, theory H-7) ---- */
+/* The estimate of s's max nodal error from an enriched solve into f (a fresh solver). */
+cv_status cv_hermite_estimate(const cv_solver *s, const cv_problem *p, cv_solver *f, double *est,
+                              double *est_vertex, char *msg, size_t len);
+
 /* ---- assembly (cv_hermite_assemble.c) ---- */
 cv_status cv_hermite_assembler_init(cv_assembler *as);
 /* cv_assemble for C^1 elements (theory H-3). */
