@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cv_hermite.h"
 #include "cv_internal.h"
 
 #define MAX_ROUNDS 80
@@ -284,12 +285,7 @@ static double dorfler_threshold(const double *eta, int E, double frac) {
  * estimate, refine. Ends with s holding the last round's solution and s->err_est. */
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   cv_status st;
-  if (p->c1) { /* the estimators of HP-2 .. HP-7 are for C^0 elements */
-    cv_set_msg(s->msg, sizeof s->msg,
-               "automatic accuracy (tol, adapt) is not available for an integrand with y'' "
-               "(C1 elements): give the mesh (elements, degree) and use converge");
-    return CVAR_EINVAL;
-  }
+  if (p->c1) return cv_hermite_adapt(s, p); /* C^1 elements: H-7, H-8 */
   cv_solver *f = cv_solver_new(&st);
   double *t = NULL, *eta = NULL, *sigma = NULL, *where = NULL;
   int *deg = NULL, E = 0, stalled = 0, warm = 0, misses = 0, halved_nodes = 1;

@@ -524,7 +524,7 @@ cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p, doub
   cv_solver *f = cv_solver_new(&st);
   if (!f) return st;
   if (s->disc.herm)
-    st = cv_hermite_estimate(s, p, f, est, est_vertex, msg, len);
+    st = cv_hermite_estimate(s, p, f, est, est_vertex, NULL, msg, len);
   else
     st = cv_estimate_enriched(s, p, f, est, est_vertex, NULL, msg, len);
   cv_solver_free(f);

@@ -50,9 +50,18 @@ cv_status cv_hermite_qpoints(const cv_solver *s, double *x, double *w, double *y
 cv_status cv_hermite_eval(const cv_solver *s, int m, const double *x, double *y, double *dy);
 
 /* ---- error estimate (cv_hermite_estimate.c, theory H-7) ---- */
-/* The estimate of s's max nodal error from an enriched solve into f (a fresh solver). */
+/* The estimate of s's max nodal error from an enriched solve into f (a fresh solver);
+ * eta (may be NULL): the largest difference on each element (E entries). */
 cv_status cv_hermite_estimate(const cv_solver *s, const cv_problem *p, cv_solver *f, double *est,
-                              double *est_vertex, char *msg, size_t len);
+                              double *est_vertex, double *eta, char *msg, size_t len);
+/* Start f (its mesh set) from s's solution: values and slopes at f's nodes. */
+cv_status cv_hermite_warm(cv_solver *f, const cv_problem *p, const cv_solver *s);
+/* H-8: the smoothness indicator of element e of s's solution, the ratio of the Legendre
+ * coefficients of degrees p, p-1 to those of p-2, p-3 (of degree >= 1), the largest over
+ * the unknowns: small (below e^-2) where the solution is smooth. */
+double cv_hermite_smoothness(const cv_solver *s, long e);
+/* --tol and --adapt for C1 elements (theory H-8). */
+cv_status cv_hermite_adapt(cv_solver *s, const cv_problem *p);
 
 /* ---- assembly (cv_hermite_assemble.c) ---- */
 cv_status cv_hermite_assembler_init(cv_assembler *as);

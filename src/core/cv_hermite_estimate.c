@@ -26,7 +26,7 @@ static cv_status enriched(const cv_disc *d, cv_solver *f, int *E) {
 }
 
 /* f's start: s's values and slopes at f's nodes (node-major, 2n per node). */
-static cv_status warm(cv_solver *f, const cv_problem *p, const cv_solver *s) {
+cv_status cv_hermite_warm(cv_solver *f, const cv_problem *p, const cv_solver *s) {
   cv_disc d;
   char msg[160];
   cv_status st = cv_disc_init(&d, p, f, msg, sizeof msg);
@@ -51,9 +51,10 @@ static cv_status warm(cv_solver *f, const cv_problem *p, const cv_solver *s) {
   return st;
 }
 
-/* max over s's nodes of |y_s - y_f| (*ev: over the element ends), and the largest |y_f|. */
+/* max over s's nodes of |y_s - y_f| (*ev: over the element ends; eta[e], if not NULL, over
+ * element e's nodes), and the largest |y_f|. */
 static cv_status difference(const cv_solver *s, const cv_solver *f, int n, double *e, double *ev,
-                            double *scale) {
+                            double *scale, double *eta) {
   const cv_disc *d = &s->disc;
   int N = d->nodes;
   double *x = cv_malloc((size_t)N * sizeof *x), *yf = cv_malloc((size_t)N * n * sizeof *yf);
@@ -69,6 +70,9 @@ static cv_status difference(const cv_solver *s, const cv_solver *f, int n, doubl
       if (!(dl <= *e)) *e = dl;
       if (j % d->p == 0 && !(dl <= *ev)) *ev = dl;
       *scale = fmax(*scale, fabs(v));
+      long el = j / d->p; /* the elements sharing node j */
+      if (eta && el < d->E) eta[el] = fmax(eta[el], dl);
+      if (eta && j % d->p == 0 && el > 0) eta[el - 1] = fmax(eta[el - 1], dl);
     }
   cv_free(x);
   cv_free(yf);
@@ -76,13 +80,13 @@ static cv_status difference(const cv_solver *s, const cv_solver *f, int n, doubl
 }
 
 cv_status cv_hermite_estimate(const cv_solver *s, const cv_problem *p, cv_solver *f, double *est,
-                              double *est_vertex, char *msg, size_t len) {
+                              double *est_vertex, double *eta, char *msg, size_t len) {
   int Ef;
   double e, ev, scale;
   f->rtol = fmax(s->rtol, 1e-12), f->atol = fmax(s->atol, 1e-12), f->maxit = s->maxit;
   f->method = CVAR_METHOD_NEWTON, f->continuation = 0, f->adapt_tol = 0.0;
   cv_status st = enriched(&s->disc, f, &Ef);
-  if (!st) st = warm(f, p, s);
+  if (!st) st = cv_hermite_warm(f, p, s);
   if (st) {
     cv_set_msg(msg, len, "out of memory for the error estimate");
     return st;
@@ -103,7 +107,8 @@ cv_status cv_hermite_estimate(const cv_solver *s, const cv_problem *p, cv_solver
                f->morse, s->morse);
     return CVAR_EDIVERGED;
   }
-  st = difference(s, f, p->n, &e, &ev, &scale);
+  for (long k = 0; eta && k < s->disc.E; k++) eta[k] = 0.0;
+  st = difference(s, f, p->n, &e, &ev, &scale, eta);
   if (st) return st;
   if (!isfinite(e) || (e > 0.5 * (scale > 0 ? scale : 1.0) && e > 1e-3)) {
     cv_set_msg(msg, len,
