@@ -161,9 +161,12 @@ typedef struct {
  *  - Fyq[(i*n + j)*m + k] = d2F/dy_i dy''_j, Fpq[...] = d2F/dy'_i dy''_j,
  *    Fqq[(i*n + j)*m + k] = d2F/dy''_i dy''_j (symmetric)          (with CVAR_NEED_HESS) */
 typedef struct {
-  cv_partials d1; /**< the first-order members, as in every call */
-  const double *d2y;
-  double *Fq, *Fyq, *Fpq, *Fqq;
+  cv_partials d1;    /**< the first-order members, as in every call */
+  const double *d2y; /**< input: y''_i at [i*m + k], length n*m */
+  double *Fq;        /**< dF/dy''_i at [i*m + k]; NULL unless CVAR_NEED_GRAD */
+  double *Fyq;       /**< d2F/dy_i dy''_j at [(i*n + j)*m + k]; NULL unless CVAR_NEED_HESS */
+  double *Fpq;       /**< d2F/dy'_i dy''_j at [(i*n + j)*m + k]; NULL unless CVAR_NEED_HESS */
+  double *Fqq;       /**< d2F/dy''_i dy''_j (symmetric); NULL unless CVAR_NEED_HESS */
 } cv_partials2;
 /** The second-order outputs of a call whose need has CVAR_NEED_Y2. */
 static inline cv_partials2 *cv_partials_y2(cv_partials *out) { return (cv_partials2 *)(void *)out; }
