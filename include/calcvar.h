@@ -240,7 +240,8 @@ CVAR_API void cv_problem_get_interval(const cv_problem *p, double *a, double *b)
 /** The integrand as a formula string, with exact symbolic derivatives (no callback to
  * write). `variable` names the independent variable (NULL for "x"); `unknowns` is a comma
  * separated list of n names (n must equal the problem's); `F` uses the scene grammar of
- * docs/scenes.md (y' is dy/dx). `parameters` is NULL or a comma separated list of
+ * docs/scenes.md (y' is dy/dx; y'' makes that unknown second order, as
+ * cv_problem_set_second_order, in an integrand or an integral constraint). `parameters` is NULL or a comma separated list of
  * `name = constant expression`. On failure returns CVAR_EINVAL and writes a sentence to
  * err (errlen bytes, may be NULL/0). The problem owns the compiled integrand. */
 CVAR_API cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,

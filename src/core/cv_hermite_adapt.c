@@ -23,7 +23,8 @@ double cv_hermite_smoothness(const cv_solver *s, long e) {
         a[k] += h->C[k * nb + t] * Ye[(t >> 1) * nc + 2 * i + (t & 1)] * (t & 1 ? J : 1.0);
     }
     int p = nb - 1;
-    double top = fabs(a[p]) + fabs(a[p - 1]), low = fabs(a[p - 2]) + (p - 3 >= 1 ? fabs(a[p - 3]) : 0.0);
+    double top = fabs(a[p]) + fabs(a[p - 1]),
+           low = fabs(a[p - 2]) + (p - 3 >= 1 ? fabs(a[p - 3]) : 0.0);
     double ratio = low > 0 ? top / low : top > 0 ? INFINITY : 0.0;
     worst = fmax(worst, ratio);
   }

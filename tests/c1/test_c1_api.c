@@ -55,7 +55,8 @@ static void cantilever(int degree) {
   cv_solver_set_degree(s, degree);
   cv_status st = cv_solve(s, p);
   CHECK(st == CVAR_OK, "cantilever degree %d: %s", degree, cv_solver_last_error(s));
-  CHECK(cv_solver_get_degree(s) == degree, "degree %d reported %d", degree, cv_solver_get_degree(s));
+  CHECK(cv_solver_get_degree(s) == degree, "degree %d reported %d", degree,
+        cv_solver_get_degree(s));
   int nn = cv_solver_get_num_nodes(s), nq = cv_solver_get_num_qpoints(s);
   CHECK(nn == 4 * (degree - 1) / 2 + 1, "degree %d: %d nodes", degree, nn);
   double *x = malloc(nn * sizeof *x), *y = malloc(nn * sizeof *y), *dy = malloc(nn * sizeof *dy);
@@ -72,8 +73,8 @@ static void cantilever(int degree) {
   for (int k = 0; k < nq; k++) e2 = fmax(e2, fabs(qd2[k] - cant(qx[k], b.EI, b.q, L, 2)));
   /* cubic: exact at the nodes (the Green's function of y'''' is a piecewise cubic); quintic
    * and septic hold the quartic itself, so y'' too, to round-off */
-  CHECK(ev < 1e-13 && es < 1e-13, "degree %d: nodal errors %.3g (values) %.3g (slopes)", degree,
-        ev, es);
+  CHECK(ev < 1e-13 && es < 1e-13, "degree %d: nodal errors %.3g (values) %.3g (slopes)", degree, ev,
+        es);
   if (degree > 3) CHECK(e2 < 1e-11, "degree %d: y'' error %.3g at the Gauss points", degree, e2);
   double A = -b.q * b.q * pow(L, 5) / (40 * b.EI);
   CHECK(fabs(cv_solver_get_action(s) - A) < (degree > 3 ? 1e-13 : 1e-2) * fabs(A),
@@ -129,7 +130,8 @@ static void bad_input(void) {
         "a slope of a first-order unknown accepted");
   cv_problem_set_second_order(p, 1);
   CHECK(cv_problem_set_end_slope(p, 1, 0, NAN) == CVAR_EINVAL, "a NaN slope accepted");
-  CHECK(cv_problem_get_second_order(p, 1) && !cv_problem_get_second_order(p, 0), "get_second_order");
+  CHECK(cv_problem_get_second_order(p, 1) && !cv_problem_get_second_order(p, 0),
+        "get_second_order");
   beam b = {1.0, 1.0, 0.0, 1.0};
   cv_problem *q = cv_problem_new(1, 0.0, 1.0, NULL);
   cv_problem_set_integrand(q, beam_F, &b);

@@ -236,5 +236,18 @@ if rc == 0:
     check("--all paths", len(sols) == 3 and kinds[0][0] == 0 and kinds[1][0] == 0 and
           kinds[2] == (1, 0.0) and abs(kinds[0][1] - kinds[1][1]) < 1e-9, kinds)
 
+# ---- batch: rows of (q, EI) against the closed-form action and bending energy
+table = os.path.join(os.environ.get("TMPDIR", "/tmp"), "c1_rows_%d.csv" % os.getpid())
+with open(table, "w") as f:
+    f.write("q,EI\n1,1\n3,2\n5,0.5\n")
+rc, out, err = run("batch", scene("cantilever.scene"), table)
+os.unlink(table)
+check("batch exit", rc == 0, err)
+for row in (list(csv.DictReader(io.StringIO(out))) if rc == 0 else []):
+    q_, EI_ = float(row["q"]), float(row["EI"])
+    U = q_ * q_ * 1.5 ** 5 / (40 * EI_)
+    check("batch row q=%g" % q_, abs(float(row["action"]) + U) < 1e-13 * U and
+          abs(float(row["bending"]) - U) < 1e-13 * U, row)
+
 print("%d failure(s)" % failures)
 sys.exit(1 if failures else 0)
