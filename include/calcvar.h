@@ -126,7 +126,12 @@ CVAR_API cv_status cv_dependency_versions(char *buf, size_t len);
 enum {
   CVAR_NEED_F = 1u,    /**< F itself */
   CVAR_NEED_GRAD = 2u, /**< F_y and F_y' */
-  CVAR_NEED_HESS = 4u  /**< F_yy, F_yy', F_y'y' */
+  CVAR_NEED_HESS = 4u, /**< F_yy, F_yy', F_y'y' */
+  /** Second-order problems only (cv_problem_set_second_order): `out` is the d1 member of
+   * a cv_partials2 carrying y'', and the groups asked for include the partials in y''
+   * (with CVAR_NEED_GRAD Fq, with CVAR_NEED_HESS Fyq, Fpq and Fqq). A callback of a
+   * first-order problem never sees this bit. */
+  CVAR_NEED_Y2 = 8u
 };
 
 /** Output buffers of an integrand call at m points, structure of arrays.
@@ -147,6 +152,24 @@ typedef struct {
   double *Fyp; /**< d2F/dy_i dy'_j at [(i*n + j)*m + k]; NULL unless CVAR_NEED_HESS */
   double *Fpp; /**< d2F/dy'_i dy'_j at [(i*n + j)*m + k]; NULL unless CVAR_NEED_HESS */
 } cv_partials;
+
+/** The outputs of a call with CVAR_NEED_Y2 (second-order problems): `out` then points to
+ * the member d1 of one of these, so the callback reaches the rest by cv_partials_y2(out).
+ * Members are NULL exactly when their group was not asked for, as in cv_partials.
+ *  - d2y[i*m + k] = y''_i (input)
+ *  - Fq[i*m + k] = dF/dy''_i                                      (with CVAR_NEED_GRAD)
+ *  - Fyq[(i*n + j)*m + k] = d2F/dy_i dy''_j, Fpq[...] = d2F/dy'_i dy''_j,
+ *    Fqq[(i*n + j)*m + k] = d2F/dy''_i dy''_j (symmetric)          (with CVAR_NEED_HESS) */
+typedef struct {
+  cv_partials d1;    /**< the first-order members, as in every call */
+  const double *d2y; /**< input: y''_i at [i*m + k], length n*m */
+  double *Fq;        /**< dF/dy''_i at [i*m + k]; NULL unless CVAR_NEED_GRAD */
+  double *Fyq;       /**< d2F/dy_i dy''_j at [(i*n + j)*m + k]; NULL unless CVAR_NEED_HESS */
+  double *Fpq;       /**< d2F/dy'_i dy''_j at [(i*n + j)*m + k]; NULL unless CVAR_NEED_HESS */
+  double *Fqq;       /**< d2F/dy''_i dy''_j (symmetric); NULL unless CVAR_NEED_HESS */
+} cv_partials2;
+/** The second-order outputs of a call whose need has CVAR_NEED_Y2. */
+static inline cv_partials2 *cv_partials_y2(cv_partials *out) { return (cv_partials2 *)(void *)out; }
 
 /** Integrand F(x, y, y') and its partials at m points.
  * \param m     number of points (1 <= m <= 256)
@@ -223,6 +246,19 @@ CVAR_API cv_status cv_problem_set_end_fixed(cv_problem *p, int end);
 /** What end `end` does: 0 fixed, 1 free, 2 on a curve; -1 for bad arguments. */
 CVAR_API int cv_problem_get_end_kind(const cv_problem *p, int end);
 /**@}*/
+/** Second derivatives (theory H-1 .. H-6): unknown k's y'' enters the integrand (or an
+ * integral constraint). The problem then uses C^1 elements (values and slopes at the
+ * nodes, cubic Hermite and the odd degrees 5 and 7 by cv_solver_set_degree;
+ * degree 1 means 3; an even degree is refused when solving) for all its unknowns, and every integrand callback is called with
+ * CVAR_NEED_Y2 (cv_partials2). Slopes start free at both
+ * ends (the natural conditions of a second-order integrand hold there at the solution). */
+CVAR_API cv_status cv_problem_set_second_order(cv_problem *p, int k);
+/** Whether unknown k was made second order (0 for a bad k). */
+CVAR_API int cv_problem_get_second_order(const cv_problem *p, int k);
+/** Fix the slope y'_k at one end (0 = a, 1 = b) of a second-order unknown k. */
+CVAR_API cv_status cv_problem_set_end_slope(cv_problem *p, int k, int end, double value);
+/** Leave the slope y'_k free at one end (the default). */
+CVAR_API cv_status cv_problem_set_free_slope(cv_problem *p, int k, int end);
 /** Initial guess (default: the straight line between the end values; with a free end,
  * the constant fixed value; with both ends free, 0). NULL restores the default. */
 CVAR_API cv_status cv_problem_set_guess(cv_problem *p, cv_guess_fn g, void *user);
@@ -234,7 +270,8 @@ CVAR_API void cv_problem_get_interval(const cv_problem *p, double *a, double *b)
 /** The integrand as a formula string, with exact symbolic derivatives (no callback to
  * write). `variable` names the independent variable (NULL for "x"); `unknowns` is a comma
  * separated list of n names (n must equal the problem's); `F` uses the scene grammar of
- * docs/scenes.md (y' is dy/dx). `parameters` is NULL or a comma separated list of
+ * docs/scenes.md (y' is dy/dx; y'' makes that unknown second order, as
+ * cv_problem_set_second_order, in an integrand or an integral constraint). `parameters` is NULL or a comma separated list of
  * `name = constant expression`. On failure returns CVAR_EINVAL and writes a sentence to
  * err (errlen bytes, may be NULL/0). The problem owns the compiled integrand. */
 CVAR_API cv_status cv_problem_set_integrand_expr(cv_problem *p, const char *variable,
@@ -361,6 +398,14 @@ typedef struct {
 CVAR_API cv_status cv_problem_check_derivatives(const cv_problem *p, int m, const double *x,
                                                 const double *y, const double *dy,
                                                 cv_derivcheck *report);
+/** The same for a second-order problem (cv_problem_set_second_order), with y''[i*m+k] in
+ * d2y: every first partial in (y, y', y'') against central differences of F, every second
+ * partial against those of the first ones; the names are "Fq[i]", "Fyq[i][j]", ... (the
+ * stored block, e.g. d2F/dy''_1 dy_0 is "Fyq[0][1]"). CVAR_EINVAL for a first-order
+ * problem or more than 64 unknowns. */
+CVAR_API cv_status cv_problem_check_derivatives2(const cv_problem *p, int m, const double *x,
+                                                 const double *y, const double *dy,
+                                                 const double *d2y, cv_derivcheck *report);
 /**@}*/
 
 /** \name Solver: discretisation, options, results */
@@ -523,6 +568,10 @@ CVAR_API cv_status cv_solver_get_interval(const cv_solver *s, double *a, double 
 CVAR_API cv_status cv_solver_get_nodes(const cv_solver *s, double *x);
 /** Nodal values, node-major: y[j*n + i] is unknown i at node j; length nodes*n. */
 CVAR_API cv_status cv_solver_get_values(const cv_solver *s, double *y);
+/** Nodal slopes y'[j*n + i] of a second-order problem's last solve (C^1 elements: the
+ * slopes are unknowns at the nodes); of a first-order one, the derivative of the
+ * interpolant at the node (from the element to its left at a shared node). Length nodes*n. */
+CVAR_API cv_status cv_solver_get_slopes(const cv_solver *s, double *dy);
 /** Discrete action S_h at the last iterate. */
 CVAR_API double cv_solver_get_action(const cv_solver *s);
 /** Max-norm of the discrete Euler-Lagrange residual scaled by the lumped nodal weights
@@ -564,6 +613,10 @@ CVAR_API int cv_solver_get_num_qpoints(const cv_solver *s);
  * arrays). Sum_k w[k] g(x[k]) is the solver's integral of g. */
 CVAR_API cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double *y,
                                          double *dy);
+/** cv_solver_get_qpoints with the second derivatives d2y[i*nq + k] as well, for a
+ * second-order problem (for a first-order one d2y must be NULL: CVAR_EINVAL). */
+CVAR_API cv_status cv_solver_get_qpoints2(const cv_solver *s, double *x, double *w, double *y,
+                                          double *dy, double *d2y);
 /** Evaluate the last solution (degree-p interpolant) at m abscissae in [a, b]:
  * y[i*m + k] and, if dy != NULL, y'[i*m + k]. */
 CVAR_API cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y,

@@ -485,10 +485,12 @@ class Problem:
     a scene (Problem.text) and loaded by the same loader, so the rules and messages are
     those of docs/scenes.md (with line numbers in Problem.text).
 
-    integrand   F as an expression of the variable, unknowns and primed unknowns (y')
+    integrand   F as an expression of the variable, unknowns and primed unknowns (y', and
+                y'' for a second-order integrand: C1 elements, docs/beams.md)
     interval    (a, b)
     boundary    {unknown: (value_at_a, value_at_b)}; a value None or "free" leaves that
-                end free (natural boundary condition); values may be expressions
+                end free (natural boundary condition); values may be expressions; a key
+                "y'" gives the slopes of a second-order unknown y (missing: both free)
     unknowns    names in order (default: the order of boundary)
     variable    the independent variable's name (default "x")
     parameters  {name: value}          definitions  {name: expression}
@@ -502,8 +504,8 @@ class Problem:
     def __init__(self, integrand, interval, boundary, unknowns=None, variable="x",
                  parameters=None, definitions=None, constraints=None, integrals=None,
                  guess=None, exact=None, report=None, mesh=None, solver=None, title=None):
-        if unknowns is None:
-            unknowns = list(boundary)
+        if unknowns is None:  # slope lines ("y'") are not unknowns
+            unknowns = [k for k in boundary if not k.endswith("'")]
         elif isinstance(unknowns, str):
             unknowns = [u.strip() for u in unknowns.split(",")]
         try:

@@ -123,10 +123,11 @@ static int split_args(int argc, char **argv, conv_opts *c, char **rest, int *nre
   return 0;
 }
 
-/* Max |y_h - y_exact| over the element boundaries (nodes j with j % p == 0), over the
- * unknowns that have an [exact] expression. */
+/* Max |y_h - y_exact| over the element boundaries (nodes j with j % p == 0, p the nodes
+ * per element: the degree, or (degree - 1)/2 for C1 elements), over the unknowns that
+ * have an [exact] expression. */
 static int vertex_error(const scene *s, const cli_report *r, double *e) {
-  int n = s->n, p = r->degree, nv = r->elements + 1;
+  int n = s->n, p = (r->nodes - 1) / r->elements, nv = r->elements + 1;
   double *xv = malloc((size_t)nv * sizeof *xv), *ex = malloc((size_t)nv * n * sizeof *ex);
   int rc = -1;
   *e = NAN;

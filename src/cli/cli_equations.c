@@ -44,7 +44,7 @@ static void write_text(FILE *f, const scene *s, const mech_equations *eq, const 
   int n = s->n, ncyc = 0;
   char num[32];
   fprintf(f, "%s (%s)\n", s->title, s->file);
-  fprintf(f, "  F(%s, y, y') = %s\n", s->variable, t->F);
+  fprintf(f, "  F(%s, y, y'%s) = %s\n", s->variable, t->mom2 ? ", y''" : "", t->F);
   if (s->nparams > 0) {
     fprintf(f, "  parameters   substituted as numbers:");
     for (int k = 0; k < s->nparams; k++)
@@ -55,7 +55,12 @@ static void write_text(FILE *f, const scene *s, const mech_equations *eq, const 
   for (int i = 0; i < n; i++) {
     const char *u = s->unknowns[i];
     fprintf(f, "\n  %s\n", u);
-    fprintf(f, "    momentum         p_%s = dF/d%s' = %s\n", u, u, t->mom[i]);
+    if (t->mom2) { /* Ostrogradsky's momenta of a second-order Lagrangian (theory P-14) */
+      fprintf(f, "    momentum         p_%s = dF/d%s' - d/dx dF/d%s'' = %s\n", u, u, u, t->mom[i]);
+      fprintf(f, "    second momentum  q_%s = dF/d%s'' = %s\n", u, u, t->mom2[i]);
+    } else {
+      fprintf(f, "    momentum         p_%s = dF/d%s' = %s\n", u, u, t->mom[i]);
+    }
     fprintf(f, "    Euler-Lagrange   %s = 0\n", t->el[i]);
     if (eq->cyclic[i]) ncyc++;
   }

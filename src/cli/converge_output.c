@@ -62,8 +62,10 @@ int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows) {
     fprintf(f, "  errors are ESTIMATES (no [exact]): from a reference solve on a finer mesh\n");
   else
     fprintf(f, "  errors against [exact]\n");
-  fprintf(f, "  error: max over all nodes; error_vertices: max over the element boundaries "
-             "(order 2p expected there)\n");
+  fprintf(f,
+          "  error: max over all nodes; error_vertices: max over the element boundaries "
+          "(order %s expected there)\n",
+          s->c1 ? "2p - 2 of the C1 elements, p + 1 over all nodes," : "2p");
   fprintf(f, "  order: log(e_prev/e) / log(N/N_prev) against the previous mesh\n");
   fprintf(f, "%9s %6s %9s %12s %6s %15s %14s %10s %10s\n", "elements", "degree", "nodes",
           est ? "error(est)" : "error", "order", est ? "error_vert(est)" : "error_vertices",

@@ -2,8 +2,8 @@
  * mesh node in increasing order of the variable, ends included.
  * SPDX-License-Identifier: MIT
  *
- * Columns: the variable, each unknown, then lambda_NAME per pointwise constraint (none
- * yet: this build refuses constrained scenes). "%.17g" round-trips every double. A
+ * Columns: the variable, each unknown, then lambda_NAME per pointwise constraint, then
+ * NAME' (the nodal slope) per unknown whose y'' the scene uses. "%.17g" round-trips every double. A
  * non-finite value (the last iterate of a diverged solve) is written as an empty field,
  * never as "nan".
  */
@@ -21,6 +21,8 @@ int cli_report_csv(FILE *f, const cli_report *r) {
   fprintf(f, "%s", s->variable);
   for (int i = 0; i < n; i++) fprintf(f, ",%s", s->unknowns[i]);
   for (int c = 0; c < s->ncons; c++) fprintf(f, ",lambda_%s", s->cons[c].name);
+  for (int i = 0; s->c1 && i < n; i++) /* the slope of each unknown with y'' */
+    if (s->order2[i]) fprintf(f, ",%s'", s->unknowns[i]);
   fputc('\n', f);
   for (int j = 0; j < r->nodes; j++) {
     field(f, r->x[j]);
@@ -32,6 +34,11 @@ int cli_report_csv(FILE *f, const cli_report *r) {
       fputc(',', f);
       if (r->lam) field(f, r->lam[(size_t)c * r->nodes + j]);
     }
+    for (int i = 0; s->c1 && i < n; i++)
+      if (s->order2[i]) {
+        fputc(',', f);
+        if (r->dy) field(f, r->dy[(size_t)j * n + i]);
+      }
     fputc('\n', f);
   }
   return ferror(f) ? -1 : 0;

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cv_hermite.h"
 #include "cv_internal.h"
 
 #define MAX_ROUNDS 80
@@ -308,6 +309,7 @@ static void prefix_msg(cv_solver *s, const char *pre) {
  * estimate, refine. Ends with s holding the last round's solution and s->err_est. */
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   cv_status st;
+  if (p->c1) return cv_hermite_adapt(s, p); /* C^1 elements: H-7, H-8 */
   cv_solver *f = cv_solver_new(&st);
   double *t = NULL, *eta = NULL, *sigma = NULL, *where = NULL;
   int *deg = NULL, E = 0, stalled = 0, warm = 0, misses = 0, halved_nodes = 1;

@@ -3,6 +3,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "cv_hermite.h"
 #include "cv_internal.h"
 
 cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc *d) {
@@ -35,12 +36,14 @@ cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc
   as->out.Fyy = w, w += n * n * m;
   as->out.Fyp = w, w += n * n * m;
   as->out.Fpp = w;
-  return CVAR_OK;
+  return d->herm ? cv_hermite_assembler_init(as) : CVAR_OK;
 }
 
 void cv_assembler_free(cv_assembler *as) {
   if (!as) return;
   cv_free(as->buf); /* K and fl live in it */
+  cv_free(as->hbuf);
+  as->hbuf = NULL;
   as->buf = as->K = NULL;
   as->fl = NULL;
 }
@@ -348,6 +351,7 @@ cv_status cv_assemble(cv_assembler *as, cv_integrand_fn Fn, void *user, const do
                       double *g, const int *colptr, double *Ax, double hscale, int overwrite) {
   const cv_disc *d = as->disc;
   int n = d->n;
+  if (d->herm) return cv_hermite_assemble(as, Fn, user, Y, S, g, colptr, Ax, hscale, overwrite);
   unsigned need = CVAR_NEED_F | (g ? CVAR_NEED_GRAD : 0u) | (Ax ? CVAR_NEED_HESS : 0u);
   double Ssum = 0.0, bad = 0.0;
   cv_status st;

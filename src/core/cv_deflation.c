@@ -384,6 +384,17 @@ static cv_status values_on(const cv_solver *s, const cv_disc *ds, double *xs, do
                            double *E) {
   int n = ds->n, N = ds->nodes;
   cv_disc_fill_nodes(ds, xs);
+  if (ds->herm) { /* C1 elements: values and slopes, the unknowns of the mesh (H-2) */
+    int nu = n / 2;
+    double *dv = ev + (size_t)N * nu; /* ev holds ndof = 2 N nu values */
+    cv_status st = cv_solver_eval(s, N, xs, ev, dv);
+    for (int j = 0; j < N && !st; j++)
+      for (int i = 0; i < nu; i++) {
+        E[(size_t)j * n + 2 * i] = ev[(size_t)i * N + j];
+        E[(size_t)j * n + 2 * i + 1] = dv[(size_t)i * N + j];
+      }
+    return st;
+  }
   cv_status st = cv_solver_eval(s, N, xs, ev, NULL);
   if (st) return st;
   for (int j = 0; j < N; j++)
@@ -391,9 +402,10 @@ static cv_status values_on(const cv_solver *s, const cv_disc *ds, double *xs, do
   return CVAR_OK;
 }
 
-static double maxdiff(const double *a, const double *b, long n) {
+/* Max difference of the values (of C1 elements: every other entry, not the slopes). */
+static double maxdiff(const double *a, const double *b, long n, int herm) {
   double m = 0.0;
-  for (long i = 0; i < n; i++) m = fmax(m, fabs(a[i] - b[i]));
+  for (long i = 0; i < n; i += herm ? 2 : 1) m = fmax(m, fabs(a[i] - b[i]));
   return m;
 }
 
@@ -409,10 +421,11 @@ static int keep_path(cv_solver *s, struct cv_pathset *ps, defl *w, double *xs, d
   if (values_on(s, w->d, xs, ev, E)) return -1;
   long nd = w->d->ndof;
   double size = 0.0, est = isfinite(s->err_est) ? s->err_est : 0.0;
-  for (long i = 0; i < nd; i++) size = fmax(size, fabs(E[i]));
+  int herm = w->d->herm != NULL;
+  for (long i = 0; i < nd; i += herm ? 2 : 1) size = fmax(size, fabs(E[i]));
   for (int k = 0; k < w->nknown; k++) {
     double tol = fmax(fmax(est, ests[k]), SAME_FLOOR * fmax(size, 1.0));
-    if (maxdiff(E, w->known[k], nd) <= tol) return 0;
+    if (maxdiff(E, w->known[k], nd, herm) <= tol) return 0;
   }
   if (defl_add_known(w, E)) return -1;
   ests[w->nknown - 1] = est;

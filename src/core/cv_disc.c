@@ -4,6 +4,7 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "cv_hermite.h"
 #include "cv_internal.h"
 
 /* Zero every field but the tables of the embedded reference element (4.6 kB, of which a
@@ -27,6 +28,7 @@ void cv_disc_free(cv_disc *d) {
   cv_free(d->pe);
   cv_free(d->en);
   cv_free(d->refs);
+  cv_free(d->herm);
   disc_clear(d);
 }
 
@@ -88,16 +90,27 @@ static cv_status disc_init_hp(cv_disc *d, const cv_meshspec *m, int nq) {
   return CVAR_OK;
 }
 
+/* Whether component i of a node is fixed at an end: a value, or (C^1, odd i) a slope. */
+static int disc_end_fixed(const cv_problem *p, int i, int end) {
+  if (!p->c1) return p->fixed[2 * i + end];
+  return i & 1 ? p->sfixed[2 * (i / 2) + end] : p->fixed[2 * (i / 2) + end];
+}
+
 /* Unknowns are node-major (theory E-2); fixed end values are removed, so free indices are
  * the global ones shifted by the fixed components of node 0, except at the two end nodes. */
 cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char *msg, size_t len) {
   cv_status st;
-  int n = p->n;
+  int n = p->c1 ? 2 * p->n : p->n; /* C^1: a value and a slope per unknown (H-2) */
+  int r = p->c1 ? cv_hermite_node_degree(s->degree, msg, len) : 0;
   disc_clear(d);
+  if (r < 0 || (p->c1 && s->mesh.degrees)) {
+    if (r >= 0) cv_set_msg(msg, len, "C1 elements take one degree for every element");
+    return CVAR_EINVAL;
+  }
   st = cv_mesh_build(&s->mesh, p->a, p->b, &d->E, &d->xe, msg, len);
   if (st) return st;
   d->n = n;
-  d->p = s->degree;
+  d->p = p->c1 ? r : s->degree;
   d->a = p->a;
   d->b = p->b;
   d->nodes = d->E * d->p + 1;
@@ -115,7 +128,11 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
     return CVAR_EINVAL;
   }
   d->ndof = d->nodes * n;
-  cv_refelem_init(&d->ref, d->p, s->nq ? s->nq : d->p + 1);
+  cv_refelem_init(&d->ref, d->p, s->nq ? s->nq : p->c1 ? 2 * d->p + 2 : d->p + 1);
+  if (p->c1 && cv_hermite_disc_init(d, s->nq)) {
+    cv_disc_free(d);
+    return CVAR_ENOMEM;
+  }
   /* fix0 and fix1 in one block, mass and imass in another: fewer allocations, and fewer
    * heap bytes for the first solve in a process to touch (docs/performance.md) */
   d->fix0 = cv_malloc(2 * (size_t)n * sizeof *d->fix0);
@@ -128,14 +145,14 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
   d->nc = nc;
   d->ni = p->ni;
   d->stride = n + nc;
-  for (int i = 0; i < n; i++) d->fix0[i] = p->fixed[2 * i] ? -1 : f++;
+  for (int i = 0; i < n; i++) d->fix0[i] = disc_end_fixed(p, i, 0) ? -1 : f++;
   d->nfree0 = f;
   d->lam0 = (f > 0 && nc > 0) ? f : -1;
   if (d->lam0 >= 0) f += nc;
   d->off0 = f;
   f += (d->nodes - 2) * d->stride;
   int f1 = f;
-  for (int i = 0; i < n; i++) d->fix1[i] = p->fixed[2 * i + 1] ? -1 : f++;
+  for (int i = 0; i < n; i++) d->fix1[i] = disc_end_fixed(p, i, 1) ? -1 : f++;
   d->nfree1 = f - f1;
   d->lamL = (d->nfree1 > 0 && nc > 0) ? f : -1;
   if (d->lamL >= 0) f += nc;
@@ -173,6 +190,7 @@ cv_status cv_disc_init(cv_disc *d, const cv_problem *p, const cv_solver *s, char
   for (int r = 0; r < d->ni; r++) d->mass[d->nu0 + r] = d->b - d->a;
   d->imass = d->mass + (f ? f : 1);
   for (int k = 0; k < f; k++) d->imass[k] = 1.0 / d->mass[k];
+  if (d->herm) cv_hermite_scale_mass(d);
   return CVAR_OK;
 }
 
@@ -208,7 +226,7 @@ CV_HOT cv_status cv_disc_build_singular_rules(cv_disc *d) {
   int qlast = 0;
   cv_free(d->srule);
   d->srule = NULL;
-  if (!d->sing_a && !d->sing_b) return CVAR_OK;
+  if ((!d->sing_a && !d->sing_b) || d->herm) return CVAR_OK; /* C^1: Gauss rules only */
   d->srule = cv_malloc((size_t)d->E * per * sizeof *d->srule);
   if (!d->srule) return CVAR_ENOMEM;
   for (long e = 0; e < d->E; e++) {

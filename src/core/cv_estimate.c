@@ -8,6 +8,7 @@
 #include <stdatomic.h>
 #include <string.h>
 
+#include "cv_hermite.h"
 #include "cv_internal.h"
 
 /* Legendre P_0..P_P at s, by the three-term recurrence. */
@@ -536,7 +537,10 @@ cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p, doub
   cv_status st;
   cv_solver *f = cv_solver_new(&st);
   if (!f) return st;
-  st = cv_estimate_enriched(s, p, f, est, est_vertex, NULL, msg, len);
+  if (s->disc.herm)
+    st = cv_hermite_estimate(s, p, f, est, est_vertex, NULL, msg, len);
+  else
+    st = cv_estimate_enriched(s, p, f, est, est_vertex, NULL, msg, len);
   cv_solver_free(f);
   return st;
 }

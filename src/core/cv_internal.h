@@ -65,7 +65,16 @@ struct cv_problem {
   int ntables; /* tables added by cv_problem_add_table, each with a reference */
   char **table_name;
   cv_table **table;
+  /* Second derivatives (cv_problem_order2.c, theory H-1): order2[k] when y''_k enters; c1
+   * when any does (then every unknown uses C^1 elements, cv_hermite.c); slopes at the
+   * ends as fixed/endval are for values. NULL / 0 for a first-order problem. */
+  int c1;
+  int *order2, *sfixed;
+  double *sendval;
 };
+
+/* Release a problem's second-order arrays (cv_problem_order2.c). */
+void cv_problem_order2_free(cv_problem *p);
 
 /* ---- reference element: GLL nodes, Gauss-Legendre rule, basis tables (cv_quadrature.c) */
 typedef struct {
@@ -135,6 +144,11 @@ typedef struct {
   int *pe;          /* degree of each element */
   long *en;         /* first node of each element, E+1 entries (en[E] = nodes - 1) */
   cv_refelem *refs; /* reference element of each degree, refs[k] for k = 1..p */
+  /* C^1 elements (cv_hermite.c, theory H-2): NULL for C^0 GLL. Then n = 2 x the problem's
+   * unknowns (value and slope of each at every node, interleaved: component 2i is y_i,
+   * 2i+1 is y_i'), p = r the node degree (nodes of GLL degree r) and the element degree
+   * is 2r + 1. */
+  struct cv_hermite *herm;
 } cv_disc;
 
 /* First node, degree and reference element of element e (constant or hp). */
@@ -225,6 +239,7 @@ typedef struct {
   cv_partials out;
   int cb_status; /* last callback return value (>0 cannot evaluate, <0 abort) */
   long nevals;
+  double *hbuf; /* C^1 elements: their own batch buffers (cv_hermite_assemble.c), else NULL */
 } cv_assembler;
 
 CV_HOT cv_status cv_assembler_init(cv_assembler *as, const cv_problem *p, const cv_disc *d);

@@ -63,14 +63,30 @@ static void to_z(nl_ctx *c, double *r, double *out) {
   for (int v = 0; v < c->nv; v++) out[v] = c->dinv[c->fof[v]] * r[c->fof[v]];
 }
 
-/* Model Hessian integrand: (|y'|^2 + |y|^2 / L^2) / 2 per component, L = b - a. */
+/* Model Hessian integrand: (|y'|^2 + |y|^2 / L^2) / 2 per component, L = b - a; with y''
+ * (C^1 elements, CVAR_NEED_Y2) L^2 |y''|^2 / 2 more (H-4). */
+static void model_y2(int m, int n, double L2, unsigned need, cv_partials *o) {
+  cv_partials2 *o2 = cv_partials_y2(o);
+  for (int k = 0; k < m; k++)
+    for (int i = 0; i < n; i++) {
+      double q = o2->d2y[i * m + k];
+      o->F[k] += 0.5 * L2 * q * q;
+      if (o2->Fq) o2->Fq[i * m + k] = L2 * q;
+    }
+  for (size_t k = 0; o2->Fqq && k < (size_t)n * n * m; k++) o2->Fyq[k] = o2->Fpq[k] = 0.0;
+  for (int i = 0; o2->Fqq && i < n; i++)
+    for (int j = 0; j < n; j++)
+      for (int k = 0; k < m; k++) o2->Fqq[(i * n + j) * m + k] = i == j ? L2 : 0.0;
+  (void)need;
+}
+
 static int model_F(int m, const double *x, const double *y, const double *dy, unsigned need,
                    cv_partials *o, void *user) {
   const int *nn = user;
   int n = nn[0];
   double iL2 = 1.0 / ((double)nn[1] * 1e-6); /* nn[1] holds (b-a)^2 in micro-units */
   (void)x;
-  (void)need;
+  if (need & CVAR_NEED_Y2) n /= 2; /* d->n counts values and slopes */
   for (int k = 0; k < m; k++) {
     double s = 0.0;
     for (int i = 0; i < n; i++)
@@ -87,6 +103,7 @@ static int model_F(int m, const double *x, const double *y, const double *dy, un
         o->Fpp[(i * n + j) * m + k] = i == j ? 1.0 : 0.0;
       }
   }
+  if (need & CVAR_NEED_Y2) model_y2(m, n, 1e-6 * nn[1], need, o);
   return 0;
 }
 

@@ -67,6 +67,7 @@ void cv_problem_free(cv_problem *p) {
   cv_free(p->ic);
   cv_free(p->fixed);
   cv_free(p->endval);
+  cv_problem_order2_free(p);
   cv_free(p);
 }
 

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "cv_hermite.h"
 #include "cv_internal.h"
 
 cv_solver *cv_solver_new(cv_status *why) {
@@ -209,10 +210,14 @@ cv_status cv_solver_get_status(const cv_solver *s) { return s ? s->status : CVAR
 const char *cv_solver_last_error(const cv_solver *s) { return s ? s->msg : "solver is NULL"; }
 int cv_solver_get_num_nodes(const cv_solver *s) { return s && s->have ? s->disc.nodes : 0; }
 int cv_solver_get_num_elements(const cv_solver *s) { return s && s->have ? s->disc.E : 0; }
-int cv_solver_get_degree(const cv_solver *s) { return s && s->have ? s->disc.p : 0; }
+int cv_solver_get_degree(const cv_solver *s) {
+  return s && s->have ? s->disc.herm ? 2 * s->disc.p + 1 : s->disc.p : 0;
+}
 int cv_solver_get_degrees(const cv_solver *s, int *degrees) {
   if (!s || !s->have) return 0;
-  if (degrees)
+  if (degrees && s->disc.herm)
+    for (long e = 0; e < s->disc.E; e++) degrees[e] = 2 * s->disc.p + 1;
+  else if (degrees)
     for (long e = 0; e < s->disc.E; e++) degrees[e] = cv_disc_edeg(&s->disc, e);
   return s->disc.E;
 }
@@ -247,6 +252,7 @@ cv_status cv_solver_get_nodes(const cv_solver *s, double *x) {
 cv_status cv_solver_get_values(const cv_solver *s, double *y) {
   if (!s || !y) return CVAR_EINVAL;
   if (!s->have) return CVAR_ESTATE;
+  if (s->disc.herm) return cv_hermite_nodal(s, 0, y);
   memcpy(y, s->y, (size_t)s->disc.ndof * sizeof *y);
   return CVAR_OK;
 }
@@ -277,6 +283,7 @@ cv_status cv_solver_get_qpoints(const cv_solver *s, double *x, double *w, double
   if (!s) return CVAR_EINVAL;
   if (!s->have) return CVAR_ESTATE;
   const cv_disc *d = &s->disc;
+  if (d->herm) return cv_hermite_qpoints(s, x, w, y, dy, NULL);
   int n = d->n;
   long nq = cv_disc_num_qpoints(d), idx = 0;
   double yv[64], dv[64];
@@ -311,6 +318,7 @@ cv_status cv_solver_eval(const cv_solver *s, int m, const double *x, double *y, 
   if (!s || m < 0 || (m > 0 && (!x || !y))) return CVAR_EINVAL;
   if (!s->have) return CVAR_ESTATE;
   const cv_disc *d = &s->disc;
+  if (d->herm) return cv_hermite_eval(s, m, x, y, dy);
   int n = d->n;
   double phi[CV_MAX_DEGREE + 1], dphi[CV_MAX_DEGREE + 1];
   double *buf = cv_malloc(2 * (size_t)n * sizeof *buf);
@@ -387,3 +395,34 @@ cv_status cv_solver_set_continuation(cv_solver *s, int on) {
 }
 
 int cv_solver_get_continuation_steps(const cv_solver *s) { return s ? s->csteps : 0; }
+
+cv_status cv_solver_get_slopes(const cv_solver *s, double *dy) {
+  if (!s || !dy) return CVAR_EINVAL;
+  if (!s->have) return CVAR_ESTATE;
+  const cv_disc *d = &s->disc;
+  if (d->herm) return cv_hermite_nodal(s, 1, dy);
+  int n = d->n;
+  double phi[CV_MAX_DEGREE + 1], dphi[CV_MAX_DEGREE + 1];
+  for (long j = 0; j < d->nodes; j++) { /* from the element on the node's left */
+    long e = j == 0 ? 0 : cv_disc_node_elem(d, j - 1), j0 = cv_disc_enode(d, e);
+    int pe = cv_disc_edeg(d, e), l = (int)(j - j0);
+    const double *xi = cv_disc_eref(d, e)->xi;
+    cv_lagrange(pe, xi, xi[l > pe ? pe : l], phi, dphi);
+    double rh = 2.0 / (d->xe[e + 1] - d->xe[e]);
+    for (int i = 0; i < n; i++) {
+      double v = 0.0;
+      for (int t = 0; t <= pe; t++) v += dphi[t] * s->y[(j0 + t) * n + i];
+      dy[j * n + i] = v * rh;
+    }
+  }
+  return CVAR_OK;
+}
+
+cv_status cv_solver_get_qpoints2(const cv_solver *s, double *x, double *w, double *y, double *dy,
+                                 double *d2y) {
+  if (!s) return CVAR_EINVAL;
+  if (!s->have) return CVAR_ESTATE;
+  if (s->disc.herm) return cv_hermite_qpoints(s, x, w, y, dy, d2y);
+  if (d2y) return CVAR_EINVAL;
+  return cv_solver_get_qpoints(s, x, w, y, dy);
+}

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "cv_hermite.h"
 #include "cv_internal.h"
 
 /* The default start at fraction t of the interval: the straight line between the end
@@ -51,6 +52,7 @@ static __attribute__((noinline)) cv_status guess_values(cv_solver *s, const cv_p
 cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y,
                           int line) {
   int n = p->n;
+  if (d->herm) return cv_hermite_start_values(s, p, d, Y, line);
   if (s->start && !line) {
     if (s->start_len != d->ndof) {
       cv_set_msg(s->msg, sizeof s->msg,
@@ -151,7 +153,7 @@ cv_status cv_start_setup(cv_solver *s, const cv_problem *p) {
   st = cv_start_values(s, p, &s->disc, s->y, 0);
   if (st) return st;
   s->have = 1;
-  detect_singular_ends(p, &s->disc, s->y);
+  if (!s->disc.herm) detect_singular_ends(p, &s->disc, s->y); /* C^1: Gauss rules only */
   s->disc.sing_a |= s->near_sing[0];
   s->disc.sing_b |= s->near_sing[1];
   st = cv_disc_build_singular_rules(&s->disc);
@@ -246,7 +248,7 @@ CV_HOT static double rule_gap(const cv_problem *p, const cv_disc *d, const doubl
 CV_HOT int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
                                    double action, double *rel) {
   *rel = 0.0;
-  if (end ? d->sing_b : d->sing_a) return 0;
+  if ((end ? d->sing_b : d->sing_a) || d->herm) return 0; /* C^1: Gauss rules only */
   long e = end ? d->E - 1 : 0, e1 = end ? d->E - 2 : 1;
   int q = d->ref.qs > d->ref.q ? d->ref.qs : d->ref.q;
   /* The points of one element: on the stack for one or a few unknowns (the check of every

@@ -51,8 +51,8 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
     }
     slot = 0;
   }
-  for (int i = 0; i < c->n && slot < 0; i++)
-    if (strcmp(name, c->unk[i]) == 0) slot = 1 + i + (primes ? c->n : 0);
+  for (int i = 0; i < c->n && slot < 0; i++) /* y'' after y': slot 1 + 2n + i */
+    if (strcmp(name, c->unk[i]) == 0) slot = 1 + i + primes * c->n;
   if (slot < 0) { /* the nearest name usable here, if a slip away (ex_name_close) */
     ex_nearest nr = {NULL, 0};
     ex_name_consider(&nr, name, c->var);
@@ -194,7 +194,8 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
   }
   c.const_only = 0;
   c.np = np;
-  ex_id f = ex_parse(d, F, resolve, &c, 0, perr, sizeof perr);
+  /* y'' in an integrand or an integral: a second-order problem (theory H-1) */
+  ex_id f = ex_parse(d, F, resolve, &c, kind != FORMULA_CONSTRAINT, perr, sizeof perr);
   if (f < 0) {
     msg(err, errlen, "%s: %s", what, perr);
     goto cleanup;
@@ -210,8 +211,14 @@ static cv_status compile(cv_problem *p, const char *variable, const char *unknow
     msg(err, errlen, "integral: the constant is not a finite number");
     goto cleanup;
   }
-  ex_integrand *g =
-      ex_integrand_new(d, c.n, f, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, perr, sizeof perr);
+  int order = 1;
+  for (int i = 0; i < c.n; i++)
+    if (ex_depends_on(d, f, 1 + 2 * c.n + i)) {
+      order = 2;
+      if ((st = cv_problem_set_second_order(p, i)) != CVAR_OK) goto nomem;
+    }
+  ex_integrand *g = ex_integrand_new_order(
+      d, c.n, 0, order, f, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, perr, sizeof perr);
   if (!g) {
     msg(err, errlen, "%s: %s", what, perr);
     st = CVAR_ENOMEM;

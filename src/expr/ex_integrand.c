@@ -9,6 +9,7 @@
 struct ex_integrand {
   int n;
   int np;              /* parameters: tape slots 2n+1 .. 2n+np */
+  int n2;              /* n for a second-order F (y''_i is slot 1+2n+np+i, X-7), else 0 */
   int owns_tapes;      /* 0 for a clone (ex_integrand_clone) */
   double *pbuf;        /* np batches, each filled with one parameter's value ... */
   int pfill;           /* ... in its first pfill points (filled as evaluations need) */
@@ -40,10 +41,10 @@ static int alloc_buffers(ex_integrand *g) {
       size_t w = ex_tape_work_size(g->tape[l], EX_INTEGRAND_BATCH);
       if (w > work) work = w;
     }
-  int nout = g->nout[2] ? g->nout[2] : g->nout[1] ? g->nout[1] : 1;
+  int nout = g->tape[2] ? g->nout[2] : g->tape[1] ? g->nout[1] : 1;
   g->work = cv_malloc((work ? work : 1) * sizeof *g->work);
   g->scratch = cv_malloc((size_t)nout * EX_INTEGRAND_BATCH * sizeof *g->scratch);
-  g->in = cv_malloc((size_t)(2 * g->n + 1 + g->np) * sizeof *g->in);
+  g->in = cv_malloc((size_t)(2 * g->n + 1 + g->np + g->n2) * sizeof *g->in);
   g->outp = cv_malloc((size_t)nout * sizeof *g->outp);
   g->pbuf = cv_calloc((size_t)(g->np ? g->np : 1) * EX_INTEGRAND_BATCH, sizeof *g->pbuf);
   g->pval = cv_calloc((size_t)g->np + 1, sizeof *g->pval);
@@ -100,52 +101,75 @@ void ex_integrand_set_param(ex_integrand *g, int j, double v) {
 
 ex_integrand *ex_integrand_new_params(ex_dag *d, int n, int np, ex_id F, unsigned max_need,
                                       char *err, size_t errlen) {
-  if (!d || n < 1 || np < 0 || F < 0 || F >= ex_dag_num_nodes(d) || n > 1000) {
+  return ex_integrand_new_order(d, n, np, 1, F, max_need, err, errlen);
+}
+
+/* The outputs of level 1 and 2 (X-4, X-7): F; Fy, Fp (and Fq); then Fyy (upper), Fyp, Fpp
+ * (upper) (and Fyq, Fpq, Fqq (upper)). Returns 0 or -1 out of memory. */
+static int partials(ex_dag *d, int n, int n2, int np, int level, ex_id *outs) {
+  int ntri = n * (n + 1) / 2, q0 = 1 + 2 * n + np;
+  int n1 = n2 ? 3 : 2; /* first partials per unknown */
+  if (level >= 1)
+    for (int i = 0; i < n; i++) {
+      outs[1 + i] = ex_diff(d, outs[0], 1 + i);
+      outs[1 + n + i] = ex_diff(d, outs[0], 1 + n + i);
+      if (n2) outs[1 + 2 * n + i] = ex_diff(d, outs[0], q0 + i);
+      if (outs[1 + i] < 0 || outs[1 + n + i] < 0 || (n2 && outs[1 + 2 * n + i] < 0)) return -1;
+    }
+  if (level < 2) return 0;
+  ex_id *yy = outs + 1 + n1 * n, *yp = yy + ntri, *pp = yp + n * n;
+  ex_id *yq = pp + ntri, *pq = yq + n * n, *qq = pq + n * n;
+  for (int i = 0; i < n; i++) {
+    ex_id Fy = outs[1 + i], Fp = outs[1 + n + i], Fq = n2 ? outs[1 + 2 * n + i] : -1;
+    for (int j = 0; j < n; j++) {
+      if (j >= i) {
+        yy[tri(n, i, j)] = ex_diff(d, Fy, 1 + j);
+        pp[tri(n, i, j)] = ex_diff(d, Fp, 1 + n + j);
+        if (yy[tri(n, i, j)] < 0 || pp[tri(n, i, j)] < 0) return -1;
+        if (n2 && (qq[tri(n, i, j)] = ex_diff(d, Fq, q0 + j)) < 0) return -1;
+      }
+      yp[i * n + j] = ex_diff(d, Fy, 1 + n + j); /* d2F / dy_i dy'_j */
+      if (yp[i * n + j] < 0) return -1;
+      if (n2 && ((yq[i * n + j] = ex_diff(d, Fy, q0 + j)) < 0 ||
+                 (pq[i * n + j] = ex_diff(d, Fp, q0 + j)) < 0))
+        return -1;
+    }
+  }
+  return 0;
+}
+
+ex_integrand *ex_integrand_new_order(ex_dag *d, int n, int np, int order, ex_id F,
+                                     unsigned max_need, char *err, size_t errlen) {
+  if (!d || n < 1 || np < 0 || F < 0 || F >= ex_dag_num_nodes(d) || n > 1000 ||
+      (order != 1 && order != 2)) {
     set_err(err, errlen, "invalid argument to ex_integrand_new");
     return NULL;
   }
-  int ntri = n * (n + 1) / 2;
+  int n2 = order == 2 ? n : 0, ntri = n * (n + 1) / 2;
   int level = max_need & CVAR_NEED_HESS ? 2 : max_need & CVAR_NEED_GRAD ? 1 : 0;
-  int nout = level == 2 ? 1 + 2 * n + 2 * ntri + n * n : level == 1 ? 1 + 2 * n : 1;
+  int nout1 = 1 + (n2 ? 3 : 2) * n, nout2 = nout1 + 2 * ntri + n * n;
+  if (n2) nout2 += ntri + 2 * n * n;
+  int nout = level == 2 ? nout2 : level == 1 ? nout1 : 1;
   ex_integrand *g = cv_calloc(1, sizeof *g);
   ex_id *outs = cv_malloc((size_t)nout * sizeof *outs);
   if (!g || !outs) goto nomem;
   g->n = n;
   g->np = np;
+  g->n2 = n2;
   g->owns_tapes = 1;
   /* the partials read no slot that F does not */
   if (!(g->used = cv_calloc((size_t)np + 1, 1))) goto nomem;
   for (int j = 0; j < np; j++) g->used[j] = (unsigned char)ex_depends_on(d, F, 1 + 2 * n + j);
-  g->max_need = max_need | CVAR_NEED_F;
+  g->max_need = max_need | CVAR_NEED_F | (n2 ? CVAR_NEED_Y2 : 0u);
   for (int i = 0; i < n; i++) g->depends_on_dy |= ex_depends_on(d, F, 1 + n + i);
+  for (int i = 0; i < n2; i++) g->depends_on_dy |= ex_depends_on(d, F, 1 + 2 * n + np + i);
   outs[0] = F;
-  if (level >= 1) {
-    for (int i = 0; i < n; i++) {
-      outs[1 + i] = ex_diff(d, F, 1 + i);
-      outs[1 + n + i] = ex_diff(d, F, 1 + n + i);
-      if (outs[1 + i] < 0 || outs[1 + n + i] < 0) goto nomem;
-    }
-  }
-  if (level == 2) {
-    ex_id *yy = outs + 1 + 2 * n, *yp = yy + ntri, *pp = yp + n * n;
-    for (int i = 0; i < n; i++) {
-      ex_id Fy = outs[1 + i], Fp = outs[1 + n + i];
-      for (int j = 0; j < n; j++) {
-        if (j >= i) {
-          yy[tri(n, i, j)] = ex_diff(d, Fy, 1 + j);
-          pp[tri(n, i, j)] = ex_diff(d, Fp, 1 + n + j);
-          if (yy[tri(n, i, j)] < 0 || pp[tri(n, i, j)] < 0) goto nomem;
-        }
-        yp[i * n + j] = ex_diff(d, Fy, 1 + n + j); /* d2F / dy_i dy'_j */
-        if (yp[i * n + j] < 0) goto nomem;
-      }
-    }
-  }
+  if (partials(d, n, n2, np, level, outs) < 0) goto nomem;
   g->nout[0] = 1;
-  g->nout[1] = 1 + 2 * n;
-  g->nout[2] = nout;
+  g->nout[1] = nout1;
+  g->nout[2] = nout2;
   for (int l = 0; l <= level; l++) {
-    g->tape[l] = ex_tape_new(d, 2 * n + 1 + np, g->nout[l], outs);
+    g->tape[l] = ex_tape_new(d, 2 * n + 1 + np + n2, g->nout[l], outs);
     if (!g->tape[l]) goto nomem;
   }
   if (alloc_buffers(g) < 0) goto nomem;
@@ -197,12 +221,44 @@ static double *dest(ex_integrand *g, double *buf, size_t offset, int o) {
   return buf ? buf + offset : g->scratch + (size_t)o * EX_INTEGRAND_BATCH;
 }
 
-/* Evaluate the smallest tape covering `need` into the given buffers (NULL: not wanted). */
+/* The caller's output buffers of one evaluation (NULL: not wanted). */
+typedef struct {
+  double *F, *Fy, *Fp, *Fyy, *Fyp, *Fpp, *Fq, *Fyq, *Fpq, *Fqq;
+} outbufs;
+
+/* Point the tape's outputs of level `level` at the buffers (offset k0, M points). */
+static void set_outputs(ex_integrand *g, int level, const outbufs *b, size_t M, int k0) {
+  int n = g->n, o;
+  g->outp[0] = dest(g, b->F, (size_t)k0, 0);
+  if (level < 1) return;
+  for (int i = 0; i < n; i++) {
+    g->outp[1 + i] = dest(g, b->Fy, i * M + k0, 1 + i);
+    g->outp[1 + n + i] = dest(g, b->Fp, i * M + k0, 1 + n + i);
+    if (g->n2) g->outp[1 + 2 * n + i] = dest(g, b->Fq, i * M + k0, 1 + 2 * n + i);
+  }
+  if (level < 2) return;
+  o = 1 + (g->n2 ? 3 : 2) * n;
+  for (int i = 0; i < n; i++)
+    for (int j = i; j < n; j++, o++) g->outp[o] = dest(g, b->Fyy, (i * n + j) * M + k0, o);
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++, o++) g->outp[o] = dest(g, b->Fyp, (i * n + j) * M + k0, o);
+  for (int i = 0; i < n; i++)
+    for (int j = i; j < n; j++, o++) g->outp[o] = dest(g, b->Fpp, (i * n + j) * M + k0, o);
+  if (!g->n2) return;
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++, o++) g->outp[o] = dest(g, b->Fyq, (i * n + j) * M + k0, o);
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++, o++) g->outp[o] = dest(g, b->Fpq, (i * n + j) * M + k0, o);
+  for (int i = 0; i < n; i++)
+    for (int j = i; j < n; j++, o++) g->outp[o] = dest(g, b->Fqq, (i * n + j) * M + k0, o);
+}
+
+/* Evaluate the smallest tape covering `need` into the given buffers; d2y: y'' (NULL for a
+ * first-order F). */
 static int eval_into(ex_integrand *g, int m, const double *x, const double *y, const double *dy,
-                     unsigned need, double *F, double *Fy, double *Fp, double *Fyy, double *Fyp,
-                     double *Fpp) {
+                     const double *d2y, unsigned need, const outbufs *b) {
   int level = need & CVAR_NEED_HESS ? 2 : need & CVAR_NEED_GRAD ? 1 : 0;
-  if (!g->tape[level]) return -1;
+  if (!g->tape[level] || (g->n2 && !d2y)) return -1;
   int n = g->n;
   size_t M = (size_t)m;
   fill_params(g, m < EX_INTEGRAND_BATCH ? m : EX_INTEGRAND_BATCH);
@@ -213,22 +269,8 @@ static int eval_into(ex_integrand *g, int m, const double *x, const double *y, c
       g->in[1 + i] = y + i * M + k0;
       g->in[1 + n + i] = dy ? dy + i * M + k0 : NULL; /* NULL: a constraint G(x, y) */
     }
-    g->outp[0] = dest(g, F, (size_t)k0, 0);
-    if (level >= 1) {
-      for (int i = 0; i < n; i++) {
-        g->outp[1 + i] = dest(g, Fy, i * M + k0, 1 + i);
-        g->outp[1 + n + i] = dest(g, Fp, i * M + k0, 1 + n + i);
-      }
-    }
-    if (level == 2) {
-      int o = 1 + 2 * n;
-      for (int i = 0; i < n; i++)
-        for (int j = i; j < n; j++, o++) g->outp[o] = dest(g, Fyy, (i * n + j) * M + k0, o);
-      for (int i = 0; i < n; i++)
-        for (int j = 0; j < n; j++, o++) g->outp[o] = dest(g, Fyp, (i * n + j) * M + k0, o);
-      for (int i = 0; i < n; i++)
-        for (int j = i; j < n; j++, o++) g->outp[o] = dest(g, Fpp, (i * n + j) * M + k0, o);
-    }
+    for (int i = 0; i < g->n2; i++) g->in[1 + 2 * n + g->np + i] = d2y + i * M + k0;
+    set_outputs(g, level, b, M, k0);
     ex_tape_eval(g->tape[level], mm, g->in, g->outp, g->work);
     /* A table met a point outside its grid: "cannot evaluate here" (the line search
      * shortens the step), and the note names the table. */
@@ -237,8 +279,9 @@ static int eval_into(ex_integrand *g, int m, const double *x, const double *y, c
   /* Symmetric blocks: the lower triangle is a copy of the upper. */
   for (int i = 0; i < n; i++)
     for (int j = 0; j < i; j++) {
-      if (Fyy) memcpy(Fyy + (i * n + j) * M, Fyy + (j * n + i) * M, M * sizeof *Fyy);
-      if (Fpp) memcpy(Fpp + (i * n + j) * M, Fpp + (j * n + i) * M, M * sizeof *Fpp);
+      if (b->Fyy) memcpy(b->Fyy + (i * n + j) * M, b->Fyy + (j * n + i) * M, M * sizeof *b->Fyy);
+      if (b->Fpp) memcpy(b->Fpp + (i * n + j) * M, b->Fpp + (j * n + i) * M, M * sizeof *b->Fpp);
+      if (b->Fqq) memcpy(b->Fqq + (i * n + j) * M, b->Fqq + (j * n + i) * M, M * sizeof *b->Fqq);
     }
   return 0;
 }
@@ -248,16 +291,45 @@ int ex_integrand_eval(int m, const double *x, const double *y, const double *dy,
   ex_integrand *g = user;
   if (!g || !out || m < 1) return -1;
   int grad = (need & CVAR_NEED_GRAD) != 0, hess = (need & CVAR_NEED_HESS) != 0;
-  return eval_into(g, m, x, y, dy, need, need & CVAR_NEED_F ? out->F : NULL, grad ? out->Fy : NULL,
-                   grad ? out->Fp : NULL, hess ? out->Fyy : NULL, hess ? out->Fyp : NULL,
-                   hess ? out->Fpp : NULL);
+  outbufs b = {need & CVAR_NEED_F ? out->F : NULL,
+               grad ? out->Fy : NULL,
+               grad ? out->Fp : NULL,
+               hess ? out->Fyy : NULL,
+               hess ? out->Fyp : NULL,
+               hess ? out->Fpp : NULL,
+               NULL,
+               NULL,
+               NULL,
+               NULL};
+  const double *d2y = NULL;
+  if (need & CVAR_NEED_Y2) { /* out is the d1 member of a cv_partials2 (calcvar.h) */
+    cv_partials2 *o2 = cv_partials_y2(out);
+    d2y = o2->d2y;
+    if (g->n2) {
+      b.Fq = grad ? o2->Fq : NULL;
+      b.Fyq = hess ? o2->Fyq : NULL, b.Fpq = hess ? o2->Fpq : NULL, b.Fqq = hess ? o2->Fqq : NULL;
+    } else { /* a first-order F in a second-order problem: its partials in y'' are 0 */
+      size_t l1 = (size_t)g->n * m, l2 = l1 * g->n;
+      for (size_t k = 0; grad && k < l1; k++) o2->Fq[k] = 0.0;
+      for (size_t k = 0; hess && k < l2; k++) o2->Fyq[k] = o2->Fpq[k] = o2->Fqq[k] = 0.0;
+    }
+  }
+  return eval_into(g, m, x, y, dy, d2y, need, &b);
 }
 
 int ex_integrand_eval_constraint(int m, const double *x, const double *y, unsigned need, double *G,
                                  double *Gy, double *Gyy, void *user) {
   ex_integrand *g = user;
   if (!g || m < 1 || g->depends_on_dy) return -1;
-  return eval_into(g, m, x, y, NULL, need, need & CVAR_NEED_F ? G : NULL,
-                   need & CVAR_NEED_GRAD ? Gy : NULL, NULL, need & CVAR_NEED_HESS ? Gyy : NULL,
-                   NULL, NULL);
+  outbufs b = {need & CVAR_NEED_F ? G : NULL,
+               need & CVAR_NEED_GRAD ? Gy : NULL,
+               NULL,
+               need & CVAR_NEED_HESS ? Gyy : NULL,
+               NULL,
+               NULL,
+               NULL,
+               NULL,
+               NULL,
+               NULL};
+  return eval_into(g, m, x, y, NULL, NULL, need, &b);
 }

@@ -34,6 +34,14 @@ ex_integrand *ex_integrand_new(ex_dag *d, int n, ex_id F, unsigned max_need, cha
 ex_integrand *ex_integrand_new_params(ex_dag *d, int n, int np, ex_id F, unsigned max_need,
                                       char *err, size_t errlen);
 
+/* The same for an integrand of order 1 (as above) or 2 (theory X-7): F may read y''_i at
+ * slot 1+2n+np+i, and the object evaluates with CVAR_NEED_Y2 only (out is then the d1 of
+ * a cv_partials2; the partials in y'' are filled as the groups ask). A first-order object
+ * called with CVAR_NEED_Y2 (an integral constraint without y'' in a second-order problem)
+ * writes exact zeros for its partials in y''. */
+ex_integrand *ex_integrand_new_order(ex_dag *d, int n, int np, int order, ex_id F,
+                                     unsigned max_need, char *err, size_t errlen);
+
 /* A second evaluator over the same compiled tapes: its own work buffers and parameter
  * values, the tapes shared read-only (so one object per thread, compiled once). The
  * clone must be freed before the object it was cloned from. NULL on allocation failure. */

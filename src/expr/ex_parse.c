@@ -241,6 +241,9 @@ static ex_id parse_name(parser *p) {
     }
     return parse_call(p, f, at);
   }
+  if (primes > 2 && p->allow_second)
+    return fail(p, at, "%s%.*s: at most the second derivative %s'' may be written", name,
+                primes > 16 ? 16 : primes, "''''''''''''''''", name);
   if (primes > 2 || (primes == 2 && !p->allow_second))
     return fail(p, at, "%s%.*s: only the first derivative %s' may be written here", name, primes,
                 "''''''''''''''''", name);

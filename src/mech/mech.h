@@ -34,6 +34,7 @@ typedef struct {
   const char *const *int_names;  /* [nints] */
   const double *start;           /* [n]: Newton's start for the equilibrium (modes only) */
   double start_x;                /* the variable there (modes: L and G do not depend on it) */
+  int order2; /* F (and the K_r) may read y''_i at slot 2n+1+i: a second-order Lagrangian */
 } mech_problem;
 
 /** Which entry a failure is about (for the caller's FILE:LINE). */
@@ -64,6 +65,13 @@ typedef struct {
   ex_id hamiltonian; /* H = sum_i y'_i p_i - F                                    (P-5) */
   int *cyclic;       /* [n]: F does not depend on y_i, so p_i is conserved         (P-7) */
   int autonomous;    /* F does not depend on the variable, so H is conserved       (P-6) */
+  /* A second-order Lagrangian (mp->order2, theory P-14): slots y'''_i and y''''_i after
+   * the multipliers' (names "y'''", "y''''"); momentum[i] is Ostrogradsky's first
+   * p_i = F_y'_i - d/dx F_y''_i, momentum2[i] the second q_i = F_y''_i; H = sum_i
+   * (y'_i p_i + y''_i q_i) - F; E_i = d/dx F_y' - F_y - d2/dx2 F_y'' (sign as above, by
+   * the coefficient of y''''_i). momentum2 is NULL for a first-order F. */
+  ex_id *momentum2;
+  ex_id F; /* the integrand in these slots */
 } mech_equations;
 
 /** Build the equations. E_i = d/dx p_i - dF/dy_i (- sum_c lambda_c dG_c/dy_i

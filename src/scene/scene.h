@@ -120,7 +120,17 @@ typedef struct scene {
   /* [plot] (an addition, docs/scenes.md): slots 0 = the variable, 1..n = the unknowns */
   int plot_path[2]; /* path = U, V: V drawn against U; -1, -1 when not given */
   int *plot_down;   /* [n + 1]: nonzero for a name drawn increasing downward */
+  /* Second derivatives (scene_order2.c): y''_i is slot sc_d2_slot(s, i) of every
+   * expression; order2[i] when it appears anywhere (then the problem is second order and
+   * every unknown uses C^1 elements, c1 = 1); sbc[i] the slope line `y' = a, b` (line 0:
+   * none, both slopes free). */
+  int c1;
+  int *order2;      /* [n] */
+  sc_boundary *sbc; /* [n] */
 } scene;
+
+/* The slot of y''_i: after the parameters and the smoothing width. */
+static inline int sc_d2_slot(const scene *s, int i) { return 2 + 2 * s->n + s->nparams + i; }
 
 /** Load a scene file. `name` for messages is the path itself; the path "-" reads standard
  * input, named "<stdin>" in messages (read once; later loads of "-" in the process reuse
@@ -212,5 +222,8 @@ int scene_eval_guess(const scene *s, int m, const double *x, double *y);
 /** K_r at m points: out[r*m + k] for each [report] entry r. */
 int scene_eval_reports(scene *s, int m, const double *x, const double *y, const double *dy,
                        double *out);
+/** The same with y'' (d2y[i*m + k]), for a scene with second derivatives. */
+int scene_eval_reports2(scene *s, int m, const double *x, const double *y, const double *dy,
+                        const double *d2y, double *out);
 
 #endif /* CV_SCENE_H */

@@ -42,6 +42,7 @@ static void worker_free(cv_batch *b, worker *w) {
   cv_free(w->qw);
   cv_free(w->qy);
   cv_free(w->qdy);
+  cv_free(w->qd2y);
   cv_free(w->qv);
   cv_free(w->prev);
   cv_free(w->prev_end);
@@ -145,8 +146,12 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen) {
     for (int i = 0; i < s->n && !b->guess_used[j]; i++)
       b->guess_used[j] = s->guess[i] >= 0 && ex_depends_on(s->dag, s->guess[i], slot);
   }
-  /* Compile once: every expression of the problem with the parameters as inputs. */
-  if (!(b->F = ex_integrand_new_params(s->dag, s->n, b->np, s->F, b->need, msg, sizeof msg))) {
+  /* Compile once: every expression of the problem with the parameters as inputs (y'' after
+   * them and the width's slot, X-7). */
+  if (!(b->F =
+            s->c1
+                ? ex_integrand_new_order(s->dag, s->n, b->np + 1, 2, s->F, b->need, msg, sizeof msg)
+                : ex_integrand_new_params(s->dag, s->n, b->np, s->F, b->need, msg, sizeof msg))) {
     snprintf(err, errlen, "%s:%d: integrand: %s", s->file, s->F_line,
              msg[0] ? msg : "out of memory");
     goto fail;
@@ -159,8 +164,10 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen) {
       goto fail;
     }
   for (int k = 0; k < s->nints; k++)
-    if (!(b->ints[k] = ex_integrand_new_params(s->dag, s->n, b->np, s->ints[k].expr, b->need, msg,
-                                               sizeof msg))) {
+    if (!(b->ints[k] = s->c1 ? ex_integrand_new_order(s->dag, s->n, b->np + 1, 2, s->ints[k].expr,
+                                                      b->need, msg, sizeof msg)
+                             : ex_integrand_new_params(s->dag, s->n, b->np, s->ints[k].expr,
+                                                       b->need, msg, sizeof msg))) {
       snprintf(err, errlen, "%s:%d: [integrals] %s: %s", s->file, s->ints[k].line, s->ints[k].name,
                msg[0] ? msg : "out of memory");
       goto fail;
@@ -169,7 +176,8 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen) {
     ex_id *outs = cv_malloc((size_t)s->nreports * sizeof *outs);
     if (!outs) goto nomem;
     for (int r = 0; r < s->nreports; r++) outs[r] = s->reports[r].expr;
-    b->rep = ex_tape_new(s->dag, 1 + 2 * s->n + b->np, s->nreports, outs);
+    b->rep =
+        ex_tape_new(s->dag, s->c1 ? sc_d2_slot(s, s->n) : 1 + 2 * s->n + b->np, s->nreports, outs);
     cv_free(outs);
     if (!b->rep) goto nomem;
   }

@@ -19,6 +19,7 @@ typedef struct {
   double *tw, *pb; /* report tape work; parameter batches */
   size_t cap;      /* quadrature points the buffers below hold */
   double *qx, *qw, *qy, *qdy, *qv;
+  double *qd2y; /* y'' at the quadrature points (second-order scenes), else NULL */
   double *prev; /* warm start: last converged nodal values */
   int prev_len, prev_row;
   double *prev_end; /* its end values [2n] */

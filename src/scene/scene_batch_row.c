@@ -89,6 +89,12 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
       bad = (s->bc[i].free_end[end]
                  ? cv_problem_set_free_end(p, i, end)
                  : cv_problem_set_end_value(p, i, end, s->bc[i].value[end])) != CVAR_OK;
+  for (int i = 0; i < s->n && !bad && s->c1; i++) { /* second order: C1 elements, slopes */
+    bad = s->order2[i] && cv_problem_set_second_order(p, i) != CVAR_OK;
+    for (int end = 0; end < 2 && !bad && s->sbc && s->sbc[i].line; end++)
+      bad = !s->sbc[i].free_end[end] &&
+            cv_problem_set_end_slope(p, i, end, s->sbc[i].value[end]) != CVAR_OK;
+  }
   for (int k = 0; k < s->ncons && !bad; k++) {
     ex_integrand_set_params(w->cons[k], w->pv);
     bad = cv_problem_add_constraint(p, ex_integrand_eval_constraint, w->cons[k], NULL) != CVAR_OK ||
@@ -162,17 +168,20 @@ static int eval_reports(const cv_batch *b, worker *w, double *out) {
   size_t q = (size_t)nq;
   if (q > w->cap) {
     cv_free(w->qx), cv_free(w->qw), cv_free(w->qy), cv_free(w->qdy), cv_free(w->qv);
+    cv_free(w->qd2y);
+    w->qd2y = s->c1 ? cv_malloc(q * n * sizeof *w->qd2y) : NULL;
     w->qx = cv_malloc(q * sizeof *w->qx);
     w->qw = cv_malloc(q * sizeof *w->qw);
     w->qy = cv_malloc(q * n * sizeof *w->qy);
     w->qdy = cv_malloc(q * n * sizeof *w->qdy);
     w->qv = cv_malloc((size_t)QBATCH * s->nreports * sizeof *w->qv);
-    w->cap = w->qx && w->qw && w->qy && w->qdy && w->qv ? q : 0;
+    w->cap = w->qx && w->qw && w->qy && w->qdy && w->qv && (!s->c1 || w->qd2y) ? q : 0;
     if (!w->cap) return -1;
   }
-  if (cv_solver_get_qpoints(w->sv, w->qx, w->qw, w->qy, w->qdy) != CVAR_OK) return -1;
-  int ns = 1 + 2 * n + np;
+  if (cv_solver_get_qpoints2(w->sv, w->qx, w->qw, w->qy, w->qdy, w->qd2y) != CVAR_OK) return -1;
+  int ns = s->c1 ? sc_d2_slot(s, n) : 1 + 2 * n + np;
   const double *in[ns];
+  for (int k = 0; k < ns; k++) in[k] = NULL;
   double *o[s->nreports];
   fill_params(w, nq, b->rep_used);
   for (int j = 0; j < np; j++) in[1 + 2 * n + j] = w->pb + (size_t)j * QBATCH;
@@ -186,6 +195,7 @@ static int eval_reports(const cv_batch *b, worker *w, double *out) {
     for (int i = 0; i < n; i++) {
       in[1 + i] = w->qy + (size_t)i * q + k0;
       in[1 + n + i] = w->qdy + (size_t)i * q + k0;
+      if (s->c1) in[sc_d2_slot(s, i)] = w->qd2y + (size_t)i * q + k0;
     }
     ex_tape_eval(b->rep, m, in, o, w->tw);
     for (int r = 0; r < s->nreports; r++)

@@ -15,10 +15,16 @@ enum { BATCH = 256 };
  * are computed once. */
 int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const double *x,
                   const double *y, const double *dy, double *out) {
+  return sc_eval_exprs2(s, nout, outs, m, x, y, dy, NULL, out);
+}
+
+int sc_eval_exprs2(const scene *s, int nout, const ex_id *outs, int m, const double *x,
+                   const double *y, const double *dy, const double *d2y, double *out) {
   int n = s->n, np = s->params_as_inputs ? s->nparams : 0, ns = 1 + 2 * n + np, rc = -1;
+  if (s->c1) ns = sc_d2_slot(s, n); /* y'' after the parameters and the width */
   if (nout == 0 || m == 0) return 0;
   ex_tape *t = ex_tape_new(s->dag, ns, nout, outs);
-  const double **in = cv_malloc((size_t)ns * sizeof *in);
+  const double **in = cv_calloc((size_t)ns, sizeof *in);
   double **o = cv_malloc((size_t)nout * sizeof *o);
   double *work = t ? cv_malloc((ex_tape_work_size(t, BATCH) + 1) * sizeof *work) : NULL;
   /* parameters as inputs: one batch per parameter filled with its value */
@@ -34,6 +40,7 @@ int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const doub
     for (int i = 0; i < n; i++) {
       in[1 + i] = y ? y + (size_t)i * m + k0 : NULL;
       in[1 + n + i] = dy ? dy + (size_t)i * m + k0 : NULL;
+      if (s->c1) in[sc_d2_slot(s, i)] = d2y ? d2y + (size_t)i * m + k0 : NULL;
     }
     for (int q = 0; q < nout; q++) o[q] = out + (size_t)q * m + k0;
     ex_tape_eval(t, b, (const double *const *)in, (double *const *)o, work);
@@ -91,11 +98,16 @@ int scene_F_depends_on_unknown(const scene *s, int i) { return ex_depends_on(s->
 
 int scene_eval_reports(scene *s, int m, const double *x, const double *y, const double *dy,
                        double *out) {
+  return scene_eval_reports2(s, m, x, y, dy, NULL, out);
+}
+
+int scene_eval_reports2(scene *s, int m, const double *x, const double *y, const double *dy,
+                        const double *d2y, double *out) {
   int nr = s->nreports, rc;
   ex_id *outs = cv_malloc((size_t)(nr + 1) * sizeof *outs);
   if (!outs) return -1;
   for (int r = 0; r < nr; r++) outs[r] = s->reports[r].expr;
-  rc = sc_eval_exprs(s, nr, outs, m, x, y, dy, out);
+  rc = sc_eval_exprs2(s, nr, outs, m, x, y, dy, d2y, out);
   cv_free(outs);
   return rc;
 }

@@ -105,6 +105,7 @@ typedef struct {
   size_t errlen;
   sc_rmode mode; /* what names resolve: parameters only, or everything */
   int limit;     /* parameters (SC_R_PARAM) or definitions (SC_R_FULL) usable: index < limit */
+  int second;    /* the value being parsed may use y'' (sc_parse) */
 } sc_loader;
 
 /* scene_parse.c */
@@ -121,6 +122,13 @@ int sc_eval_params(const scene *s, ex_id e, double *value);
 const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap);
 int sc_first_slot(const scene *s, ex_id e, int from, int to);
 
+/* scene_order2.c: which unknowns are second order; slope lines checked against them. */
+int sc_load_order2(sc_loader *L);
+/* A slope line `y' = a, b` of [boundary] (entry e, unknown k): parsed into s->sbc[k]. */
+int sc_load_slope_line(sc_loader *L, const sc_entry *e, int k);
+/* Whether e reads some y''; the first such unknown's index in *which (may be NULL). */
+int sc_uses_second(const scene *s, ex_id e, int *which);
+
 /* scene_load.c: a new name (identifier, not reserved, not taken; `role` for the message). */
 int sc_check_new_name(sc_loader *L, int line, const char *name, const char *role);
 
@@ -130,6 +138,9 @@ int sc_load_tables(sc_loader *L);
 struct cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t errlen);
 
 /* scene_eval.c */
+/* The same with y'' (d2y[i*m + k]; NULL where no expression reads it). */
+int sc_eval_exprs2(const scene *s, int nout, const ex_id *outs, int m, const double *x,
+                   const double *y, const double *dy, const double *d2y, double *out);
 int sc_eval_exprs(const scene *s, int nout, const ex_id *outs, int m, const double *x,
                   const double *y, const double *dy, double *out);
 

@@ -50,6 +50,8 @@ void scene_free(scene *s) {
   items_free(s->ints, s->nints);
   items_free(s->reports, s->nreports);
   cv_free(s->breakpoints);
+  cv_free(s->order2);
+  cv_free(s->sbc);
   ex_dag_free(s->dag);
   cv_free(s);
 }
@@ -319,7 +321,7 @@ static scene *load_buffer(const char *text, size_t len, const char *name, int ns
       load_definitions(&L) < 0 || load_interval_integrand(&L) < 0 || sc_load_boundary(&L) < 0 ||
       sc_load_guess_exact(&L) < 0 || sc_load_constraints(&L) < 0 || sc_load_ends(&L) < 0 ||
       sc_load_report(&L) < 0 || sc_load_mesh(&L) < 0 || sc_load_solver(&L) < 0 ||
-      sc_load_plot(&L) < 0) {
+      sc_load_plot(&L) < 0 || sc_load_order2(&L) < 0) {
     sc_raw_free(&L.raw);
     scene_free(s);
     return NULL;

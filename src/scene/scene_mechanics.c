@@ -21,6 +21,13 @@ static void adapter_free(adapter *a) {
   cv_free(a->start);
 }
 
+/* e with the scene's y''_i slots moved to mech's 2n+1+i (mech.h); -1 out of memory. */
+static ex_id to_mech_slots(const scene *s, ex_id e) {
+  for (int i = 0; i < s->n && e >= 0 && s->c1; i++)
+    e = ex_subst(s->dag, e, sc_d2_slot(s, i), ex_slot(s->dag, 1 + 2 * s->n + i));
+  return e;
+}
+
 static int adapter_new(const scene *s, int with_start, adapter *a) {
   int n = s->n, nc = s->ncons, ni = s->nints;
   memset(a, 0, sizeof *a);
@@ -38,13 +45,21 @@ static int adapter_new(const scene *s, int with_start, adapter *a) {
     a->names[n + c] = s->cons[c].name;
   }
   for (int r = 0; r < ni; r++) {
-    a->ids[nc + r] = s->ints[r].expr;
+    if ((a->ids[nc + r] = to_mech_slots(s, s->ints[r].expr)) < 0) {
+      adapter_free(a);
+      return -1;
+    }
     a->names[n + nc + r] = s->ints[r].name;
   }
   mech_problem *mp = &a->mp;
   mp->dag = s->dag;
   mp->n = n;
-  mp->F = s->F;
+  mp->F = to_mech_slots(s, s->F);
+  mp->order2 = s->c1;
+  if (mp->F < 0 || (s->c1 && s->params_as_inputs)) { /* mech's y'' slots are parameters' */
+    adapter_free(a);
+    return -1;
+  }
   mp->ncons = nc;
   mp->cons = a->ids;
   mp->nints = ni;
@@ -89,6 +104,12 @@ cv_status scene_modes_new(const scene *s, mech_modes *md, char *err, size_t errl
   adapter a;
   memset(md, 0, sizeof *md);
   if (err && errlen) err[0] = '\0';
+  if (s->c1) {
+    sc_err(err, errlen, s->file, s->F_line,
+           "modes: the integrand has y'', and small oscillations are computed for a "
+           "Lagrangian L(y, y') only");
+    return CVAR_EINVAL;
+  }
   if (adapter_new(s, 1, &a) < 0) {
     sc_err(err, errlen, s->file, 0, "out of memory while computing the modes");
     return CVAR_ENOMEM;

@@ -30,6 +30,7 @@ cv_status scene_modes_new(const scene *s, mech_modes *md, char *err, size_t errl
 typedef struct {
   int n;
   char **mom, **el, *H, *F;
+  char **mom2; /* second-order Lagrangian: Ostrogradsky's second momenta F_y'', else NULL */
 } scene_eq_texts;
 
 /** Print eq's expressions (all of them, or -1 on allocation failure; free it either way). */

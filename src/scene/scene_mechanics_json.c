@@ -33,7 +33,12 @@ int scene_eq_texts_make(scene_eq_texts *t, const scene *s, const mech_equations 
     if (!(t->mom[i] = print_expr(s, eq, eq->momentum[i])) ||
         !(t->el[i] = print_expr(s, eq, eq->el[i])))
       return -1;
-  ex_id F = ex_collect(s->dag, s->F);
+  if (eq->momentum2) {
+    if (!(t->mom2 = cv_calloc((size_t)n + 1, sizeof *t->mom2))) return -1;
+    for (int i = 0; i < n; i++)
+      if (!(t->mom2[i] = print_expr(s, eq, eq->momentum2[i]))) return -1;
+  }
+  ex_id F = ex_collect(s->dag, eq->F >= 0 ? eq->F : s->F); /* in mech's slots */
   if (F < 0 || !(t->H = print_expr(s, eq, eq->hamiltonian)) || !(t->F = print_expr(s, eq, F)))
     return -1;
   return 0;
@@ -43,7 +48,9 @@ void scene_eq_texts_free(scene_eq_texts *t) {
   for (int i = 0; i < t->n; i++) {
     if (t->mom) cv_free(t->mom[i]);
     if (t->el) cv_free(t->el[i]);
+    if (t->mom2) cv_free(t->mom2[i]);
   }
+  cv_free(t->mom2);
   cv_free(t->mom);
   cv_free(t->el);
   cv_free(t->H);
@@ -66,6 +73,12 @@ char *scene_equations_json(const scene *s, const mech_equations *eq, const scene
     if (eq->cyclic[i]) json_array_append_new(cyc, json_string(s->unknowns[i]));
   }
   json_object_set_new(o, "momenta", mom);
+  if (t->mom2) { /* a second-order Lagrangian: Ostrogradsky's second momenta dF/dy'' */
+    json_t *m2 = json_object();
+    for (int i = 0; m2 && i < s->n; i++)
+      json_object_set_new(m2, s->unknowns[i], json_string(t->mom2[i]));
+    if (m2) json_object_set_new(o, "momenta_second", m2);
+  }
   json_object_set_new(o, "euler_lagrange", el);
   json_object_set_new(o, "hamiltonian", json_string(t->H));
   json_object_set_new(o, "cyclic", cyc);

@@ -17,6 +17,8 @@ const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap) {
     snprintf(buf, cap, "%s", s->variable);
   else if (slot <= s->n)
     snprintf(buf, cap, "%s", s->unknowns[slot - 1]);
+  else if (slot >= sc_d2_slot(s, 0) && slot < sc_d2_slot(s, s->n))
+    snprintf(buf, cap, "%s''", s->unknowns[slot - sc_d2_slot(s, 0)]);
   else
     snprintf(buf, cap, "%s'", s->unknowns[slot - 1 - s->n]);
   return buf;
@@ -138,10 +140,14 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
     return ex_slot(d, 0);
   }
   if ((i = find_name(s->unknowns, s->n, name)) >= 0) {
-    if (primes > 1) {
-      snprintf(err, errlen, "only first derivatives may appear: '%s' has %d primes", name, primes);
+    if (primes > 1 && !L->second) {
+      snprintf(err, errlen,
+               "%s'': a second derivative may appear only in the integrand, [definitions], "
+               "[integrals] and [report]",
+               name);
       return -1;
     }
+    if (primes == 2) return ex_slot(d, sc_d2_slot(s, i));
     return ex_slot(d, primes ? 1 + s->n + i : 1 + i);
   }
   snprintf(err, errlen, "unknown name '%s'%s", name, hint);
@@ -158,7 +164,11 @@ ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const
     sc_err(L->err, L->errlen, L->file, line, "%s: a value is missing", what);
     return -1;
   }
-  ex_id r = ex_parse(L->s->dag, text, resolve, L, 0, msg, sizeof msg);
+  /* y'' where a second-order integrand may have it (SCENES.md): the integrand, definitions,
+   * integrals and reports, named by the callers' `what` */
+  L->second = strcmp(what, "integrand") == 0 || strncmp(what, "[definitions]", 13) == 0 ||
+              strncmp(what, "[integrals] ", 12) == 0 || strncmp(what, "[report]", 8) == 0;
+  ex_id r = ex_parse(L->s->dag, text, resolve, L, 1, msg, sizeof msg);
   if (r >= 0) {
     /* A constant that is not finite (0/0, log(0), sqrt(-1)*0) is bad input, never a NaN
      * carried into the solve (theory (EX-1)). */
@@ -226,7 +236,8 @@ int sc_parse_const_node(sc_loader *L, const sc_entry *e, int off, const char *te
   if (node) *node = -1;
   if (r < 0) return -1;
   sc_entry_locate(e, off, &line, &col);
-  int slot = sc_first_slot(L->s, r, 0, 2 * L->s->n);
+  int slot = sc_first_slot(L->s, r, 0, 2 * L->s->n), k2;
+  if (slot < 0 && sc_uses_second(L->s, r, &k2)) slot = sc_d2_slot(L->s, k2);
   int bad = slot >= 0;
   if (!bad && L->s->params_as_inputs) {
     if (sc_eval_params(L->s, r, value) < 0) {

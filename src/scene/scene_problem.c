@@ -15,7 +15,11 @@ static int guess_cb(int m, const double *x, double *y, void *user) {
 /* An integrand object for e; with parameters as inputs they are set to their values. */
 static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *msg, size_t len) {
   int np = s->params_as_inputs ? s->nparams : 0;
-  ex_integrand *g = ex_integrand_new_params(s->dag, s->n, np, e, max_need, msg, len);
+  /* second order: y'' after the parameters and the width's slot (X-7), which F never reads
+   * when the parameters are numbers */
+  ex_integrand *g =
+      s->c1 ? ex_integrand_new_order(s->dag, s->n, s->nparams + 1, 2, e, max_need, msg, len)
+            : ex_integrand_new_params(s->dag, s->n, np, e, max_need, msg, len);
   if (g && np) {
     double *v = cv_malloc((size_t)np * sizeof *v);
     if (!v) {
@@ -41,6 +45,8 @@ static void set_width(void *user, double w) {
 static ex_integrand *compile_integrand(const scene *s, unsigned max_need, int *count, char *msg,
                                        size_t len) {
   int np = s->params_as_inputs ? s->nparams : 0;
+  *count = 0;
+  if (s->c1) return compile(s, s->F, max_need, msg, len); /* C^1: no smoothing of jumps */
   ex_id Fs = ex_smooth_jumps(s->dag, s->F, 1, 2 * s->n, 2 * s->n + 1 + np, count);
   if (Fs < 0) return NULL;
   if (*count == 0) return compile(s, s->F, max_need, msg, len);
@@ -85,10 +91,27 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
         goto fail;
       }
     }
+  for (int i = 0; i < s->n && s->c1; i++) { /* second order: C^1 elements, slopes (H-1) */
+    why = s->order2[i] ? cv_problem_set_second_order(p, i) : CVAR_OK;
+    for (int end = 0; end < 2 && why == CVAR_OK && s->sbc && s->sbc[i].line; end++)
+      if (!s->sbc[i].free_end[end]) why = cv_problem_set_end_slope(p, i, end, s->sbc[i].value[end]);
+    if (why != CVAR_OK) {
+      sc_err(err, errlen, s->file, s->sbc && s->sbc[i].line ? s->sbc[i].line : s->F_line,
+             "%s'': %s", s->unknowns[i], cv_strerror(why));
+      goto fail;
+    }
+  }
   /* [constraints] G(x, y) = 0 and [integrals] int K = c (theory C-1, C-2), compiled with
    * the derivatives the method needs. */
   for (int k = 0; k < s->ncons; k++) {
     const sc_item *it = &s->cons[k];
+    if (s->c1) { /* the node multipliers of C-1 are for C^0 elements */
+      sc_err(err, errlen, s->file, it->line,
+             "[constraints] %s: pointwise constraints are not available with y'' in the "
+             "scene (C1 elements); an integral constraint is",
+             it->name);
+      goto fail;
+    }
     ex_integrand *g = compile(s, it->expr, max_need, msg, sizeof msg);
     if (!g) {
       sc_err(err, errlen, s->file, it->line, "[constraints] %s: %s", it->name,

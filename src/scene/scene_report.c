@@ -37,6 +37,7 @@ void cli_report_free(cli_report *r) {
   for (int c = 0; r->contact && r->sc && c < r->sc->ncons; c++) cv_free(r->contact[c]);
   cv_free(r->contact);
   cv_free(r->ncontact);
+  cv_free(r->dy);
   cv_free(r->has_mu);
   cv_free(r->mu);
   cv_free(r->degrees);
@@ -182,8 +183,9 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
   double *H = cv_malloc(q * sizeof *H), *mom = cv_malloc(q * n * sizeof *mom);
   double *xb = cv_malloc(((size_t)r->elements + 1) * sizeof *xb);
   unsigned char *skip = cv_calloc((size_t)r->elements + 1, 1);
-  if (!x || !w || !y || !dy || !v || !H || !mom || !xb || !skip) goto done;
-  if (!element_bounds(r, xb) || cv_solver_get_qpoints(sv, x, w, y, dy) != CVAR_OK) {
+  double *d2y = s->c1 ? cv_malloc(q * n * sizeof *d2y) : NULL;
+  if (!x || !w || !y || !dy || !v || !H || !mom || !xb || !skip || (s->c1 && !d2y)) goto done;
+  if (!element_bounds(r, xb) || cv_solver_get_qpoints2(sv, x, w, y, dy, d2y) != CVAR_OK) {
     rc = 0; /* nothing to evaluate on: leave the keys out */
     goto done;
   }
@@ -191,7 +193,9 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
   /* With constraints, H of F alone is conserved only when no constraint depends on the
    * variable and there is no integral constraint (whose multiplier enters the conserved
    * quantity); a momentum only when no constraint involves that unknown (docs/cli.md). */
-  cv_status st = cv_problem_eval_energy(p, nq, x, y, dy, H, mom);
+  /* y'' in F: the first-order energy and momenta do not apply (Ostrogradsky's are in
+   * `equations`), so their keys are left out */
+  cv_status st = s->c1 ? CVAR_EINVAL : cv_problem_eval_energy(p, nq, x, y, dy, H, mom);
   if (st == CVAR_ENOMEM) goto done;
   /* A callback that fails here leaves energy and momenta out, as non-finite values do. */
   int have = st == CVAR_OK;
@@ -201,7 +205,7 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
     if (!scene_F_depends_on_unknown(s, i) && !constraints_depend_on(s, 1 + i))
       r->has_mom[i] = elem_avg_range(mom + (size_t)i * q, w, x, nq, xb, skip, r->elements,
                                      &r->mom_min[i], &r->mom_max[i]) == 0;
-  if (s->nreports > 0 && scene_eval_reports(s, nq, x, y, dy, v) < 0) goto done;
+  if (s->nreports > 0 && scene_eval_reports2(s, nq, x, y, dy, d2y, v) < 0) goto done;
   for (int k = 0; k < s->nreports; k++) {
     double sum = 0;
     for (int j = 0; j < nq; j++) sum += w[j] * v[(size_t)k * q + j];
@@ -219,6 +223,7 @@ done:
   cv_free(v);
   cv_free(H);
   cv_free(mom);
+  cv_free(d2y);
   return rc;
 }
 
@@ -320,6 +325,13 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
     }
   }
   if (nn > 0 && nodal_error(r, s) < 0) return -1;
+  if (nn > 0 && s->c1) { /* the slopes are unknowns of the C^1 elements (CSV NAME') */
+    if (!(r->dy = cv_malloc((size_t)nn * n * sizeof *r->dy))) return -1;
+    if (cv_solver_get_slopes(sv, r->dy) != CVAR_OK) {
+      cv_free(r->dy);
+      r->dy = NULL;
+    }
+  }
   /* Multiplier fields (CSV lambda_NAME) and integral multipliers (JSON multipliers). */
   if (nn > 0 && s->ncons > 0) {
     r->lam = cv_malloc((size_t)nn * s->ncons * sizeof *r->lam);

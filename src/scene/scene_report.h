@@ -52,6 +52,7 @@ typedef struct {
   double *rep;
   double *x, *y; /* nodes and node-major values y[j*n + i] */
   double *lam;   /* multiplier fields lam[c*nodes + j] of [constraints], or NULL */
+  double *dy;    /* y'' in the scene: node-major nodal slopes dy[j*n + i] (CSV NAME'), or NULL */
   int *has_mu;   /* [integrals] multipliers */
   double *mu;
   int *ncontact;    /* per [constraints] entry: its contact intervals (inequalities), or NULL */

@@ -100,6 +100,15 @@ int sc_load_boundary(sc_loader *L) {
   for (int i = 0; i < L->raw.ne[SEC_BOUNDARY]; i++) {
     const sc_entry *e = &L->raw.e[SEC_BOUNDARY][i];
     int k = unknown_index(s, e->key);
+    size_t kl = strlen(e->key);
+    if (k < 0 && kl > 1 && e->key[kl - 1] == '\'') { /* y' = a, b: a slope line (H-1) */
+      char base[128];
+      snprintf(base, sizeof base, "%.*s", (int)(kl - 1), e->key);
+      if ((k = unknown_index(s, base)) >= 0) {
+        if (sc_load_slope_line(L, e, k) < 0) return -1;
+        continue;
+      }
+    }
     if (k < 0) {
       sc_err(L->err, L->errlen, L->file, e->line, "'%s' in [boundary] is not an unknown", e->key);
       return -1;
@@ -169,7 +178,8 @@ static ex_id parse_of_variable(sc_loader *L, const sc_entry *e, const char *what
   char nb[128];
   ex_id r = sc_parse(L, e, 0, e->value, what);
   if (r < 0) return -1;
-  int slot = sc_first_slot(L->s, r, 1, 2 * L->s->n);
+  int slot = sc_first_slot(L->s, r, 1, 2 * L->s->n), k2;
+  if (slot < 0 && sc_uses_second(L->s, r, &k2)) slot = sc_d2_slot(L->s, k2);
   if (slot >= 0) {
     sc_err(L->err, L->errlen, L->file, e->line,
            "%s may depend only on the variable '%s', not on '%s'", what, L->s->variable,
@@ -360,7 +370,8 @@ int sc_load_constraints(sc_loader *L) {
     return -1;
   for (int i = 0; i < s->ncons; i++) {
     const sc_item *c = &s->cons[i];
-    int slot = sc_first_slot(s, c->expr, 1 + s->n, 2 * s->n);
+    int slot = sc_first_slot(s, c->expr, 1 + s->n, 2 * s->n), k2;
+    if (slot < 0 && sc_uses_second(s, c->expr, &k2)) slot = sc_d2_slot(s, k2);
     if (slot >= 0) {
       sc_err(L->err, L->errlen, L->file, c->line,
              "[constraints] %s is a pointwise constraint G(%s, y) and may not use '%s'", c->name,

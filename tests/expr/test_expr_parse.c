@@ -111,7 +111,7 @@ static void check_errors(void) {
       {"1 + q", 0, 5, "unknown name 'q'"},
       {"x'", 0, 1, "prime is only allowed on an unknown"},
       {"2 + y''", 0, 5, "y'': only the first derivative y' may be written here"},
-      {"y'''", 1, 1, "only the first derivative"},
+      {"y'''", 1, 1, "at most the second derivative"},
       {"(x)'", 0, 4, "prime is only allowed"},
       {"2'", 0, 2, "prime is only allowed"},
       {"pi'", 0, 3, "prime is only allowed"},

@@ -1,0 +1,253 @@
+#!/usr/bin/env python3
+# tests/c1/test_cli_c1.py — second derivatives through the calcvar command: closed forms
+# (simply supported beam, cantilever with its natural conditions at the free end, a beam
+# on an elastic foundation, a C0 and a C1 unknown coupled), the observed order of the C1
+# elements of degrees 3, 5, 7 against theory H-6, `--tol` on the clamped elastica against
+# an independent shooting reference, `check`, `equations`, the CSV slope column and --all.
+# SPDX-License-Identifier: MIT
+#
+# usage: test_cli_c1.py CALCVAR DATA_DIR
+import csv
+import io
+import json
+import math
+import os
+import subprocess
+import sys
+
+calcvar, data = [os.path.abspath(a) for a in sys.argv[1:3]]
+failures = 0
+
+
+def check(what, ok, detail=""):
+    global failures
+    if not ok:
+        failures += 1
+        print("FAIL %s %s" % (what, detail))
+
+
+def run(*args):
+    r = subprocess.run([calcvar] + list(args), capture_output=True, text=True, timeout=240)
+    return r.returncode, r.stdout, r.stderr
+
+
+def scene(name):
+    return os.path.join(data, name)
+
+
+def solve_json(name, *opts):
+    rc, out, err = run("solve", scene(name), "--json", "-", "--quiet", *opts)
+    return rc, (json.loads(out) if out.strip() else {}), err
+
+
+def solve_csv(name, *opts):
+    rc, out, err = run("solve", scene(name), "--csv", "-", "--quiet", *opts)
+    return rc, list(csv.reader(io.StringIO(out)))
+
+
+# ---- simply supported beam: the quartic is in the quintic space (round-off), the cubic
+# ---- elements are exact at the nodes (the Green's function of y'''' is piecewise cubic)
+for deg, tol_nodal in ((3, 1e-15), (5, 1e-15), (7, 1e-15)):
+    rc, j, err = solve_json("simply_supported_beam.scene", "--elements", "4", "--degree", str(deg))
+    check("beam degree %d exit" % deg, rc == 0, err)
+    if rc == 0:
+        check("beam degree %d nodal" % deg, j["error"]["max_nodal"] <= tol_nodal, j["error"])
+        check("beam degree %d Morse" % deg, j["morse_index"] == 0 and j["stationary_kind"] == "minimum")
+        if deg > 3:  # the action of the exact quartic, -1/240, to round-off
+            check("beam degree %d action" % deg, j["error"]["action"] <= 1e-16, j["error"])
+        check("beam degree %d nodes" % deg, j["nodes"] == 4 * (deg - 1) // 2 + 1, j["nodes"])
+
+# ---- cantilever: values, the CSV slope column, and the natural conditions at the free end
+# ---- (moment EI w'' and shear EI w''' zero), read off the last element's quintic through
+# ---- its three nodes' values and slopes (an independent Hermite reconstruction)
+rc, rows = solve_csv("cantilever.scene")
+check("cantilever exit", rc == 0)
+if rc == 0:
+    check("cantilever CSV header", rows[0] == ["x", "w", "w'"], rows[0])
+    pts = [tuple(float(v) for v in r) for r in rows[1:]]
+    EI, q, L = 2.0, 3.0, 1.5
+    ex = lambda x: q * x * x * (6 * L * L - 4 * L * x + x * x) / (24 * EI)
+    dex = lambda x: q * (12 * L * L * x - 12 * L * x * x + 4 * x ** 3) / (24 * EI)
+    check("cantilever values", max(abs(w - ex(x)) for x, w, _ in pts) < 1e-14)
+    check("cantilever slopes", max(abs(s - dex(x)) for x, _, s in pts) < 1e-13)
+    # quintic through (x_k, w_k, w'_k), k = last three nodes: solve the 6x6 system
+    last = pts[-3:]
+    A, b = [], []
+    for x, w, s in last:
+        A.append([x ** k for k in range(6)])
+        b.append(w)
+        A.append([k * x ** (k - 1) if k else 0.0 for k in range(6)])
+        b.append(s)
+    n = 6
+    for c in range(n):  # Gaussian elimination with partial pivoting
+        p = max(range(c, n), key=lambda r: abs(A[r][c]))
+        A[c], A[p], b[c], b[p] = A[p], A[c], b[p], b[c]
+        for r in range(c + 1, n):
+            f = A[r][c] / A[c][c]
+            A[r] = [a - f * ac for a, ac in zip(A[r], A[c])]
+            b[r] -= f * b[c]
+    co = [0.0] * n
+    for r in range(n - 1, -1, -1):
+        co[r] = (b[r] - sum(A[r][k] * co[k] for k in range(r + 1, n))) / A[r][r]
+    d2 = sum(k * (k - 1) * co[k] * L ** (k - 2) for k in range(2, 6))
+    d3 = sum(k * (k - 1) * (k - 2) * co[k] * L ** (k - 3) for k in range(3, 6))
+    scale = q * L * L / EI  # the size of w'' at the clamped end
+    check("cantilever moment at the free end", abs(EI * d2) < 1e-9 * EI * scale, EI * d2)
+    check("cantilever shear at the free end", abs(EI * d3) < 1e-8 * EI * scale / L, EI * d3)
+rc, j, err = solve_json("cantilever.scene")
+if rc == 0:
+    U = q * q * L ** 5 / (40 * EI)  # the bending energy: the action is -U
+    check("cantilever report", abs(j["report"]["bending"] - U) < 1e-13 * U, j.get("report"))
+    check("cantilever no first-order energy", "energy" not in j and "momenta" not in j)
+
+# ---- observed orders (theory H-6): max nodal error O(h^(p+1)), vertices O(h^(2p-2))
+for name in ("foundation.scene", "mixed.scene"):
+    rc, out, err = run("converge", scene(name), "--degree", "3,5,7", "--elements", "4",
+                       "--levels", "4", "--json", "-")
+    check("%s converge exit" % name, rc == 0, err)
+    rows = json.loads(out) if rc == 0 else []
+    for deg in (3, 5, 7):
+        errs = [(r["elements"], r["error"]["max_nodal"]) for r in rows if r["degree"] == deg]
+        # the last pair above the round-off floor
+        good = [(e1, a, e2, b) for (e1, a), (e2, b) in zip(errs, errs[1:]) if b > 1e-12]
+        if not good:
+            check("%s degree %d: a pair of errors above round-off" % (name, deg), False, errs)
+            continue
+        e1, a, e2, b = good[-1]
+        order = math.log(a / b) / math.log(e2 / e1)
+        check("%s degree %d order %.2f (expected %d)" % (name, deg, order, deg + 1),
+              abs(order - (deg + 1)) < 0.5, errs)
+
+# ---- --tol on the clamped elastica, against shooting (pure Python, independent of
+# ---- calcvar): the first integral F_y' - d/dx F_y'' = C of y''^2 / (1 + y'^2)^(5/2) gives
+# ---- y''' = (5 p q^2 / w - C w^(5/2)) / 2, w = 1 + p^2; unknowns y''(0) and C
+
+
+def rhs(z, C):
+    y, p, q = z
+    w = 1 + p * p
+    return (p, q, 0.5 * (5 * p * q * q / w - C * w ** 2.5))
+
+
+def rk4(z, h, C):
+    k1 = rhs(z, C)
+    k2 = rhs([a + 0.5 * h * b for a, b in zip(z, k1)], C)
+    k3 = rhs([a + 0.5 * h * b for a, b in zip(z, k2)], C)
+    k4 = rhs([a + h * b for a, b in zip(z, k3)], C)
+    return [a + h / 6 * (b + 2 * c + 2 * d + e) for a, b, c, d, e in zip(z, k1, k2, k3, k4)]
+
+
+def shoot(q0, C, xs, hmax):
+    """y at the abscissae xs (increasing, from 0), and y, y' at 1."""
+    z, x, out = [0.0, 0.0, q0], 0.0, []
+    for xt in list(xs) + [1.0]:
+        m = max(1, int(math.ceil((xt - x) / hmax)))
+        h = (xt - x) / m
+        for _ in range(m):
+            z = rk4(z, h, C)
+        x = xt
+        out.append(z[0])
+    return out[:-1], z
+
+
+def residual(u, hmax):
+    try:
+        _, z = shoot(u[0], u[1], [], hmax)
+        return [z[0] - 0.5, z[1] - 2.0]
+    except OverflowError:  # a trial that blows up: rejected by the damping below
+        return [math.inf, math.inf]
+
+
+def reference(xs, hmax):
+    """Damped Newton on (y''(0), C), from a start that a coarse scan of the shots shows near
+    (the shot (1, 0) ends at y = 0.68, y' = 2.08)."""
+    u = [1.0, 0.0]
+    r = residual(u, hmax)
+    for _ in range(60):
+        J = []
+        for k in range(2):
+            v = list(u)
+            dv = 1e-7 * max(1.0, abs(v[k]))
+            v[k] += dv
+            rk = residual(v, hmax)
+            J.append([(rk[0] - r[0]) / dv, (rk[1] - r[1]) / dv])
+        det = J[0][0] * J[1][1] - J[1][0] * J[0][1]
+        du = [(r[0] * J[1][1] - r[1] * J[1][0]) / det, (r[1] * J[0][0] - r[0] * J[0][1]) / det]
+        lam = 1.0
+        while lam > 1e-6:
+            v = [u[0] - lam * du[0], u[1] - lam * du[1]]
+            rv = residual(v, hmax)
+            if max(map(abs, rv)) < max(map(abs, r)) or max(map(abs, r)) < 1e-15:
+                break
+            lam *= 0.5
+        u, r = v, rv
+        if max(abs(d) for d in du) < 1e-14 or max(map(abs, r)) < 1e-15:
+            break
+    y, _ = shoot(u[0], u[1], xs, hmax)
+    return y
+
+
+for T in (1e-6, 1e-8, 1e-10):
+    rc, out, err = run("solve", scene("elastica.scene"), "--tol", str(T), "--json",
+                       os.devnull, "--csv", "-", "--quiet")
+    check("elastica --tol %g exit" % T, rc == 0, err)
+    if rc != 0:
+        continue
+    pts = [(float(a), float(b)) for a, b, _ in list(csv.reader(io.StringIO(out)))[1:]]
+    xs = [x for x, _ in pts]
+    r1, r2 = reference(xs, 1.0 / 1500), reference(xs, 1.0 / 3000)
+    ref = [b + (b - a) / 15 for a, b in zip(r1, r2)]  # Richardson on RK4
+    ref_err = max(abs(a - b) for a, b in zip(ref, r2))
+    check("elastica reference accuracy %.2g" % ref_err, ref_err < 1e-12)
+    true = max(abs(y - r) for (_, y), r in zip(pts, ref))
+    rc, j, _ = solve_json("elastica.scene", "--tol", str(T))
+    est = j.get("error_estimate", float("nan"))
+    check("elastica --tol %g: true error %.2g <= 10 T" % (T, true), true <= 10 * T)
+    check("elastica --tol %g: estimate %.2g not far below the true error %.2g" % (T, est, true),
+          est >= 0.1 * true)
+    check("elastica --tol %g: degrees" % T, len(j.get("degrees", [])) == j.get("elements"))
+    check("elastica --tol %g: minimum" % T, j.get("stationary_kind") == "minimum")
+
+# ---- check: the C1 unknowns counted, the partials in y'' against finite differences
+rc, out, err = run("check", scene("cantilever.scene"))
+check("check exit", rc == 0, out + err)
+check("check counts", "9 values + 9 slopes - 2 fixed at the ends = 16 unknowns" in out, out)
+check("check slope line", "slope        w': 0 at x = 0, free (natural)" in out, out)
+rc, out, err = run("check", scene("elastica.scene"))
+check("check elastica derivatives", rc == 0 and "agree with finite differences" in out, out)
+
+# ---- equations: the fourth-order Euler-Lagrange equation and Ostrogradsky's momenta
+rc, out, err = run("equations", scene("cantilever.scene"), "--json", "-")
+check("equations exit", rc == 0, err)
+if rc == 0:
+    e = json.loads(out)
+    el = e["euler_lagrange"]["w"].replace(" ", "")
+    check("equations EL", el == "2*w''''-3", el)
+    check("equations momenta", e["momenta"]["w"].replace(" ", "") == "-2*w'''" and
+          e["momenta_second"]["w"].replace(" ", "") == "2*w''", e)
+
+# ---- --all: the straight column past its buckling load is a saddle, the two buckled
+# ---- shapes are minima of equal action
+rc, out, err = run("solve", scene("buckled.scene"), "--all", "--json", "-", "--quiet")
+check("--all exit", rc == 0, err)
+if rc == 0:
+    sols = json.loads(out)["solutions"]
+    kinds = sorted((s["morse_index"], round(s["action"], 9)) for s in sols)
+    check("--all paths", len(sols) == 3 and kinds[0][0] == 0 and kinds[1][0] == 0 and
+          kinds[2] == (1, 0.0) and abs(kinds[0][1] - kinds[1][1]) < 1e-9, kinds)
+
+# ---- batch: rows of (q, EI) against the closed-form action and bending energy
+table = os.path.join(os.environ.get("TMPDIR", "/tmp"), "c1_rows_%d.csv" % os.getpid())
+with open(table, "w") as f:
+    f.write("q,EI\n1,1\n3,2\n5,0.5\n")
+rc, out, err = run("batch", scene("cantilever.scene"), table)
+os.unlink(table)
+check("batch exit", rc == 0, err)
+for row in (list(csv.DictReader(io.StringIO(out))) if rc == 0 else []):
+    q_, EI_ = float(row["q"]), float(row["EI"])
+    U = q_ * q_ * 1.5 ** 5 / (40 * EI_)
+    check("batch row q=%g" % q_, abs(float(row["action"]) + U) < 1e-13 * U and
+          abs(float(row["bending"]) - U) < 1e-13 * U, row)
+
+print("%d failure(s)" % failures)
+sys.exit(1 if failures else 0)
