@@ -145,7 +145,32 @@ static void bad_input(void) {
   cv_problem_free(p);
 }
 
+/* A formula with y'' (cv_problem_set_integrand_expr) makes its unknown second order: the
+ * simply supported beam y''^2/2 - y on [0, 1], exact y = x (1 - 2x^2 + x^3)/24. */
+static void formula(void) {
+  char err[256] = "";
+  cv_problem *p = cv_problem_new(1, 0.0, 1.0, NULL);
+  cv_status st =
+      cv_problem_set_integrand_expr(p, NULL, "y", "EI/2*y''^2 - y", "EI = 1", err, sizeof err);
+  CHECK(st == CVAR_OK && cv_problem_get_second_order(p, 0), "formula with y'': %s", err);
+  cv_problem_set_dirichlet(p, 0, 0.0, 0.0);
+  cv_solver *s = cv_solver_new(NULL);
+  cv_solver_set_elements(s, 3);
+  cv_solver_set_degree(s, 5);
+  CHECK(cv_solve(s, p) == CVAR_OK, "formula beam: %s", cv_solver_last_error(s));
+  double x[7], y[7], e = 0;
+  CHECK(cv_solver_get_num_nodes(s) == 7, "formula beam nodes %d", cv_solver_get_num_nodes(s));
+  cv_solver_get_nodes(s, x);
+  cv_solver_get_values(s, y);
+  for (int j = 0; j < 7; j++)
+    e = fmax(e, fabs(y[j] - x[j] * (1 - 2 * x[j] * x[j] + x[j] * x[j] * x[j]) / 24));
+  CHECK(e < 1e-15, "formula beam: nodal error %.3g", e);
+  cv_solver_free(s);
+  cv_problem_free(p);
+}
+
 int main(void) {
+  formula();
   cantilever(3);
   cantilever(5);
   cantilever(7);

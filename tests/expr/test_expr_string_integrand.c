@@ -91,7 +91,7 @@ static void check_errors(void) {
     const char *var, *unk, *F, *par, *contains;
   } cases[] = {
       {NULL, "y", "y*q", NULL, "integrand: column 3: unknown name 'q'"},
-      {NULL, "y", "y''", NULL, "integrand: column 1: y''"},
+      {NULL, "y", "y'''", NULL, "integrand: column 1: y''': at most the second derivative"},
       {NULL, "y", "x' + y", NULL, "integrand: column 1: a prime is only allowed on an unknown"},
       {NULL, "y", "c'*y", "c = 1", "'c' is a parameter"},
       {NULL, "y, z", "y", NULL, "2 names given, but the problem has 1 unknown"},
