@@ -124,13 +124,20 @@ static int constraints_depend_on(const scene *s, int slot) {
 
 /* The element boundaries xb[0..E] of the report's mesh, from its nodes and degrees; 0 when
  * they do not add up. */
-static int element_bounds(const cli_report *r, double *xb) {
+/* Node steps of element e: its degree for GLL elements; (p - 1) / 2 for the C^1 elements
+ * of degree p (values and slopes at those nodes, theory H-2). */
+static long element_step(const cli_report *r, int c1, int e) {
+  int p = r->degrees[e];
+  return c1 ? (p <= 3 ? 1 : (p - 1) / 2) : p;
+}
+
+static int element_bounds(const cli_report *r, int c1, double *xb) {
   long j = 0;
   if (!r->degrees || r->elements <= 0) return 0;
   for (int e = 0; e <= r->elements; e++) {
     if (j >= r->nodes) return 0;
     xb[e] = r->x[j];
-    if (e < r->elements) j += r->degrees[e];
+    if (e < r->elements) j += element_step(r, c1, e);
   }
   return j == r->nodes - 1;
 }
@@ -143,7 +150,7 @@ static int element_bounds(const cli_report *r, double *xb) {
  * from -24.4 to -0.68). Sets skip[e], r->e_skipped and the extent of the skipped elements;
  * none when there is no estimate, and never every element. */
 #define MEANINGFUL 1e-3
-static void unknown_slopes(cli_report *r, const cv_solver *sv, const double *xb,
+static void unknown_slopes(cli_report *r, const cv_solver *sv, int c1, const double *xb,
                            unsigned char *skip) {
   double est = cv_solver_get_error_estimate(sv);
   int n = r->n, E = r->elements, count = 0;
@@ -151,7 +158,7 @@ static void unknown_slopes(cli_report *r, const cv_solver *sv, const double *xb,
   r->e_skipped = 0;
   if (!(est > 0) || !isfinite(est)) return;
   for (int e = 0; e < E; e++) {
-    long j1 = j + r->degrees[e];
+    long j1 = j + element_step(r, c1, e);
     double change = 0.0;
     for (int i = 0; i < n; i++)
       change = fmax(change, fabs(r->y[(size_t)j1 * n + i] - r->y[(size_t)j * n + i]));
@@ -185,11 +192,11 @@ static int qpoint_quantities(cli_report *r, scene *s, const cv_problem *p, cv_so
   unsigned char *skip = cv_calloc((size_t)r->elements + 1, 1);
   double *d2y = s->c1 ? cv_malloc(q * n * sizeof *d2y) : NULL;
   if (!x || !w || !y || !dy || !v || !H || !mom || !xb || !skip || (s->c1 && !d2y)) goto done;
-  if (!element_bounds(r, xb) || cv_solver_get_qpoints2(sv, x, w, y, dy, d2y) != CVAR_OK) {
+  if (!element_bounds(r, s->c1, xb) || cv_solver_get_qpoints2(sv, x, w, y, dy, d2y) != CVAR_OK) {
     rc = 0; /* nothing to evaluate on: leave the keys out */
     goto done;
   }
-  unknown_slopes(r, sv, xb, skip);
+  unknown_slopes(r, sv, s->c1, xb, skip);
   /* With constraints, H of F alone is conserved only when no constraint depends on the
    * variable and there is no integral constraint (whose multiplier enters the conserved
    * quantity); a momentum only when no constraint involves that unknown (docs/cli.md). */
