@@ -599,6 +599,12 @@ CVAR_API int cv_solver_get_degenerate(const cv_solver *s);
  * largest possible Morse index). */
 CVAR_API int cv_solver_get_num_free(const cv_solver *s);
 
+/** The contact set of inequality k in the last solve: the intervals [iv[2i], iv[2i+1]]
+ * where it is active (a touching point is [x, x]), their ends placed between nodes from
+ * the gap (theory OB-4). Up to cap intervals are written; *count receives how many there
+ * are. CVAR_EINVAL when k is not an inequality, CVAR_ESTATE before a solve. */
+CVAR_API cv_status cv_solver_get_contact(const cv_solver *s, const cv_problem *p, int k, double *iv,
+                                         int cap, int *count);
 /** The multiplier field of pointwise constraint k at the nodes of the last solve,
  * lambda[j], j < cv_solver_get_num_nodes(). At an end node whose unknowns are all fixed
  * (no multiplier there) the value is extrapolated from the neighbouring nodes. */

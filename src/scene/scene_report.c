@@ -346,7 +346,7 @@ int cli_report_collect(cli_report *r, scene *s, const cv_problem *p, cv_solver *
     for (int c = 0; c < s->ncons; c++)
       if (cv_solver_get_multiplier_field(sv, c, r->lam + (size_t)c * nn) != CVAR_OK)
         for (int j = 0; j < nn; j++) r->lam[(size_t)c * nn + j] = NAN;
-    if (cli_report_contact(r, s) < 0) return -1;
+    if (cli_report_contact(r, s, p, sv) < 0) return -1;
   }
   r->has_mu = cv_calloc((size_t)s->nints + 1, sizeof *r->has_mu);
   r->mu = cv_calloc((size_t)s->nints + 1, sizeof *r->mu);

@@ -71,9 +71,9 @@ int cli_report_estimate(cli_report *r, const cv_solver *sv, const cv_problem *p)
 int cli_estimate_error(const cv_solver *sv, const cv_problem *p, double *e_all, double *e_vertex,
                        char *why, size_t len);
 void cli_report_free(cli_report *r);
-/* scene_contact.c: the contact intervals of the inequalities (theory OB-4) from the
- * multiplier fields; 0, or -1 on allocation failure. */
-int cli_report_contact(cli_report *r, const scene *s);
+/* scene_contact.c: the contact intervals of the inequalities (theory OB-4) of the last
+ * solve; 0, or -1 on allocation failure. */
+int cli_report_contact(cli_report *r, const scene *s, const cv_problem *p, const cv_solver *sv);
 
 /* Collect and, without [exact], estimate the error: the rounds' own estimate when
  * `adaptive` (1: --adapt; 2: --tol, then always, with the degrees), else
