@@ -40,8 +40,8 @@ static cv_status node_gaps(const cv_solver *s, const cv_problem *p, int k, const
   return st;
 }
 
-cv_status cv_solver_get_contact(const cv_solver *s, const cv_problem *p, int k, double *iv,
-                                int cap, int *count) {
+cv_status cv_solver_get_contact(const cv_solver *s, const cv_problem *p, int k, double *iv, int cap,
+                                int *count) {
   if (!s || !p || !count || k < 0 || k >= p->nc || (cap > 0 && !iv)) return CVAR_EINVAL;
   if (!s->have) return CVAR_ESTATE;
   *count = 0;

@@ -81,6 +81,72 @@ check("rotation converged", r["status"] == "converged", r["message"])
 check("rotation action", abs(r["action"] - A) <= 1e-9, (r["action"], A))
 check("rotation index", r["morse_index"] == 0, r["morse_index"])
 
+
+# The rotation's path against the exact one under --tol T: the true nodal error at most
+# 10 T. The exact th(t) inverts t(th) = int_0^th dphi / sqrt(2 (E + cos phi)) (th(0) = 0:
+# the guess 2 pi t / 4 has mean pi, and so has the rotation through th(0) = 0, which is odd
+# about t = 2; the phase condition asks for exactly that mean), by Newton's method on
+# 40-point Gauss-Legendre quadrature.
+def gauss_legendre(n):
+    xs, ws = [], []
+    for i in range(n):
+        x = math.cos(math.pi * (i + 0.75) / (n + 0.5))
+        for _ in range(100):
+            p0, p1 = 1.0, x
+            for k in range(2, n + 1):
+                p0, p1 = p1, ((2 * k - 1) * x * p1 - (k - 1) * p0) / k
+            dp = n * (x * p1 - p0) / (x * x - 1)
+            dx = p1 / dp
+            x -= dx
+            if abs(dx) < 1e-16:
+                break
+        xs.append(x)
+        ws.append(2 / ((1 - x * x) * dp * dp))
+    return xs, ws
+
+
+GX, GW = gauss_legendre(40)
+
+
+def energy_for(T):
+    N = 4000
+
+    def period(E):
+        return sum(1 / math.sqrt(2 * (E + math.cos(2 * math.pi * k / N))) for k in range(N)) * \
+            2 * math.pi / N
+
+    lo, hi = 1 + 1e-9, 1e4
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if period(mid) > T else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+E4 = energy_for(4.0)
+
+
+def t_of(th):
+    return sum(w * 0.5 * th / math.sqrt(2 * (E4 + math.cos(0.5 * th * (x + 1))))
+               for x, w in zip(GX, GW))
+
+
+def th_of(t):
+    th = 2 * math.pi * t / 4
+    for _ in range(50):
+        d = (t_of(th) - t) * math.sqrt(2 * (E4 + math.cos(th)))
+        th -= d
+        if abs(d) < 1e-15:
+            break
+    return th
+
+
+for T in (1e-6, 1e-8, 1e-10):
+    p = run(PEND % ("4", "periodic + 2*pi", "2*pi*t/4"), "--tol", repr(T), "--csv", "-")
+    rows = [list(map(float, l.split(","))) for l in p.stdout.split("\n")[1:] if l]
+    err = max(abs(th - th_of(t)) for t, th in rows)
+    print("rotation --tol %g: true max nodal error %.2e on %d nodes" % (T, err, len(rows)))
+    check("rotation --tol %g" % T, err <= 10 * T, err)
+
 RES = """[scene]
 interval  = 0, 2*pi
 unknowns  = y
