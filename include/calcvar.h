@@ -548,6 +548,16 @@ CVAR_API const char *cv_scene_get_unknown(const cv_scene *sc, int i);
 CVAR_API const char *cv_scene_get_title(const cv_scene *sc);
 /** The name of the independent variable ("x" unless the scene says otherwise). */
 CVAR_API const char *cv_scene_get_variable(const cv_scene *sc);
+/** The number of the scene's [constraints] (pointwise, each with a multiplier field). */
+CVAR_API int cv_scene_get_num_constraints(const cv_scene *sc);
+/** The name of constraint k, in file order (its multiplier field is lambda_NAME; index k of
+ * cv_solver_get_multiplier_field); NULL when out of range; owned by the scene. */
+CVAR_API const char *cv_scene_get_constraint(const cv_scene *sc, int k);
+/** The number of the scene's [integrals] (integral constraints, each with a multiplier). */
+CVAR_API int cv_scene_get_num_integrals(const cv_scene *sc);
+/** The name of integral constraint k, in file order (index k of cv_solver_get_multiplier);
+ * NULL when out of range; owned by the scene. */
+CVAR_API const char *cv_scene_get_integral(const cv_scene *sc, int k);
 /** Override a [mesh] or [solver] setting before cv_scene_problem_new and
  * cv_scene_configure_solver, as the command's options do: "elements", "degree",
  * "tolerance", "max_iterations", "adapt", "tol" (a number; "tol" starts from the mesh
