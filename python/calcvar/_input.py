@@ -17,7 +17,9 @@ NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
 
 
 def number(v, what):
-    """A finite real from a Python or numpy number (or a 0-d array)."""
+    """A real from a Python or numpy number (or a 0-d array)."""
+    if type(v) is float or type(v) is int:  # the common case, without the ABC checks
+        return float(v)
     if isinstance(v, np.ndarray) and v.ndim == 0:
         v = v[()]
     if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
@@ -27,6 +29,8 @@ def number(v, what):
 
 def whole(v, what):
     """A whole number from a Python or numpy integer, or a float with no fraction."""
+    if type(v) is int:
+        return v
     x = number(v, what)
     if not np.isfinite(x) or x != int(x):
         raise bad("%s=%r: a whole number is needed" % (what, v))

@@ -50,6 +50,8 @@ class Progress(Structure):
 
 
 PROGRESS_FN = CFUNCTYPE(c_int, POINTER(Progress), c_void_p)
+# the same C type, its arguments left as addresses: the cheapest call for the interrupt check
+TICK_FN = CFUNCTYPE(c_int, c_void_p, c_void_p)
 GUESS_FN = CFUNCTYPE(c_int, c_int, POINTER(c_double), POINTER(c_double), c_void_p)
 
 
@@ -101,7 +103,7 @@ _sig("cv_solver_get_search", c_int, c_void_p, c_void_p)
 _sig("cv_problem_get_interval", None, c_void_p, dp, dp)
 _sig("cv_solver_new", c_void_p, POINTER(c_int))
 _sig("cv_solver_free", None, c_void_p)
-_sig("cv_solver_set_progress", c_int, c_void_p, PROGRESS_FN, c_void_p)
+_sig("cv_solver_set_progress", c_int, c_void_p, c_void_p, c_void_p)  # PROGRESS_FN or TICK_FN
 _sig("cv_solve", c_int, c_void_p, c_void_p)
 _sig("cv_solver_get_status", c_int, c_void_p)
 _sig("cv_solver_get_method", c_int, c_void_p)

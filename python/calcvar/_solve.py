@@ -17,6 +17,7 @@ from ._errors import InputError, bad, fail
 from ._input import expr, number, whole
 from ._interrupt import Guard
 from ._lib import lib
+from ._problem import Problem
 from ._solution import Handles, Solution, Solutions, build_report, read_fields
 
 METHODS = ("newton", "lbfgs", "tnewton", "mma", "ccsaq", "slsqp", "auglag")
@@ -24,8 +25,7 @@ METHODS = ("newton", "lbfgs", "tnewton", "mma", "ccsaq", "slsqp", "auglag")
 
 def scene_text(scene):
     """A Problem's text; a path or scene text unchanged (str, bytes, os.PathLike)."""
-    from ._problem import Problem
-    if isinstance(scene, Problem):
+    if type(scene) is not str and isinstance(scene, Problem):
         return scene.text
     return scene
 
@@ -42,7 +42,7 @@ def load(scene, set, err=None):
         for key, value in set.items():
             pairs.append(("%s=%s" % (key, expr(value, "set %s" % key))).encode())
     arr = (ctypes.c_char_p * len(pairs))(*pairs) if pairs else None
-    if isinstance(scene, os.PathLike):
+    if type(scene) is not str and isinstance(scene, os.PathLike):
         scene = os.fspath(scene)
     if isinstance(scene, bytes):
         scene = scene.decode()
@@ -69,20 +69,23 @@ def _options(elements, degree, method, tolerance, max_iterations, adapt, tol, ma
              time_limit):
     """The options as (name, value) for cv_scene_set_option, checked."""
     out = []
-    for key, v in (("elements", elements), ("degree", degree),
-                   ("max_iterations", max_iterations), ("max_nodes", max_nodes)):
+    if elements is not None:
+        out.append((b"elements", float(whole(elements, "elements"))))
+    if degree is not None:
+        out.append((b"degree", float(whole(degree, "degree"))))
+    for key, v in (("max_iterations", max_iterations), ("max_nodes", max_nodes)):
         if v is not None:
-            out.append((key, float(whole(v, key))))
+            out.append((key.encode(), float(whole(v, key))))
     for key, v in (("tolerance", tolerance), ("adapt", adapt), ("tol", tol),
                    ("time_limit", time_limit)):
         if v is not None:
-            out.append((key, number(v, key)))
+            out.append((key.encode(), number(v, key)))
     if method is not None:
         code = ctypes.c_int()
         if not isinstance(method, str) or lib.cv_method_from_name(
                 method.encode(), ctypes.byref(code)) != _lib.OK:
             raise bad("method=%r: unknown method (known: %s)" % (method, ", ".join(METHODS)))
-        out.append(("method", float(code.value)))
+        out.append((b"method", float(code.value)))
     return out
 
 
@@ -91,7 +94,7 @@ def _progress(guard, user_fn, verbose, caught):
     cancels when Ctrl-C was pressed (guard.hit), or the user's function returned true or
     raised (kept in caught, raised by solve)."""
     if user_fn is None and not verbose:
-        return _lib.PROGRESS_FN(lambda info_p, user: guard.hit)
+        return _lib.TICK_FN(lambda info_p, user: guard.hit)
 
     def call(info_p, _user):
         if guard.hit:
@@ -193,8 +196,9 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
     Bad input raises InputError (a ValueError) with the FILE:LINE sentence. A solve that
     does not converge is not an exception: look at Solution.status / .success.
     """
-    title = getattr(scene, "title", None) if not isinstance(scene, (str, bytes)) else None
-    scene = scene_text(scene)
+    title = None
+    if type(scene) is not str and isinstance(scene, Problem):
+        title, scene = scene.title, scene.text
     opts = _options(elements, degree, method, tolerance, max_iterations, adapt, tol,
                     max_nodes, time_limit)
     if all:
@@ -218,7 +222,7 @@ def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
 def _run(h, g, scene, set, opts, err, all, max_paths, work, guess, progress, verbose, title):
     h.scene = load(scene, set, err)
     for key, value in opts:
-        if lib.cv_scene_set_option(h.scene, key.encode(), value, err, _lib.ERRLEN) != _lib.OK:
+        if lib.cv_scene_set_option(h.scene, key, value, err, _lib.ERRLEN) != _lib.OK:
             raise bad(err.value.decode(errors="replace"))
     h.problem = lib.cv_scene_problem_new(h.scene, err, _lib.ERRLEN)
     if not h.problem:
@@ -236,14 +240,14 @@ def _run(h, g, scene, set, opts, err, all, max_paths, work, guess, progress, ver
         lib.cv_problem_set_guess(h.problem, cb, None)
     cb = _progress(g, progress, verbose, caught)
     h.keep.append(cb)
-    lib.cv_solver_set_progress(h.solver, cb, None)
+    lib.cv_solver_set_progress(h.solver, ctypes.cast(cb, ctypes.c_void_p), None)
     if all:
         if work is not None:
             lib.cv_solver_set_search_work(h.solver, float(work))
         st = lib.cv_solve_all(h.solver, h.problem, int(max_paths))  # the GIL is released
     else:
         st = lib.cv_solve(h.solver, h.problem)  # the GIL is released in here
-    lib.cv_solver_set_progress(h.solver, _lib.PROGRESS_FN(), None)
+    lib.cv_solver_set_progress(h.solver, None, None)
     if g.hit:
         return None  # the Guard raises KeyboardInterrupt; finally frees the handles
     if caught:
