@@ -128,6 +128,7 @@ _sig("cv_solver_set_mesh_hp", c_int, c_void_p, c_int, c_void_p, c_void_p)
 _sig("cv_solver_set_tol", c_int, c_void_p, c_double, c_int)
 _sig("cv_solver_set_adapt", c_int, c_void_p, c_double, c_int)
 _sig("cv_solver_set_breakpoints", c_int, c_void_p, c_int, c_void_p)
+_sig("cv_solver_set_continuation", c_int, c_void_p, c_int)
 _sig("cv_problem_get_num_constraints", c_int, c_void_p)
 _sig("cv_problem_get_num_integrals", c_int, c_void_p)
 

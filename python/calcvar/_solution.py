@@ -158,6 +158,7 @@ class Solution:
         self._report = report
         self._title = title   # a Problem's own title (its scene text carries a plain one)
         self._interp = None
+        self._curve = None
         self.x = x
         self.values = values
         self._code = code
@@ -273,16 +274,42 @@ class Solution:
         if xv.size and not (np.all(xv >= a) and np.all(xv <= b)):
             raise InputError("CVAR_EINVAL", "cannot evaluate the solution there: the points "
                              "must lie in [%.17g, %.17g]" % (a, b))
+        y, dy = self._interp_()(xv, derivative)
+        if scalar:
+            y = y[:, 0]
+            dy = dy[:, 0] if derivative else None
+        return (y, dy) if derivative else y
+
+    def _interp_(self):
         if self._interp is None:
             if self.x.size == 0:
                 raise CalcvarError("CVAR_ESTATE", "this solve has no mesh to evaluate: %s"
                                    % self.message)
             self._interp = Interpolant(self.x, self.values, self.degrees)
-        y, dy = self._interp(xv, derivative)
-        if scalar:
-            y = y[:, 0]
-            dy = dy[:, 0] if derivative else None
-        return (y, dy) if derivative else y
+        return self._interp
+
+    @property
+    def curve_error(self):
+        """The estimated error of sol(x) between the nodes, as a dict: "curve", the max of
+        |sol(x) - y+(x)| over 16 points inside each element and the nodes, and "nodes",
+        the same at the nodes alone (about the report's nodal estimate), y+ the enriched
+        solve of the report's estimate (docs/theory.md HP-2). `tol` and the report bound the
+        nodal error; "curve" is what sol(x) can be off by anywhere. Costs one more solve
+        (the first time); a converged solve only."""
+        if self._curve is None:
+            if not self.success:
+                raise CalcvarError(self.status_code, "no estimate of the curve's error: the "
+                                   "solve did not converge")
+            h = self._hold
+            if h is None:
+                raise CalcvarError("CVAR_ESTATE", "this Solution was unpickled without its "
+                                   "curve error (read curve_error before pickling)")
+            from ._curve import estimate
+            with Guard() as g, h.lock:
+                tick = ctypes.cast(_lib.TICK_FN(lambda i, u: g.hit), ctypes.c_void_p)
+                if self._curve is None:
+                    self._curve = estimate(self, h, tick)
+        return self._curve
 
     @property
     def report(self):
@@ -316,11 +343,12 @@ class Solution:
         self._fields()
         self.report  # noqa: B018 - read now: the copy has no handles to build it from
         return {"x": self.x, "values": self.values, "code": self._code, "fields": self._f,
-                "report": self._report, "title": self._title}
+                "report": self._report, "title": self._title, "curve": self._curve}
 
     def __setstate__(self, st):
         self.__init__(None, st["x"], st["values"], st["code"], st["fields"], st["report"],
                       st["title"])
+        self._curve = st.get("curve")
         for a in (self.x, self.values):
             a.flags.writeable = False
 
