@@ -73,7 +73,6 @@ def estimate(sol, h, tick):
                                % lib.cv_strerror(st).decode())
         lib.cv_solver_set_progress(f, tick, None)
         st = lib.cv_solve(f, h.problem)
-        lib.cv_solver_set_progress(f, None, None)
         if st != _lib.OK:
             raise CalcvarError(status_name(st), "no estimate of the curve's error: the "
                                "enriched solve failed (%s)"

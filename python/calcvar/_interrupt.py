@@ -18,7 +18,8 @@ except ImportError:  # pragma: no cover - another interpreter
 
 SIGINT = _sig.SIGINT
 _default = _sig.default_int_handler
-_main = threading.main_thread()
+_main = threading.main_thread().ident
+_ident = threading.get_ident
 
 
 class Guard:
@@ -35,7 +36,7 @@ class Guard:
         self.hit = True
 
     def __enter__(self):
-        if threading.current_thread() is _main:
+        if _ident() == _main:
             old = _sig.getsignal(SIGINT)
             if callable(old):  # not SIG_IGN / SIG_DFL (Ctrl-C ignored, or fatal anyway)
                 _sig.signal(SIGINT, self._on_sigint)

@@ -49,8 +49,8 @@ class Progress(Structure):
                 ("round", c_int), ("elements", c_int), ("estimate", c_double)]
 
 
-PROGRESS_FN = CFUNCTYPE(c_int, POINTER(Progress), c_void_p)
-# the same C type, its arguments left as addresses: the cheapest call for the interrupt check
+# cv_progress_fn, its arguments left as addresses (the cheapest call for the interrupt check;
+# a progress function reads Progress.from_address(info))
 TICK_FN = CFUNCTYPE(c_int, c_void_p, c_void_p)
 GUESS_FN = CFUNCTYPE(c_int, c_int, POINTER(c_double), POINTER(c_double), c_void_p)
 
@@ -103,7 +103,7 @@ _sig("cv_solver_get_search", c_int, c_void_p, c_void_p)
 _sig("cv_problem_get_interval", None, c_void_p, dp, dp)
 _sig("cv_solver_new", c_void_p, POINTER(c_int))
 _sig("cv_solver_free", None, c_void_p)
-_sig("cv_solver_set_progress", c_int, c_void_p, c_void_p, c_void_p)  # PROGRESS_FN or TICK_FN
+_sig("cv_solver_set_progress", c_int, c_void_p, TICK_FN, c_void_p)
 _sig("cv_solve", c_int, c_void_p, c_void_p)
 _sig("cv_solver_get_status", c_int, c_void_p)
 _sig("cv_solver_get_method", c_int, c_void_p)

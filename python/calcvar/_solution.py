@@ -27,7 +27,7 @@ class Handles:
     """The scene, problem and solver of one solve; freed once, with the last owner."""
 
     __slots__ = ("scene", "problem", "solver", "keep", "lock", "owned")
-    live = 0  # handle triples not yet freed (the tests check that nothing leaks)
+    _live = 0  # handle triples not yet freed (the tests check that nothing leaks)
     _count_lock = threading.Lock()
 
     def __init__(self):
@@ -36,7 +36,7 @@ class Handles:
         self.owned = False  # a Solution holds them
         self.lock = threading.RLock()
         with Handles._count_lock:
-            Handles.live += 1
+            Handles._live += 1
 
     def free(self):
         with self.lock:
@@ -53,7 +53,12 @@ class Handles:
             if scene:
                 lib.cv_scene_free(scene)
             with Handles._count_lock:
-                Handles.live -= 1
+                Handles._live -= 1
+
+    @staticmethod
+    def live():
+        """Handle triples made and not yet freed (the tests check that nothing leaks)."""
+        return Handles._live
 
     def __del__(self):
         try:
@@ -306,7 +311,7 @@ class Solution:
                                    "curve error (read curve_error before pickling)")
             from ._curve import estimate
             with Guard() as g, h.lock:
-                tick = ctypes.cast(_lib.TICK_FN(lambda i, u: g.hit), ctypes.c_void_p)
+                tick = _lib.TICK_FN(lambda i, u: g.hit)
                 if self._curve is None:
                     self._curve = estimate(self, h, tick)
         return self._curve

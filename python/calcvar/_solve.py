@@ -100,7 +100,7 @@ def _progress(guard, user_fn, verbose, caught):
         if guard.hit:
             return 1
         try:
-            info = info_p.contents
+            info = _lib.Progress.from_address(info_p)
             d = {"kind": "round" if info.kind == 1 else "newton",
                  "iteration": info.iteration, "residual": info.residual, "step": info.step,
                  "alpha": info.alpha, "action": info.action, "round": info.round,
@@ -117,7 +117,7 @@ def _progress(guard, user_fn, verbose, caught):
             caught.append(e)
             return 1
 
-    return _lib.PROGRESS_FN(call)
+    return _lib.TICK_FN(call)
 
 
 def _guess(guess, h, caught):
@@ -240,14 +240,14 @@ def _run(h, g, scene, set, opts, err, all, max_paths, work, guess, progress, ver
         lib.cv_problem_set_guess(h.problem, cb, None)
     cb = _progress(g, progress, verbose, caught)
     h.keep.append(cb)
-    lib.cv_solver_set_progress(h.solver, ctypes.cast(cb, ctypes.c_void_p), None)
+    lib.cv_solver_set_progress(h.solver, cb, None)
     if all:
         if work is not None:
             lib.cv_solver_set_search_work(h.solver, float(work))
         st = lib.cv_solve_all(h.solver, h.problem, int(max_paths))  # the GIL is released
     else:
         st = lib.cv_solve(h.solver, h.problem)  # the GIL is released in here
-    lib.cv_solver_set_progress(h.solver, None, None)
+    # the callback stays set: h.keep holds it as long as the solver lives
     if g.hit:
         return None  # the Guard raises KeyboardInterrupt; finally frees the handles
     if caught:

@@ -134,5 +134,5 @@ PATTERNS = {"deepcopy": deepcopy, "pickle": pickle_, "pool_spawn": lambda: pool(
 if __name__ == "__main__":
     PATTERNS[sys.argv[1]]()
     gc.collect()
-    assert Handles.live == 0, "%d handle triples not freed" % Handles.live
+    assert Handles.live() == 0, "%d handle triples not freed" % Handles.live()
     print("OK")

@@ -34,5 +34,5 @@ try:
 except KeyboardInterrupt:
     t = time.time()
     gc.collect()
-    print("interrupted %.6f %d %d" % (t, Handles.live, len(steps) if progress else -1),
+    print("interrupted %.6f %d %d" % (t, Handles.live(), len(steps) if progress else -1),
           flush=True)
