@@ -357,6 +357,37 @@ class Solution:
         for a in (self.x, self.values):
             a.flags.writeable = False
 
+    def plot(self, ax=None, points=801, nodes=True):
+        """Draw each unknown against the variable with matplotlib (an optional import):
+        sol(x) at `points` points and, with nodes=True, the nodal values as dots. Returns
+        the Axes (a new figure's when ax is None)."""
+        import matplotlib.pyplot as plt
+        if ax is None:
+            ax = plt.figure().add_subplot()
+        a, b = self.interval
+        xs = np.linspace(a, b, int(points))
+        ys = self(xs)
+        for i, name in enumerate(self.unknowns):
+            line, = ax.plot(xs, ys[i], label=name)
+            if nodes:
+                ax.plot(self.x, self.values[:, i], ".", color=line.get_color())
+        ax.set_xlabel(self.variable)
+        ax.set_title("%s: %s" % (self.title, self.status))
+        ax.legend()
+        return ax
+
+    def _repr_html_(self):
+        """A short table for Jupyter."""
+        import html
+        rows = [("status", self.status), ("action", "%.15g" % self.action),
+                ("morse index", self.morse_index), ("mesh", "%d elements, degree %d"
+                                                   % (self.elements, self.degree)),
+                ("unknowns", ", ".join(self.unknowns)), ("message", self.message)]
+        return ("<table><caption>calcvar.Solution: %s</caption>%s</table>"
+                % (html.escape(self.title), "".join(
+                    "<tr><th>%s</th><td>%s</td></tr>" % (k, html.escape(str(v)))
+                    for k, v in rows)))
+
     def __repr__(self):
         return ("<calcvar.Solution %s: %s, %d elements of degree %d, unknowns %s>"
                 % (self.title, self.status, self.elements, self.degree,

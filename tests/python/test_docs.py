@@ -26,6 +26,7 @@ def blocks():
 def test_every_python_block_runs():
     found = blocks()
     assert len(found) >= 15, "docs/python.md has %d python blocks" % len(found)
+    os.environ.setdefault("MPLBACKEND", "Agg")  # sol.plot() without a display
     ns = {"__name__": "__docs__"}
     here = os.getcwd()
     os.chdir(ROOT)

@@ -155,3 +155,18 @@ def test_batch_structured_array():
     assert np.max(np.abs(warm["action"] - exact)) < 1e-8 and warm["warm"][1:].all()
     with pytest.raises(ValueError, match="not a parameter|unknown|column"):
         calcvar.batch(CAT, {"k": [1.0]})
+
+
+def test_plot_and_html():
+    """plot() draws sol(x) and the nodes (the drawn data are the solution's own values);
+    _repr_html_ escapes the title."""
+    mpl = pytest.importorskip("matplotlib")
+    mpl.use("Agg")
+    s = calcvar.Problem("y'^2/2", (0, 1), {"y": (0, 1)}, title="<b>line</b>").solve(
+        elements=4, degree=2)
+    ax = s.plot(points=11)
+    curve, dots = ax.get_lines()
+    assert np.allclose(curve.get_ydata(), s(np.linspace(0, 1, 11))[0], atol=0, rtol=0)
+    assert np.array_equal(dots.get_xdata(), s.x)
+    html = s._repr_html_()
+    assert "&lt;b&gt;line&lt;/b&gt;" in html and "converged" in html
