@@ -3,6 +3,8 @@ them (the cv_batch_* API: the scene compiled once, rows on several threads), int
 numpy structured array.
 SPDX-License-Identifier: MIT
 """
+from __future__ import annotations
+
 import ctypes
 import os
 import tempfile
@@ -39,7 +41,8 @@ def _columns(table):
     return names, cols
 
 
-def batch(scene, table, *, threads=0, warm=False, elements=None, degree=None):
+def batch(scene, table, *, threads: int = 0, warm: bool = False,
+          elements: int | None = None, degree: int | None = None) -> np.ndarray:
     """Solve the scene once per row of `table` (parameters of [parameters], a column per
     parameter given), as `calcvar batch SCENE TABLE` does, and return a numpy structured
     array: the table's columns, then status, action, iterations, time_s, morse_index (-1

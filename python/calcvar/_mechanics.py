@@ -2,6 +2,8 @@
 of a scene, as the dicts of their --json (docs/mechanics.md).
 SPDX-License-Identifier: MIT
 """
+from __future__ import annotations
+
 import ctypes
 import json
 
@@ -29,7 +31,7 @@ def _mechanics(new, to_json, free, scene, set):
             lib.cv_scene_free(h)
 
 
-def equations(scene, *, set=None):
+def equations(scene, *, set: dict | None = None) -> dict:
     """The mechanics of a scene's integrand F (a path, scene text or Problem, with `set`
     overriding [parameters]) as a dict, the JSON of `calcvar equations --json`
     (docs/mechanics.md): "momenta" and "euler_lagrange" ({unknown: expression}),
@@ -40,7 +42,7 @@ def equations(scene, *, set=None):
                       scene, set)
 
 
-def modes(scene, *, set=None):
+def modes(scene, *, set: dict | None = None) -> dict:
     """The equilibrium of a scene's Lagrangian L(y, y') found from its guess at the start
     of the interval, and the small oscillations there, as a dict: the JSON of `calcvar
     modes --json` (docs/mechanics.md): "equilibrium" ({unknown: value}), "modes" (a list of

@@ -9,6 +9,8 @@ copy.deepcopy), which read them under the same lock. Pickling reads everything f
 can cross processes (multiprocessing, fork or spawn) and threads.
 SPDX-License-Identifier: MIT
 """
+from __future__ import annotations
+
 import copy
 import ctypes
 import json
@@ -258,13 +260,13 @@ class Solution:
             return self[name]
         raise AttributeError("Solution has no attribute or unknown %r" % name)
 
-    def keys(self):
+    def keys(self) -> tuple:
         """The names s[name] accepts: unknowns, lambda_C and mu_K."""
         f = self._fields()
         return (f["unknowns"] + tuple("lambda_" + c for c in f["lambdas"])
                 + tuple("mu_" + k for k in f["mus"]))
 
-    def __call__(self, xs, derivative=False):
+    def __call__(self, xs, derivative: bool = False):
         """The solution (and with derivative=True also y') at xs in [a, b]: arrays of shape
         (n, m) for m abscissae, (n,) for a scalar."""
         scalar = np.ndim(xs) == 0

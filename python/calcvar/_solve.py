@@ -7,13 +7,16 @@ flag the progress callback returns to the library after every Newton step (Ctrl-
 the solve within one step, then KeyboardInterrupt is raised; docs/python.md).
 SPDX-License-Identifier: MIT
 """
+from __future__ import annotations
+
 import ctypes
 import os
+from typing import Any, Callable, Mapping, Optional, Union
 
 import numpy as np
 
 from . import _lib
-from ._errors import InputError, bad, fail
+from ._errors import bad, fail
 from ._input import expr, number, whole
 from ._interrupt import Guard
 from ._lib import lib
@@ -164,10 +167,19 @@ def _guess(guess, h, caught):
     return _lib.GUESS_FN(call)
 
 
-def solve(scene, *, elements=None, degree=None, method=None, tolerance=None,
-          max_iterations=None, adapt=None, set=None, tol=None, max_nodes=None,
-          time_limit=None, all=False, max_paths=8, work=None, guess=None, progress=None,
-          verbose=False):
+Scene = Union[str, bytes, "os.PathLike[str]", Problem]
+Number = Union[int, float, "np.number"]
+
+
+def solve(scene: Scene, *, elements: Optional[Number] = None,
+          degree: Optional[Number] = None, method: Optional[str] = None,
+          tolerance: Optional[Number] = None, max_iterations: Optional[Number] = None,
+          adapt: Optional[Number] = None, set: Optional[Mapping[str, Any]] = None,
+          tol: Optional[Number] = None, max_nodes: Optional[Number] = None,
+          time_limit: Optional[Number] = None, all: bool = False, max_paths: int = 8,
+          work: Optional[Number] = None, guess: Any = None,
+          progress: Optional[Callable[[dict], Any]] = None,
+          verbose: bool = False) -> Union[Solution, Solutions]:
     """Solve a scene as `calcvar solve` does and return a Solution.
 
     scene: a path (str or os.PathLike), the text of a scene (any str with a newline or
