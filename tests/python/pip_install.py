@@ -19,7 +19,8 @@ import tempfile
 
 CATENARY = r'''
 import calcvar
-sol = calcvar.Problem("y*sqrt(1 + y'^2)", (-1, 1), {"y": ("2*cosh(1/2)", "2*cosh(1/2)")}).solve(elements=16, degree=4)
+p = calcvar.Problem("y*sqrt(1 + y'^2)", (-1, 1), {"y": ("2*cosh(1/2)", "2*cosh(1/2)")})
+sol = p.solve(elements=16, degree=4)
 print(sol.status, sol.action)
 import math, os, sys
 exact = 2 + 2 * math.sinh(1)   # c (1 + (c/2) sinh(2/c)), c = 2

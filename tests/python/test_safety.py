@@ -40,9 +40,9 @@ def test_crash_pattern(pattern):
 @pytest.mark.parametrize("mode", ["plain", "progress"])
 def test_ctrl_c_stops_the_solve(mode):
     """SIGINT 1.5 s into a solve that would run for about half a minute: KeyboardInterrupt
-    within BOUND = 1 s (a Newton step here takes 0.02-0.4 s; measured: 0.01-0.07 s), every handle freed, and nothing
-    printed by ctypes ("Exception ignored ..."). Three times each, with and without a
-    progress function."""
+    within BOUND = 1 s (a Newton step here takes 0.02-0.4 s; measured: 0.01-0.07 s), every
+    handle freed, and nothing printed by ctypes ("Exception ignored ..."). Three times each,
+    with and without a progress function."""
     for run in range(3):
         p = subprocess.Popen([sys.executable, os.path.join(HERE, "interrupt_child.py"), mode],
                              env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
