@@ -759,7 +759,11 @@ CVAR_API cv_status cv_solver_set_search_work(cv_solver *s, double factor);
 /** Number of distinct converged paths of the last cv_solve_all (0 otherwise). */
 CVAR_API int cv_solver_get_num_solutions(const cv_solver *s);
 /** Make path k (0 <= k < cv_solver_get_num_solutions) the one the getters read (nodes,
- * values, action, Morse index, multipliers, ...). CVAR_ESTATE without a cv_solve_all. */
+ * values, action, Morse index, multipliers, ...). CVAR_ESTATE without a cv_solve_all.
+ * Selecting modifies the solver: the paths are not handles of their own, and the rule on
+ * threads (one handle, one thread at a time) covers select-then-read as one use. To use
+ * paths independently, copy each one's results out (the Python module reads every path,
+ * with its report, into a Solution of its own). */
 CVAR_API cv_status cv_solver_select_solution(cv_solver *s, int k);
 /** What the last cv_solve_all tried and why it stopped. CVAR_ESTATE without one. */
 CVAR_API cv_status cv_solver_get_search(const cv_solver *s, cv_search_info *info);
