@@ -12,7 +12,7 @@ import tempfile
 import numpy as np
 
 from . import _lib
-from ._errors import bad, fail, status_word
+from ._errors import InputError, bad, fail, status_word
 from ._input import whole
 from ._interrupt import Guard
 from ._lib import lib
@@ -54,7 +54,7 @@ def batch(scene, table, *, threads: int = 0, warm: bool = False,
     scene: a path, scene text or Problem. threads: 0 = the cores available. warm: start
     each row from the previous row's solution on the same thread. elements, degree:
     override [mesh]. Bad values (a row that makes the scene invalid) raise InputError
-    naming the row before anything is solved.
+    naming the row (counted from 0) before anything is solved.
     """
     from ._solve import scene_text
     text = scene_text(scene)
@@ -80,6 +80,10 @@ def batch(scene, table, *, threads: int = 0, warm: bool = False,
             if not b:
                 raise bad(err.value.decode(errors="replace").replace(tmp or "\0", "<string>"))
             return _run(b, g, names, rows, nrows, threads, warm, mesh, err)
+        except InputError as e:
+            if tmp:  # scene text: name it as solve() does, not by the temporary file
+                raise bad(str(e).replace(tmp, "<string>")) from None
+            raise
         finally:
             if b:
                 lib.cv_batch_free(b)
@@ -119,6 +123,12 @@ def _run(b, g, names, rows, nrows, threads, warm, mesh, err):
             fail(st, "batch: the rows could not be solved (%s)" % lib.cv_strerror(st).decode())
     if g.hit:
         return None
+    fixed = ("status", "action", "iterations", "time_s", "morse_index", "error_max_nodal",
+             "error_estimate", "warm", "message")
+    clash = [n for n in names if n in fixed or n in outs]
+    if clash:
+        raise bad("table: the parameter %r has the name of a result column; rename it in the "
+                  "scene to use batch()" % clash[0])
     dtype = ([(n, "f8") for n in names]
              + [("status", "U16"), ("action", "f8"), ("iterations", "i4"), ("time_s", "f8"),
                 ("morse_index", "i4"), ("error_max_nodal", "f8"), ("error_estimate", "f8")]

@@ -155,6 +155,15 @@ def test_batch_structured_array():
     assert np.max(np.abs(warm["action"] - exact)) < 1e-8 and warm["warm"][1:].all()
     with pytest.raises(ValueError, match="not a parameter|unknown|column"):
         calcvar.batch(CAT, {"k": [1.0]})
+    # c = 0 makes the ends c cosh(1/c) infinite: refused naming the row, before solving
+    with pytest.raises(ValueError, match=r"table row 1: <string>:\d+: \[boundary\] y at a "
+                                         r"is not a finite number"):
+        calcvar.batch(CAT, {"c": [2.0, 0.0]})
+    with pytest.raises(ValueError, match="finite"):
+        calcvar.batch(CAT, {"c": [np.nan]})
+    clash = calcvar.Problem("y'^2/2", (0, 1), {"y": (0, "status")}, parameters={"status": 1})
+    with pytest.raises(ValueError, match="name of a result column"):
+        calcvar.batch(clash, {"status": [1.0]})
 
 
 def test_plot_and_html():
