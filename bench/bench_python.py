@@ -2,7 +2,8 @@
 """bench/bench_python.py — what calcvar.solve adds to the same C calls (target <= 20 us).
 
 usage: CALCVAR_LIB=build/libcalcvar.so PYTHONPATH=python \\
-       python3 bench/bench_python.py build/bench/bench_scene_api [SCENE]
+       flock /tmp/calcvar-build.lock /usr/bin/python3 bench/bench_python.py \\
+       build/bench/bench_scene_api [SCENE]
 Both sides solve the same scene on the same small mesh (so that the overhead is not
 hidden in a long solve) and copy nodes and values out; each side is the best of 5 rounds,
 the C baseline (bench_scene_api) measured in the same run. Timings on a shared machine

@@ -658,6 +658,16 @@ CVAR_API const char *cv_scene_get_unknown(const cv_scene *sc, int i);
 CVAR_API const char *cv_scene_get_title(const cv_scene *sc);
 /** The name of the independent variable ("x" unless the scene says otherwise). */
 CVAR_API const char *cv_scene_get_variable(const cv_scene *sc);
+/** The number of the scene's [constraints] (pointwise, each with a multiplier field). */
+CVAR_API int cv_scene_get_num_constraints(const cv_scene *sc);
+/** The name of constraint k, in file order (its multiplier field is lambda_NAME; index k of
+ * cv_solver_get_multiplier_field); NULL when out of range; owned by the scene. */
+CVAR_API const char *cv_scene_get_constraint(const cv_scene *sc, int k);
+/** The number of the scene's [integrals] (integral constraints, each with a multiplier). */
+CVAR_API int cv_scene_get_num_integrals(const cv_scene *sc);
+/** The name of integral constraint k, in file order (index k of cv_solver_get_multiplier);
+ * NULL when out of range; owned by the scene. */
+CVAR_API const char *cv_scene_get_integral(const cv_scene *sc, int k);
 /** Override a [mesh] or [solver] setting before cv_scene_problem_new and
  * cv_scene_configure_solver, as the command's options do: "elements", "degree",
  * "tolerance", "max_iterations", "adapt", "tol" (a number; "tol" starts from the mesh
@@ -859,7 +869,11 @@ CVAR_API cv_status cv_solver_set_search_work(cv_solver *s, double factor);
 /** Number of distinct converged paths of the last cv_solve_all (0 otherwise). */
 CVAR_API int cv_solver_get_num_solutions(const cv_solver *s);
 /** Make path k (0 <= k < cv_solver_get_num_solutions) the one the getters read (nodes,
- * values, action, Morse index, multipliers, ...). CVAR_ESTATE without a cv_solve_all. */
+ * values, action, Morse index, multipliers, ...). CVAR_ESTATE without a cv_solve_all.
+ * Selecting modifies the solver: the paths are not handles of their own, and the rule on
+ * threads (one handle, one thread at a time) covers select-then-read as one use. To use
+ * paths independently, copy each one's results out (the Python module reads every path,
+ * with its report, into a Solution of its own). */
 CVAR_API cv_status cv_solver_select_solution(cv_solver *s, int k);
 /** What the last cv_solve_all tried and why it stopped. CVAR_ESTATE without one. */
 CVAR_API cv_status cv_solver_get_search(const cv_solver *s, cv_search_info *info);

@@ -1,6 +1,7 @@
 """calcvar._lib — the C library through ctypes (internal).
 
-The library is found, in order, at $CALCVAR_LIB, at the path meson wrote into
+The library is found, in order, at $CALCVAR_LIB, beside the module in the wheel of
+`pip install .` (meson-python's .calcvar.mesonpy.libs), at the path meson wrote into
 _config.py when it installed this module, or by ctypes.util.find_library. Every call
 below goes through ctypes.CDLL, which releases the GIL for the duration of the call
 (so a long cv_solve does not block other Python threads); callbacks take it back.
@@ -21,10 +22,14 @@ def _find():
         return path
     try:
         from . import _config  # written by meson at install time
-        if os.path.exists(_config.LIBRARY):
-            return _config.LIBRARY
-    except ImportError:
-        pass
+    except ImportError:  # the source tree (tests set CALCVAR_LIB)
+        _config = None
+    if _config is not None:
+        here = os.path.dirname(os.path.abspath(__file__))
+        bundled = os.path.join(os.path.dirname(here), ".calcvar.mesonpy.libs", _config.BUNDLED)
+        for path in (bundled, _config.LIBRARY):
+            if os.path.exists(path):
+                return path
     name = ctypes.util.find_library("calcvar")
     if name:
         return name
@@ -44,7 +49,9 @@ class Progress(Structure):
                 ("round", c_int), ("elements", c_int), ("estimate", c_double)]
 
 
-PROGRESS_FN = CFUNCTYPE(c_int, POINTER(Progress), c_void_p)
+# cv_progress_fn, its arguments left as addresses (the cheapest call for the interrupt check;
+# a progress function reads Progress.from_address(info))
+TICK_FN = CFUNCTYPE(c_int, c_void_p, c_void_p)
 GUESS_FN = CFUNCTYPE(c_int, c_int, POINTER(c_double), POINTER(c_double), c_void_p)
 
 
@@ -69,6 +76,10 @@ _sig("cv_scene_get_num_unknowns", c_int, c_void_p)
 _sig("cv_scene_get_unknown", c_char_p, c_void_p, c_int)
 _sig("cv_scene_get_title", c_char_p, c_void_p)
 _sig("cv_scene_get_variable", c_char_p, c_void_p)
+_sig("cv_scene_get_num_constraints", c_int, c_void_p)
+_sig("cv_scene_get_constraint", c_char_p, c_void_p, c_int)
+_sig("cv_scene_get_num_integrals", c_int, c_void_p)
+_sig("cv_scene_get_integral", c_char_p, c_void_p, c_int)
 _sig("cv_scene_set_option", c_int, c_void_p, c_char_p, c_double, c_char_p, c_size_t)
 _sig("cv_scene_problem_new", c_void_p, c_void_p, c_char_p, c_size_t)
 _sig("cv_scene_configure_solver", c_int, c_void_p, c_void_p, c_char_p, c_size_t)
@@ -92,7 +103,7 @@ _sig("cv_solver_get_search", c_int, c_void_p, c_void_p)
 _sig("cv_problem_get_interval", None, c_void_p, dp, dp)
 _sig("cv_solver_new", c_void_p, POINTER(c_int))
 _sig("cv_solver_free", None, c_void_p)
-_sig("cv_solver_set_progress", c_int, c_void_p, PROGRESS_FN, c_void_p)
+_sig("cv_solver_set_progress", c_int, c_void_p, TICK_FN, c_void_p)
 _sig("cv_solve", c_int, c_void_p, c_void_p)
 _sig("cv_solver_get_status", c_int, c_void_p)
 _sig("cv_solver_get_method", c_int, c_void_p)
@@ -107,6 +118,41 @@ _sig("cv_solver_get_action", c_double, c_void_p)
 _sig("cv_solver_get_num_iterations", c_int, c_void_p)
 _sig("cv_solver_get_morse_index", c_int, c_void_p)
 _sig("cv_solver_eval", c_int, c_void_p, c_int, c_void_p, c_void_p, c_void_p)
+_sig("cv_solver_get_degrees", c_int, c_void_p, c_void_p)
+_sig("cv_solver_get_error_estimate", c_double, c_void_p)
+_sig("cv_solver_get_time", c_double, c_void_p)
+_sig("cv_solver_get_multiplier_field", c_int, c_void_p, c_int, c_void_p)
+_sig("cv_solver_get_multiplier", c_int, c_void_p, c_int, POINTER(c_double))
+_sig("cv_solver_set_start", c_int, c_void_p, c_int, c_void_p)
+_sig("cv_solver_set_mesh_hp", c_int, c_void_p, c_int, c_void_p, c_void_p)
+_sig("cv_solver_set_tol", c_int, c_void_p, c_double, c_int)
+_sig("cv_solver_set_adapt", c_int, c_void_p, c_double, c_int)
+_sig("cv_solver_set_breakpoints", c_int, c_void_p, c_int, c_void_p)
+_sig("cv_solver_set_continuation", c_int, c_void_p, c_int)
+_sig("cv_problem_get_num_constraints", c_int, c_void_p)
+_sig("cv_problem_get_num_integrals", c_int, c_void_p)
+
+# cv_batch_* (the engine of `calcvar batch`)
+class BatchResult(Structure):
+    """cv_batch_result of calcvar.h."""
+    _fields_ = [("status", c_int), ("iterations", c_int), ("time_s", c_double),
+                ("has_result", c_int), ("action", c_double), ("morse_index", c_int),
+                ("error_max_nodal", c_double), ("error_estimate", c_double),
+                ("outputs", POINTER(c_double)), ("warm", c_int), ("message", ctypes.c_char * 400)]
+
+
+_sig("cv_batch_new", c_void_p, c_char_p, c_char_p, c_size_t)
+_sig("cv_batch_free", None, c_void_p)
+_sig("cv_batch_num_parameters", c_int, c_void_p)
+_sig("cv_batch_parameter_name", c_char_p, c_void_p, c_int)
+_sig("cv_batch_num_outputs", c_int, c_void_p)
+_sig("cv_batch_output_name", c_char_p, c_void_p, c_int)
+_sig("cv_batch_set_columns", c_int, c_void_p, c_int, POINTER(c_char_p), c_char_p, c_size_t)
+_sig("cv_batch_set_threads", c_int, c_void_p, c_int)
+_sig("cv_batch_set_warm_start", c_int, c_void_p, c_int)
+_sig("cv_batch_set_mesh", c_int, c_void_p, c_int, c_int)
+_sig("cv_batch_check_row", c_int, c_void_p, c_void_p, c_char_p, c_size_t)
+_sig("cv_batch_solve", c_int, c_void_p, c_int, c_void_p, POINTER(BatchResult))
 
 STATUS = {}
 _k = 0
@@ -118,6 +164,7 @@ while True:
     _k += 1
 OK = STATUS["CVAR_OK"]
 EINVAL = STATUS["CVAR_EINVAL"]
+ECANCELLED = STATUS["CVAR_ECANCELLED"]
 ENOMEM = STATUS["CVAR_ENOMEM"]
 
 

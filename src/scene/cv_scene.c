@@ -114,6 +114,18 @@ const char *cv_scene_get_variable(const cv_scene *sc) {
   return sc && sc->s->variable ? sc->s->variable : "x";
 }
 
+int cv_scene_get_num_constraints(const cv_scene *sc) { return sc ? sc->s->ncons : 0; }
+
+const char *cv_scene_get_constraint(const cv_scene *sc, int k) {
+  return sc && k >= 0 && k < sc->s->ncons ? sc->s->cons[k].name : NULL;
+}
+
+int cv_scene_get_num_integrals(const cv_scene *sc) { return sc ? sc->s->nints : 0; }
+
+const char *cv_scene_get_integral(const cv_scene *sc, int k) {
+  return sc && k >= 0 && k < sc->s->nints ? sc->s->ints[k].name : NULL;
+}
+
 /* Integer options must be whole numbers in range; reals finite and positive. */
 static int whole(double v, double lo, double hi) {
   return isfinite(v) && v == floor(v) && v >= lo && v <= hi;

@@ -143,7 +143,7 @@ def test_problem_pointwise_constraint_and_free_end():
     # free end: min int y'^2/2 + y, y(0) = 0, y'(1) = 0: y = x^2/2 - x
     q = calcvar.Problem(integrand="y'^2/2 + y", interval=(0, 1), boundary={"y": (0, None)})
     s2 = q.solve(elements=4, degree=2)
-    assert np.max(np.abs(s2.y - (s2.x**2 / 2 - s2.x))) < 1e-10
+    assert np.max(np.abs(s2["y"] - (s2.x**2 / 2 - s2.x))) < 1e-10
 
 
 def test_problem_equations():
