@@ -41,11 +41,14 @@ class Problem:
                 a string in calcvar's grammar (powers with ^) or a sympy expression
     interval    (a, b)
     boundary    {unknown: (value_at_a, value_at_b)}; None or "free" leaves that end free
-                (natural boundary condition); values may be expressions
+                (natural boundary condition); values may be expressions; "periodic" or
+                "periodic + D" instead of the pair makes a closed path (docs/periodic.md)
     unknowns    names in order (default: the order of boundary)
     variable    the independent variable's name (default "x")
     parameters  {name: value}          definitions  {name: expression}
-    constraints {name: G}              pointwise G(x, y) = 0, multiplier field lambda_name
+    constraints {name: G}              pointwise G(x, y) = 0, multiplier field lambda_name;
+                                       "G >= 0" or "G <= 0": an obstacle (docs/obstacles.md)
+    ends        {"start" | "end": "free" or G(x, y)}: a moving end (docs/moving-ends.md)
     integrals   {name: (K, c)}         int K dx = c, multiplier mu_name
     guess, exact {unknown: expression of the variable}; exact may have "action": value
     report      {name: K}              integrals reported after solving
@@ -57,7 +60,8 @@ class Problem:
 
     def __init__(self, integrand, interval, boundary, unknowns=None, variable="x",
                  parameters=None, definitions=None, constraints=None, integrals=None,
-                 guess=None, exact=None, report=None, mesh=None, solver=None, title=None):
+                 guess=None, exact=None, report=None, mesh=None, solver=None, title=None,
+                 ends=None):
         if not isinstance(boundary, dict):
             raise bad("boundary must be a dict {unknown: (value at a, value at b)}")
         if unknowns is None:  # slope lines ("y'") are not unknowns
@@ -86,9 +90,17 @@ class Problem:
         def ex(k, v, what):
             return expr(v, what)
 
-        def ends(k, v, what):
+        def values(k, v, what):
+            if isinstance(v, str) and v.strip().startswith("periodic"):  # docs/periodic.md
+                check_text(v, what)
+                return v.strip()
             ya, yb = _pair(v, what)
             return "%s, %s" % (_end(ya, what), _end(yb, what))
+
+        def moving(k, v, what):  # docs/moving-ends.md
+            if k not in ("start", "end"):
+                raise bad("%s: the keys of ends are 'start' and 'end'" % what)
+            return _end(v, what)
 
         def integral(k, v, what):
             K, c = _pair(v, what + " (K, c)")
@@ -96,11 +108,12 @@ class Problem:
 
         section("parameters", parameters, ex)
         section("definitions", definitions, ex)
-        section("boundary", boundary, ends)
+        section("boundary", boundary, values)
         section("guess", guess, ex)
         section("constraints", constraints, ex)
         section("integrals", integrals, integral)
         section("exact", exact, ex)
+        section("ends", ends, moving)
         section("report", report, ex)
         section("mesh", mesh, lambda k, v, w: _setting(v, w))
         section("solver", solver, lambda k, v, w: _setting(v, w))
