@@ -132,9 +132,7 @@ int ex_eval_with(const ex_dag *d, ex_id e, const double *slots,
     }
     switch (nd->op) {
     case EX_NUM: val[i] = nd->v; break;
-    case EX_SLOT:
-      val[i] = slot_value ? slot_value(user, nd->a) : slots ? slots[nd->a] : NAN;
-      break;
+    case EX_SLOT: val[i] = slot_value ? slot_value(user, nd->a) : slots ? slots[nd->a] : NAN; break;
     case EX_TABLE: ex_table_apply(d, nd, u, &val[i]); break; /* NaN outside the grid */
     default: val[i] = ex_apply(nd->op, u[0], u[1], u[2]);
     }
