@@ -55,7 +55,7 @@ def expect(what, r, code, msg=None):
 
 
 def no_temp_left(what, d):
-    left = [f for f in os.listdir(d) if ".tmp." in f]
+    left = [f for f in os.listdir(d) if ".tmp." in f or f.startswith("calcvar-")]
     if left:
         fail(what + ": temporary files", "none left", left)
 
@@ -335,6 +335,37 @@ def check_signals(tmp):
             fail("batch under %s: the old output" % sig.name, "kept", read(out)[:60])
 
 
+def check_plot_memory(tmp):
+    """Item 1: --plot under a memory limit ends with exit 0 and a whole picture, or exit 3,
+    a sentence and the old picture; never a crash, never a temporary file left."""
+    import resource
+
+    def limit(mb):
+        return lambda: resource.setrlimit(resource.RLIMIT_AS, (mb << 20, mb << 20))
+    probe = run(["--version"], tmp, preexec_fn=limit(400))
+    if probe.returncode != 0:  # a sanitised build reserves terabytes of address space
+        print("skip: calcvar does not start under a 400 MB address-space limit (sanitisers?)")
+        return
+    for pic in ("p.png", "p.svg"):
+        for mb in (30, 45, 60, 80, 105, 400):
+            target = os.path.join(tmp, pic)
+            write(target, b"old picture\n")
+            r = run(["solve", SCENE, "--quiet", "--plot", pic], tmp, preexec_fn=limit(mb),
+                    env=dict(os.environ, TMPDIR=tmp))  # the drawing's scratch file too
+            what = "--plot %s under %d MB" % (pic, mb)
+            if r.returncode == 0:
+                data = read(target)
+                whole = data.rstrip().endswith(b"</svg>") if pic.endswith("svg") else \
+                    data.startswith(b"\x89PNG") and data.endswith(b"IEND\xaeB`\x82")
+                if not whole:
+                    fail(what, "a whole picture with exit 0", data[:40])
+            else:
+                expect(what, r, 3, "the plotting library failed")
+                if read(target) != b"old picture\n":
+                    fail(what, "the old picture kept", read(target)[:40])
+            no_temp_left(what, tmp)
+
+
 def check_mpi(tmp):
     """Item 3: under MPI a failing output ends every rank, with exit 3."""
     mpirun = shutil.which("mpirun")
@@ -372,7 +403,7 @@ def main():
     with tempfile.TemporaryDirectory() as base:
         for check in (check_table_inputs, check_bad_bytes, check_closed_stdout,
                       check_same_file, check_stdout_append, check_full, check_tmpfs,
-                      check_pipe_closed, check_signals, check_mpi):
+                      check_pipe_closed, check_signals, check_plot_memory, check_mpi):
             d = os.path.join(base, check.__name__)
             os.mkdir(d)
             n0 = failures
