@@ -608,7 +608,7 @@ int cli_batch(int argc, char **argv) {
   cli_mpi mpi;
   cli_mpi_init(&mpi);
   rc = own_args(argc, argv, rest, &nrest, &table_path, &out_path, &threads, &warm, &help);
-  if (rc == 0) rc = cli_args_parse("batch", nrest, rest, &o);
+  if (rc == 0 && !help) rc = cli_args_parse("batch", nrest, rest, &o); /* --help needs no scene */
   free(rest);
   if (rc != 0 || help || o.help) {
     if (rc == 0 && mpi.rank == 0) usage(stdout);
