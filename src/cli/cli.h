@@ -4,6 +4,7 @@
 #define CV_CLI_H
 
 #include <stdio.h>
+#include <sys/types.h>
 
 #include "calcvar.h"
 #include "scene/scene.h"
@@ -74,16 +75,40 @@ typedef struct {
   char *scratch;    /* a rendering scratch file in $TMPDIR (streams) */
   int stream;       /* dest is a device, FIFO or socket: written through */
   FILE *f;
+  int exists; /* identity (regular files): dest's device and inode, or, when dest */
+  dev_t dev;  /* is not there yet, its directory's and base, its name there */
+  ino_t ino;
+  const char *base;
 } cli_outfile;
 int cli_outfile_open(cli_outfile *o, const char *path, const char *input);
+/* The same with several files being read (inputs[k] may be NULL or "-"), all refused as
+ * outputs (the first is called the scene in the message). */
+int cli_outfile_open_inputs(cli_outfile *o, const char *path, const char *const *inputs,
+                            int ninputs);
+/* -1 after a message when two open outputs are one file (--json X --csv ./X), else 0. */
+int cli_outfile_clash(const cli_outfile *a, const cli_outfile *b, const char *what_a,
+                      const char *what_b);
 int cli_outfile_commit(cli_outfile *o);
 /* Commit when the writer succeeded (wrote >= 0), else say why (a write error) and abandon. */
 int cli_outfile_finish(cli_outfile *o, int wrote);
-/* For a library that writes a file by name (PLplot): the name to write to, then
- * commit_rendered moves or copies it into place. */
+/* For a library that writes a file by name (PLplot): a scratch file to write to, then
+ * commit_rendered checks that it holds a whole picture (PNG, or SVG when svg) and copies
+ * it into o with every write checked, and commits. */
 int cli_outfile_render_name(cli_outfile *o, const char **name);
-int cli_outfile_commit_rendered(cli_outfile *o);
+int cli_outfile_commit_rendered(cli_outfile *o, int svg);
 void cli_outfile_abandon(cli_outfile *o);
+/* Whether a failure to write standard output was already said (said once a run). */
+int cli_stdout_reported(void);
+void cli_stdout_set_reported(void);
+/* cli_signals.c: temporary files removed when the run is interrupted. cli_mkstemp is
+ * mkstemp that registers its file (and never returns a descriptor 0-2: they are held
+ * open from the start, cli_signals_setup); cli_temp_forget drops a name once the file is
+ * renamed or removed (NULL is ignored). cli_signals_setup also makes SIGPIPE a write error
+ * (EPIPE: exit 3) and returns 1 when standard output was closed at the start. */
+int cli_signals_setup(void);
+int cli_mkstemp(char *tmpl);
+void cli_temp_forget(const char *name);
+
 /* args.c: the start of a command that reads one scene (equations, modes): parse the
  * arguments (--help prints usage), accept only the scene options, load the scene into *s
  * and open --json's file in *jf. Returns -1 to go on, else the exit status (after a

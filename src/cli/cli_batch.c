@@ -10,12 +10,14 @@
  */
 #define _GNU_SOURCE /* sched_getaffinity, CPU_COUNT, getline */
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
 #include <sched.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -39,7 +41,8 @@ static void usage(FILE *f) {
         "Output: the input columns, status, action, iterations, time_s, morse_index,\n"
         "error_max_nodal (with [exact]), error_estimate (with --adapt, always with --tol),\n"
         "one column per [report] entry and integral multiplier (mu_NAME), message.\n"
-        "exit status: 0 every row converged, 1 some did not, 2 bad input\n",
+        "exit status: 0 every row converged, 1 some did not, 2 bad input, 3 the output\n"
+        "could not be written\n",
         f);
 }
 
@@ -52,6 +55,13 @@ int cli_cores_available(void) {
 
 /* ---- the table ---------------------------------------------------------------------- */
 
+/* The table is opened once and read twice (check, then solve) through one stream: a
+ * regular file is rewound; standard input ("-", or a path to the same file such as
+ * /dev/stdin) that is a pipe is first copied into an unlinked scratch file. Like a scene,
+ * a table must be a regular file or standard input (a FIFO would block, /dev/zero never
+ * ends) of at most SC_MAX_TABLE_BYTES, its lines at most MAX_LINE bytes of text. */
+enum { MAX_LINE = 1 << 20 };
+
 typedef struct {
   const char *path;
   FILE *f;
@@ -59,17 +69,147 @@ typedef struct {
   size_t cap;
   int lineno;
   int ncols;
-  char **names; /* header */
-  char **field; /* fields of the current row (point into line) */
+  char **names;  /* header */
+  char **field;  /* fields of the current row (point into line) */
+  char why[160]; /* next_line's reason for -2 */
 } table;
 
+static const char *kind_of(mode_t m) {
+  return S_ISDIR(m)    ? "a directory"
+         : S_ISCHR(m)  ? "a character device"
+         : S_ISBLK(m)  ? "a block device"
+         : S_ISFIFO(m) ? "a FIFO (named pipe)"
+         : S_ISSOCK(m) ? "a socket"
+                       : "not a regular file";
+}
+
+/* Does path name the file standard input is open on ("-", /dev/stdin, /dev/fd/0)? */
+static int is_stdin(const char *path) {
+  struct stat a, b;
+  if (strcmp(path, "-") == 0) return 1;
+  return stat(path, &a) == 0 && fstat(STDIN_FILENO, &b) == 0 && a.st_dev == b.st_dev &&
+         a.st_ino == b.st_ino;
+}
+
+/* Bytes a table's text may not hold: NUL and the control characters but tab and CR. */
+static int bad_byte(const char *p, size_t n) {
+  for (size_t i = 0; i < n; i++) {
+    unsigned char c = (unsigned char)p[i];
+    if ((c < 0x20 && c != '\t' && c != '\r' && c != '\n') || c == 0x7f) return 1 + (int)i;
+  }
+  return 0;
+}
+
+/* Standard input that is not a regular file, copied into an unlinked scratch file (at
+ * most SC_MAX_TABLE_BYTES). The stream, or NULL after a message. */
+static FILE *spool_stdin(const char *path) {
+  const char *dir = getenv("TMPDIR");
+  char name[4096];
+  snprintf(name, sizeof name, "%s/calcvar-table.XXXXXX", dir && dir[0] ? dir : "/tmp");
+  int fd = mkstemp(name);
+  if (fd < 0) {
+    fprintf(stderr, "%s: cannot keep standard input for the second pass: %s: %s\n", path, name,
+            strerror(errno));
+    return NULL;
+  }
+  unlink(name); /* gone with the descriptor, whatever happens */
+  FILE *f = fdopen(fd, "w+");
+  if (!f) close(fd);
+  char buf[65536];
+  long long total = 0;
+  ssize_t k = 0;
+  while (f && (k = read(STDIN_FILENO, buf, sizeof buf)) != 0) {
+    if (k < 0 && errno == EINTR) continue;
+    /* a stream that is not text ends here, not after 1 GiB of it is kept */
+    const char *why = k < 0                      ? strerror(errno)
+                      : bad_byte(buf, (size_t)k) ? "it is not a text table"
+                      : (total += k) > SC_MAX_TABLE_BYTES
+                          ? "larger than 1 GiB, the most calcvar reads"
+                      : fwrite(buf, 1, (size_t)k, f) != (size_t)k ? strerror(errno)
+                                                                  : NULL;
+    if (why) {
+      fprintf(stderr, "%s: cannot read the table: %s\n", path, why);
+      fclose(f);
+      return NULL;
+    }
+  }
+  if (!f || fflush(f) != 0 || fseek(f, 0, SEEK_SET) != 0) {
+    fprintf(stderr, "%s: cannot keep standard input for the second pass: %s\n", path,
+            strerror(errno));
+    if (f) fclose(f);
+    return NULL;
+  }
+  return f;
+}
+
+/* Open the table for reading (see above): 0, or EXIT_BADINPUT after a message. */
+static int table_source(table *t, const char *path, int ranks) {
+  struct stat st;
+  if (is_stdin(path)) {
+    if (ranks > 1) {
+      fprintf(stderr,
+              "%s: under MPI the table must be a file (only rank 0 has standard "
+              "input)\n",
+              path);
+      return EXIT_BADINPUT;
+    }
+    if (fstat(STDIN_FILENO, &st) != 0 || S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ||
+        S_ISDIR(st.st_mode)) { /* /dev/zero never ends; a terminal is no table */
+      fprintf(stderr, "%s: cannot read a table from standard input: it is %s\n", path,
+              kind_of(st.st_mode));
+      return EXIT_BADINPUT;
+    }
+    int fd = S_ISREG(st.st_mode) ? dup(STDIN_FILENO) : -1;
+    t->f = fd >= 0 ? fdopen(fd, "r") : spool_stdin(path);
+    if (fd >= 0 && !t->f) close(fd);
+    if (!t->f) return EXIT_BADINPUT;
+  } else {
+    if (stat(path, &st) != 0) {
+      fprintf(stderr, "%s: cannot open: %s\n", path, strerror(errno));
+      return EXIT_BADINPUT;
+    }
+    int fd = S_ISREG(st.st_mode) ? open(path, O_RDONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC) : -1;
+    if (fd >= 0 && (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))) { /* replaced since stat */
+      close(fd);
+      fd = -1;
+    }
+    if (fd < 0) {
+      fprintf(stderr,
+              "%s: cannot read a table from %s; give a CSV file, or '-' for standard "
+              "input\n",
+              path, S_ISREG(st.st_mode) ? strerror(errno) : kind_of(st.st_mode));
+      return EXIT_BADINPUT;
+    }
+    if (!(t->f = fdopen(fd, "r"))) {
+      close(fd);
+      fprintf(stderr, "%s: cannot open: %s\n", path, strerror(errno));
+      return EXIT_BADINPUT;
+    }
+  }
+  if (fstat(fileno(t->f), &st) == 0 && st.st_size > SC_MAX_TABLE_BYTES) {
+    fprintf(stderr, "%s: the table is larger than 1 GiB, the most calcvar reads\n", path);
+    return EXIT_BADINPUT;
+  }
+  return 0;
+}
+
 /* Next non-blank line split at commas into t->field; returns the field count, 0 at the
- * end, -1 on a read error. Fields are trimmed of blanks; the line's end is removed. */
+ * end, -1 on a read error, -2 for a line that is not text (t->why says why). Fields are
+ * trimmed of blanks; the line's end is removed. */
 static int next_line(table *t, int maxf) {
   for (;;) {
     ssize_t len = getline(&t->line, &t->cap, t->f);
     if (len < 0) return ferror(t->f) ? -1 : 0;
     t->lineno++;
+    int bad = bad_byte(t->line, (size_t)len);
+    if (len > MAX_LINE || bad) {
+      if (len > MAX_LINE)
+        snprintf(t->why, sizeof t->why, "the line is longer than %d bytes", MAX_LINE);
+      else
+        snprintf(t->why, sizeof t->why, "byte %d of the line is 0x%02x, not text", bad,
+                 (unsigned char)t->line[bad - 1]);
+      return -2;
+    }
     while (len > 0 && (t->line[len - 1] == '\n' || t->line[len - 1] == '\r')) t->line[--len] = '\0';
     char *p = t->line;
     while (*p == ' ' || *p == '\t') p++;
@@ -99,16 +239,13 @@ static void table_close(table *t) {
   memset(t, 0, sizeof *t);
 }
 
-/* Open and read the header (and make its names the batch's columns when set_columns). 0, or
+/* Open the table and read its header; its names become the batch's columns. 0, or
  * EXIT_BADINPUT after a message. */
-static int table_open(table *t, const char *path, cv_batch *b, int set_columns) {
+static int table_open(table *t, const char *path, cv_batch *b, int ranks) {
   char err[512];
   memset(t, 0, sizeof *t);
   t->path = path;
-  if (!(t->f = fopen(path, "r"))) {
-    fprintf(stderr, "%s: cannot open: %s\n", path, strerror(errno));
-    return EXIT_BADINPUT;
-  }
+  if (table_source(t, path, ranks) != 0) return EXIT_BADINPUT;
   int np = cv_batch_num_parameters(b), maxf = np + 1;
   t->field = malloc((size_t)maxf * sizeof *t->field);
   if (!t->field) {
@@ -118,9 +255,9 @@ static int table_open(table *t, const char *path, cv_batch *b, int set_columns) 
   int k = next_line(t, maxf);
   if (k <= 0) {
     fprintf(stderr, "%s:%d: %s\n", path, t->lineno > 0 ? t->lineno : 1,
-            k < 0 ? "read error"
-                  : "the table is empty (it needs a header of parameter "
-                    "names)");
+            k == -2 ? t->why
+            : k < 0 ? "read error"
+                    : "the table is empty (it needs a header of parameter names)");
     return EXIT_BADINPUT;
   }
   if (k > np) {
@@ -133,10 +270,19 @@ static int table_open(table *t, const char *path, cv_batch *b, int set_columns) 
   t->ncols = k;
   for (int c = 0; c < k; c++)
     if (!(t->names[c] = strdup(t->field[c]))) return EXIT_BADINPUT;
-  if (set_columns &&
-      cv_batch_set_columns(b, k, (const char *const *)t->names, err, sizeof err) != CVAR_OK) {
+  if (cv_batch_set_columns(b, k, (const char *const *)t->names, err, sizeof err) != CVAR_OK) {
     fprintf(stderr, "%s:%d: %s\n", path, t->lineno, err[0] ? err : "out of memory");
     return EXIT_BADINPUT;
+  }
+  return 0;
+}
+
+/* Back to the first row for the second pass (the header is read again and skipped). */
+static int table_rewind(table *t) {
+  t->lineno = 0;
+  if (fseek(t->f, 0, SEEK_SET) != 0 || next_line(t, t->ncols) != t->ncols) {
+    fprintf(stderr, "%s: the table changed while it was read\n", t->path);
+    return -1;
   }
   return 0;
 }
@@ -211,7 +357,7 @@ static int table_fields(table *t, char *msg, size_t len) {
   int k = next_line(t, t->ncols);
   if (k == 0) return 0;
   if (k < 0) {
-    snprintf(msg, len, "%s:%d: read error", t->path, t->lineno);
+    snprintf(msg, len, "%s:%d: %s", t->path, t->lineno, k == -2 ? t->why : "read error");
     return -EXIT_BADINPUT;
   }
   if (k != t->ncols) {
@@ -462,7 +608,7 @@ int cli_batch(int argc, char **argv) {
   cli_mpi mpi;
   cli_mpi_init(&mpi);
   rc = own_args(argc, argv, rest, &nrest, &table_path, &out_path, &threads, &warm, &help);
-  if (rc == 0) rc = cli_args_parse("batch", nrest, rest, &o);
+  if (rc == 0 && !help) rc = cli_args_parse("batch", nrest, rest, &o); /* --help needs no scene */
   free(rest);
   if (rc != 0 || help || o.help) {
     if (rc == 0 && mpi.rank == 0) usage(stdout);
@@ -506,31 +652,47 @@ int cli_batch(int argc, char **argv) {
   return rc;
 }
 
-int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_path, int threads,
-                  int warm, cli_mpi *mpi) {
-  char err[SC_ERRLEN];
-  int rc = EXIT_BADINPUT;
+/* ---- the run: scene, check, output, solve, finish ------------------------------------ */
+
+/* What the steps of one run share. Under MPI every rank runs every step; where one rank
+ * alone can fail (rank 0 opens and writes the output) the ranks agree on the outcome
+ * (agree), so that none is left waiting for the others in a collective call. */
+typedef struct {
+  const cli_opts *o;
+  cli_mpi *mpi;
+  const char *out_path;
+  cv_batch *b;
   table t;
-  memset(&t, 0, sizeof t);
-  cli_outfile of = {0};
-  cv_batch *b = NULL;
-  double *vals = NULL, *outs = NULL;
-  window wd = {0};
-  cli_buf buf = {0};
-  thread_state *ts = NULL;
-  unsigned char *bad = NULL;
-  size_t(*where)[3] = NULL;
+  cli_outfile of;
+  FILE *f;             /* rank 0: the output (of.f or stdout); NULL on the other ranks */
+  int threads, W, wsz; /* rows per window per rank (W), and over all ranks */
+  long nrows;
+  double *vals, *outs;
+  window wd;
+  cli_buf buf;
+  thread_state *ts;
+  unsigned char *bad;
+  size_t (*where)[3];
+  cli_batch_cols cols;
+} batch_run;
+
+/* Whether any rank says bad (every rank gets the answer). */
+static int agree(cli_mpi *mpi, int bad) { return cli_mpi_min_long(mpi, bad ? -1 : 0) < 0; }
+
+/* The scene with the command's options, compiled once as a batch. 0, or EXIT_BADINPUT. */
+static int batch_scene(const cli_opts *o, cv_batch **bp) {
+  char err[SC_ERRLEN];
   scene *s = scene_load_file_inputs(o->scene_path, o->nset, o->set, err, sizeof err);
   if (!s) {
     fprintf(stderr, "%s\n", err);
-    goto done;
+    return EXIT_BADINPUT;
   }
   if (o->elements) s->elements = o->elements;
   if (o->degree) s->degree = o->degree;
   cli_apply_solver_options(o, s);
   if (cli_apply_accuracy(o, s) != 0) {
     scene_free(s);
-    goto done;
+    return EXIT_BADINPUT;
   }
   if ((s->method == CVAR_METHOD_LBFGS || s->method == CVAR_METHOD_TNEWTON) &&
       (s->ncons > 0 || s->nints > 0)) {
@@ -539,189 +701,234 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
             "slsqp, auglag or newton\n",
             cv_method_name(s->method));
     scene_free(s);
-    goto done;
+    return EXIT_BADINPUT;
   }
-  int settings_line = s->settings_line;
-  const char *scene_file = o->scene_path;
-  if (!(b = scene_batch_new(s, err, sizeof err))) { /* b owns s from here */
+  if (!(*bp = scene_batch_new(s, err, sizeof err))) { /* it owns s from here */
     fprintf(stderr, "%s\n", err);
-    goto done;
+    return EXIT_BADINPUT;
   }
-  if ((rc = table_open(&t, table_path, b, 1)) != 0) goto done;
-  rc = EXIT_BADINPUT;
-  if (settings_line && t.ncols > 0) {
-    /* a [mesh]/[solver] number computed from a parameter: it would have to follow the
-     * row, which this build does not do (docs/cli.md) */
-    fprintf(stderr,
-            "%s:%d: a [mesh] or [solver] value uses a parameter; calcvar batch "
-            "keeps one mesh and solver setting for every row\n",
-            scene_file, settings_line > 0 ? settings_line : 0);
-    goto done;
-  }
-  int nc = t.ncols;
-  if (threads == 0) threads = cli_cores_available();
-  cv_batch_set_threads(b, threads);
-  cv_batch_set_warm_start(b, warm);
+  return 0;
+}
+
+/* Windows and per-thread buffers. 0, or -1 after a message. */
+static int batch_alloc(batch_run *r) {
+  int nc = r->t.ncols, threads = r->threads;
   /* Windows: W rows per rank (threads x ROWS_PER_THREAD), under MPI the ranks take
    * consecutive blocks of one window of W * size rows. */
-  int W = threads * ROWS_PER_THREAD, wsz = W * mpi->size;
-  vals = malloc((size_t)threads * stride(nc) * sizeof *vals);
-  wd.ncols = nc;
-  ts = calloc((size_t)threads, sizeof *ts);
-  outs = malloc((size_t)threads * stride(cv_batch_num_outputs(b)) * sizeof *outs);
-  bad = malloc((size_t)W + 1);
-  where = malloc(((size_t)W + 1) * sizeof *where);
-  if (!vals || !ts || !outs || !bad || !where) {
-    fprintf(stderr, "calcvar batch: out of memory\n");
-    goto done;
-  }
+  r->W = threads * ROWS_PER_THREAD;
+  r->wsz = r->W * r->mpi->size;
+  r->vals = malloc((size_t)threads * stride(nc) * sizeof *r->vals);
+  r->wd.ncols = nc;
+  r->ts = calloc((size_t)threads, sizeof *r->ts);
+  r->outs = malloc((size_t)threads * stride(cv_batch_num_outputs(r->b)) * sizeof *r->outs);
+  r->bad = malloc((size_t)r->W + 1);
+  r->where = malloc(((size_t)r->W + 1) * sizeof *r->where);
+  if (r->vals && r->ts && r->outs && r->bad && r->where) return 0;
+  fprintf(stderr, "calcvar batch: out of memory\n");
+  return -1;
+}
 
-  /* Pass 1: the whole table is checked before anything is written. Lines are read and
-   * counted here; the numbers and the scene each row makes are checked by the workers
-   * (each rank its blocks); the first bad row over all ranks is reported. */
-  long nrows = 0, first_bad = LONG_MAX;
-  int kind = 0; /* of this rank's first bad row: 1 a value, 2 the line itself */
+/* Pass 1: the whole table is checked before anything is written. Lines are read and
+ * counted here; the numbers and the scene each row makes are checked by the workers
+ * (each rank its blocks); the first bad row over all ranks is reported. 0, or
+ * EXIT_BADINPUT after a message. */
+static int batch_check(batch_run *r) {
+  cli_mpi *mpi = r->mpi;
+  long first_bad = LONG_MAX;
+  int kind = 0, nomem = 0; /* of this rank's first bad row: 1 a value, 2 the line itself */
   char badmsg[2 * SC_ERRLEN] = "";
-  for (int at_end = 0; !at_end && first_bad == LONG_MAX;) {
-    long w0 = nrows, m0 = w0 + (long)mpi->rank * W;
-    wd.n = 0, wd.slen = 0;
-    for (long r = w0; r < w0 + wsz; r++) {
-      int k = table_fields(&t, badmsg, sizeof badmsg);
+  for (int at_end = 0; !at_end && first_bad == LONG_MAX && !nomem;) {
+    long w0 = r->nrows, m0 = w0 + (long)mpi->rank * r->W;
+    r->wd.n = 0, r->wd.slen = 0;
+    for (long i = w0; i < w0 + r->wsz; i++) {
+      int k = table_fields(&r->t, badmsg, sizeof badmsg);
       if (k == 0) {
         at_end = 1;
         break;
       }
       if (k < 0) { /* every rank sees it; rank 0 says so */
-        first_bad = r, kind = 2, at_end = 1;
+        first_bad = i, kind = 2, at_end = 1;
         break;
       }
-      nrows++;
-      if (r >= m0 && r < m0 + W && window_add(&wd, &t) < 0) {
-        fprintf(stderr, "calcvar batch: out of memory\n");
-        goto done;
-      }
+      r->nrows++;
+      if (i >= m0 && i < m0 + r->W && window_add(&r->wd, &r->t) < 0) nomem = 1;
     }
-    check_job cj = {&wd, vals, bad};
-    if (scene_batch_for_each(b, wd.n, scene_batch_block(b, wd.n), check_item, &cj) != CVAR_OK) {
-      fprintf(stderr, "calcvar batch: out of memory\n");
-      goto done;
-    }
-    for (int r = 0; r < wd.n; r++)
-      if (bad[r] && m0 + r < first_bad) {
-        first_bad = m0 + r, kind = 1;
-        bad_row_message(b, &t, &wd, r, vals, badmsg, sizeof badmsg);
+    check_job cj = {&r->wd, r->vals, r->bad};
+    if (!nomem && scene_batch_for_each(r->b, r->wd.n, scene_batch_block(r->b, r->wd.n), check_item,
+                                       &cj) != CVAR_OK)
+      nomem = 1;
+    for (int i = 0; i < r->wd.n && !nomem; i++)
+      if (r->bad[i] && m0 + i < first_bad) {
+        first_bad = m0 + i, kind = 1;
+        bad_row_message(r->b, &r->t, &r->wd, i, r->vals, badmsg, sizeof badmsg);
         break;
       }
   }
+  if (nomem) fprintf(stderr, "calcvar batch: out of memory\n");
+  if (agree(mpi, nomem)) return EXIT_BADINPUT;
   long global_bad = cli_mpi_min_long(mpi, first_bad);
   if (global_bad != LONG_MAX) { /* said once: by the rank whose row it is */
     if (first_bad == global_bad && (kind == 1 || mpi->rank == 0)) fprintf(stderr, "%s\n", badmsg);
-    goto done;
+    return EXIT_BADINPUT;
   }
-  if (nrows > INT_MAX / 2) {
-    fprintf(stderr, "%s: more than %d rows\n", t.path, INT_MAX / 2);
-    goto done;
+  if (r->nrows > INT_MAX / 2) {
+    fprintf(stderr, "%s: more than %d rows\n", r->t.path, INT_MAX / 2);
+    return EXIT_BADINPUT;
   }
-  table_close(&t);
-  /* the header again (the columns were set from it in pass 1, before the workers) */
-  if ((rc = table_open(&t, table_path, b, 0)) != 0) goto done;
-  rc = EXIT_BADINPUT;
-  if (out_path && strcmp(out_path, table_path) == 0) {
-    fprintf(stderr, "calcvar batch: --out %s would overwrite the table being read\n", out_path);
-    goto done;
-  }
-  if (mpi->rank == 0 && out_path && cli_outfile_open(&of, out_path, o->scene_path) < 0) goto done;
-  FILE *f = mpi->rank == 0 ? (out_path ? of.f : stdout) : NULL;
+  return 0;
+}
 
-  cli_batch_cols cols = {nc, 0, 0, cv_batch_num_outputs(b)};
-  const scene *sc = scene_batch_scene(b);
+/* Rank 0 opens the output (never the scene or the table, by any name) and writes the
+ * header. 0, or EXIT_BADINPUT on every rank when rank 0 could not open it. */
+static int batch_output(batch_run *r, const char *table_path) {
+  const char *inputs[2] = {r->o->scene_path, table_path};
+  int bad = r->mpi->rank == 0 && r->out_path &&
+            cli_outfile_open_inputs(&r->of, r->out_path, inputs, 2) < 0;
+  if (agree(r->mpi, bad)) return EXIT_BADINPUT;
+  r->f = r->mpi->rank == 0 ? (r->out_path ? r->of.f : stdout) : NULL;
+  cli_batch_cols cols = {r->t.ncols, 0, 0, cv_batch_num_outputs(r->b)};
+  const scene *sc = scene_batch_scene(r->b);
   for (int i = 0; i < sc->n; i++) cols.err_nodal |= sc->exact[i] >= 0;
   /* the estimate where it applies: --adapt without [exact], and --tol always (its target) */
   cols.err_est = (!cols.err_nodal && sc->adapt > 0) || sc->tol > 0;
+  r->cols = cols;
+  FILE *f = r->f;
   if (f) {
-    for (int c = 0; c < nc; c++) fprintf(f, "%s,", t.names[c]);
+    for (int c = 0; c < r->t.ncols; c++) fprintf(f, "%s,", r->t.names[c]);
     fprintf(f, "status,action,iterations,time_s,morse_index");
     if (cols.err_nodal) fprintf(f, ",error_max_nodal");
     if (cols.err_est) fprintf(f, ",error_estimate");
-    for (int k = 0; k < cols.nout; k++) fprintf(f, ",%s", cv_batch_output_name(b, k));
+    for (int k = 0; k < cols.nout; k++) fprintf(f, ",%s", cv_batch_output_name(r->b, k));
     fprintf(f, ",message\n");
   }
+  return 0;
+}
 
-  /* Pass 2: each window is read here, solved and formatted by the workers (each into its
-   * own buffer), put together in input order and written (under MPI: rank 0 gathers). */
-  long done_rows = 0, failures = 0;
-  int tty = mpi->rank == 0 && isatty(2);
+/* One window of pass 2 on this rank: read, solve, format, and write (rank 0, through the
+ * gather). 0; -1 when the output could not be written; -2 for anything else (after a
+ * message). Every rank returns the same. */
+static int batch_window(batch_run *r, long w0, long wn) {
+  char badmsg[2 * SC_ERRLEN];
+  long m0 = w0 + (long)r->mpi->rank * r->W;
+  int bad = 0;
+  r->wd.n = 0, r->wd.slen = 0;
+  for (long i = w0; i < w0 + wn && !bad; i++) {
+    if (table_fields(&r->t, badmsg, sizeof badmsg) <= 0) { /* the file changed since pass 1 */
+      fprintf(stderr, "%s: the table changed while it was read\n", r->t.path);
+      bad = 1;
+    } else if (i >= m0 && i < m0 + r->W && window_add(&r->wd, &r->t) < 0) {
+      bad = 2;
+    }
+  }
+  for (int k = 0; k < r->threads; k++) r->ts[k].tb.len = 0;
+  solve_job sj = {&r->wd, &r->cols, m0, r->vals, r->outs, r->ts, r->where};
+  if (!bad && scene_batch_for_each(r->b, r->wd.n, scene_batch_block(r->b, r->wd.n), solve_item,
+                                   &sj) != CVAR_OK)
+    bad = 2;
+  r->buf.len = 0;
+  for (int i = 0; i < r->wd.n && !bad; i++)
+    cli_buf_put(&r->buf, r->ts[r->where[i][0]].tb.data + r->where[i][1], r->where[i][2]);
+  for (int k = 0; k < r->threads; k++) bad |= r->ts[k].tb.failed ? 2 : 0;
+  bad |= r->buf.failed ? 2 : 0;
+  if (bad & 2) fprintf(stderr, "calcvar batch: out of memory\n");
+  if (agree(r->mpi, bad)) return -2;
+  if (cli_mpi_gather_write(r->mpi, r->f, &r->buf) < 0) {
+    if (r->f)
+      fprintf(stderr, "calcvar batch: cannot write %s: %s\n",
+              r->out_path ? r->out_path : "standard output", strerror(errno));
+    return -1;
+  }
+  return 0;
+}
+
+/* Pass 2: each window is read here, solved and formatted by the workers (each into its
+ * own buffer), put together in input order and written (under MPI: rank 0 gathers).
+ * 0, -1 (the output could not be written) or -2. */
+static int batch_solve(batch_run *r) {
+  long done_rows = 0;
+  int tty = r->mpi->rank == 0 && isatty(2), rc = 0;
   double t0 = wall();
-  int ok = 1;
-  while (done_rows < nrows && ok) {
-    long w0 = done_rows, wn = nrows - w0 < wsz ? nrows - w0 : wsz;
-    long m0 = w0 + (long)mpi->rank * W;
-    wd.n = 0, wd.slen = 0;
-    for (long r = w0; r < w0 + wn && ok; r++) {
-      if (table_fields(&t, badmsg, sizeof badmsg) <= 0) { /* the file changed since pass 1 */
-        fprintf(stderr, "%s: the table changed while it was read\n", t.path);
-        ok = 0;
-      } else if (r >= m0 && r < m0 + W && window_add(&wd, &t) < 0) {
-        ok = 0;
-      }
-    }
-    if (!ok) break;
-    for (int k = 0; k < threads; k++) ts[k].tb.len = 0;
-    solve_job sj = {&wd, &cols, m0, vals, outs, ts, where};
-    if (scene_batch_for_each(b, wd.n, scene_batch_block(b, wd.n), solve_item, &sj) != CVAR_OK) {
-      fprintf(stderr, "calcvar batch: out of memory\n");
-      ok = 0;
-      break;
-    }
-    buf.len = 0;
-    for (int r = 0; r < wd.n; r++)
-      cli_buf_put(&buf, ts[where[r][0]].tb.data + where[r][1], where[r][2]);
-    for (int k = 0; k < threads; k++) ok &= !ts[k].tb.failed;
-    if (buf.failed || !ok) {
-      ok = 0;
-      break;
-    }
-    if (cli_mpi_gather_write(mpi, f, &buf) < 0) {
-      ok = 0;
-      break;
-    }
+  while (done_rows < r->nrows && rc == 0) {
+    long wn = r->nrows - done_rows < r->wsz ? r->nrows - done_rows : r->wsz;
+    if ((rc = batch_window(r, done_rows, wn)) != 0) break;
     done_rows += wn;
     if (tty) {
-      failures = 0;
-      for (int k = 0; k < threads; k++) failures += ts[k].fails;
+      long failures = 0;
+      for (int k = 0; k < r->threads; k++) failures += r->ts[k].fails;
       double el = wall() - t0;
-      fprintf(stderr, "\rcalcvar batch: %ld/%ld rows, %.1f rows/s, %ld failed", done_rows, nrows,
+      fprintf(stderr, "\rcalcvar batch: %ld/%ld rows, %.1f rows/s, %ld failed", done_rows, r->nrows,
               el > 0 ? done_rows / el : 0.0, failures);
     }
   }
-  failures = 0;
-  for (int k = 0; k < threads; k++) failures += ts[k].fails;
   if (tty) fputc('\n', stderr);
-  if (!ok) {
-    rc = EXIT_UNSOLVED;
-    goto done;
+  return rc;
+}
+
+/* Rank 0 puts the output in place (or flushes standard output); every rank learns whether
+ * that worked. 0, or -1 (after rank 0's message). */
+static int batch_commit(batch_run *r) {
+  int bad = 0;
+  if (r->f && r->out_path) {
+    bad = cli_outfile_commit(&r->of) < 0; /* it says why */
+  } else if (r->f && (fflush(stdout) != 0 || ferror(stdout))) {
+    if (!cli_stdout_reported())
+      fprintf(stderr, "calcvar: cannot write standard output: %s\n", strerror(errno));
+    cli_stdout_set_reported();
+    bad = 1;
   }
-  if (f && out_path && cli_outfile_commit(&of) < 0) {
-    fprintf(stderr, "calcvar batch: %s could not be written\n", out_path);
-    rc = EXIT_UNSOLVED;
-    goto done;
+  return agree(r->mpi, bad) ? -1 : 0;
+}
+
+static void batch_run_free(batch_run *r) {
+  cli_outfile_abandon(&r->of);
+  free(r->buf.data);
+  for (int k = 0; r->ts && k < r->threads; k++) free(r->ts[k].tb.data);
+  free(r->ts);
+  free(r->outs);
+  free(r->bad);
+  free(r->where);
+  free(r->vals);
+  window_free(&r->wd);
+  table_close(&r->t);
+  cv_batch_free(r->b);
+}
+
+int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_path, int threads,
+                  int warm, cli_mpi *mpi) {
+  batch_run r;
+  memset(&r, 0, sizeof r);
+  r.o = o, r.mpi = mpi, r.out_path = out_path;
+  int rc = batch_scene(o, &r.b);
+  if (rc == 0) rc = table_open(&r.t, table_path, r.b, mpi->size);
+  int settings_line = r.b ? scene_batch_scene(r.b)->settings_line : 0;
+  if (rc == 0 && settings_line && r.t.ncols > 0) {
+    /* a [mesh]/[solver] number computed from a parameter: it would have to follow the
+     * row, which this build does not do (docs/cli.md) */
+    fprintf(stderr,
+            "%s:%d: a [mesh] or [solver] value uses a parameter; calcvar batch "
+            "keeps one mesh and solver setting for every row\n",
+            o->scene_path, settings_line > 0 ? settings_line : 0);
+    rc = EXIT_BADINPUT;
   }
-  if (f && !out_path && fflush(stdout) != 0) {
-    rc = EXIT_UNSOLVED;
-    goto done;
+  if (rc == 0) {
+    r.threads = threads ? threads : cli_cores_available();
+    cv_batch_set_threads(r.b, r.threads);
+    cv_batch_set_warm_start(r.b, warm);
+    if (agree(mpi, batch_alloc(&r) < 0)) rc = EXIT_BADINPUT;
   }
-  rc = cli_mpi_reduce_failures(mpi, failures) == 0 ? EXIT_SOLVED : EXIT_UNSOLVED;
-done:
-  cli_outfile_abandon(&of);
-  free(buf.data);
-  for (int k = 0; ts && k < threads; k++) free(ts[k].tb.data);
-  free(ts);
-  free(outs);
-  free(bad);
-  free(where);
-  free(vals);
-  window_free(&wd);
-  table_close(&t);
-  cv_batch_free(b);
+  if (rc == 0) rc = batch_check(&r);
+  if (rc == 0 && agree(mpi, table_rewind(&r.t) < 0)) rc = EXIT_BADINPUT;
+  if (rc == 0) rc = batch_output(&r, table_path);
+  if (rc == 0) {
+    int solved = batch_solve(&r);
+    rc = solved == -1 ? EXIT_IOERROR : solved < 0 ? EXIT_UNSOLVED : 0;
+  }
+  if (rc == 0 && batch_commit(&r) < 0) rc = EXIT_IOERROR;
+  if (rc == 0) {
+    long failures = 0;
+    for (int k = 0; k < r.threads; k++) failures += r.ts[k].fails;
+    rc = cli_mpi_reduce_failures(mpi, failures) == 0 ? EXIT_SOLVED : EXIT_UNSOLVED;
+  }
+  batch_run_free(&r);
   return rc;
 }

@@ -293,7 +293,8 @@ int cli_converge(int argc, char **argv) {
     goto done;
   }
   if ((o.json && cli_outfile_open(&jf, o.json, o.scene_path) < 0) ||
-      (c.svg && cli_outfile_open(&gf, c.svg, o.scene_path) < 0)) {
+      (c.svg && cli_outfile_open(&gf, c.svg, o.scene_path) < 0) ||
+      cli_outfile_clash(&jf, &gf, "--json", "--svg") < 0) {
     rc = EXIT_BADINPUT;
     goto done;
   }

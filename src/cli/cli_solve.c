@@ -125,7 +125,10 @@ int cli_solve(int argc, char **argv) {
   }
   if ((o.json && cli_outfile_open(&jf, o.json, o.scene_path) < 0) ||
       (o.csv && cli_outfile_open(&cf, o.csv, o.scene_path) < 0) ||
-      (o.plot && cli_outfile_open(&pf, o.plot, o.scene_path) < 0)) {
+      (o.plot && cli_outfile_open(&pf, o.plot, o.scene_path) < 0) ||
+      cli_outfile_clash(&jf, &cf, "--json", "--csv") < 0 ||
+      cli_outfile_clash(&jf, &pf, "--json", "--plot") < 0 ||
+      cli_outfile_clash(&cf, &pf, "--csv", "--plot") < 0) {
     rc = EXIT_BADINPUT;
     goto done;
   }

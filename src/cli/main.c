@@ -27,6 +27,8 @@ static void usage(FILE *f) {
 
 /* Standard output is checked like any output file: a full disk, /dev/full or a closed
  * pipe must not pass for success (exit 3, docs/cli.md). */
+static int stdout_closed; /* standard output was closed when calcvar started (>&-) */
+
 static int finish(int rc) {
   errno = 0;
   int bad = fflush(stdout) != 0 || ferror(stdout);
@@ -36,13 +38,21 @@ static int finish(int rc) {
     e = errno;
   }
   if (!bad) return rc;
-  fprintf(stderr, "calcvar: cannot write standard output: %s\n", e ? strerror(e) : "write error");
+  if (cli_stdout_reported())
+    ; /* said already, where it happened */
+  else if (stdout_closed)
+    fprintf(stderr, "calcvar: cannot write standard output: it is closed\n");
+  else
+    fprintf(stderr, "calcvar: cannot write standard output: %s\n", e ? strerror(e) : "write error");
   return rc == EXIT_BADINPUT ? rc : EXIT_IOERROR;
 }
 
 static int run(int argc, char **argv);
 
-int main(int argc, char **argv) { return finish(run(argc, argv)); }
+int main(int argc, char **argv) {
+  stdout_closed = cli_signals_setup();
+  return finish(run(argc, argv));
+}
 
 static int run(int argc, char **argv) {
   if (argc < 2) return cli_gallery();

@@ -3,16 +3,23 @@
  *
  * The only file that includes plplot.h. The device follows the file's ending: ".svg" is
  * PLplot's own "svg" driver (text stays <text>, so a browser renders and searches it),
- * ".png" is "pngcairo" (Debian plplot-driver-cairo). The picture is drawn into the
- * temporary file of a cli_outfile and renamed into place at the end, so a failure never
- * leaves half a picture behind. PLplot ends the process on an internal error (plexit);
- * the handler below removes the temporary file first.
+ * ".png" is "pngcairo" (Debian plplot-driver-cairo).
+ *
+ * Drawing runs in a child process (fork), into a scratch file: PLplot, cairo, fontconfig
+ * and GLib end the process on errors of their own (plexit, a SIGTRAP from GLib, SIGSEGV
+ * in fontconfig under a memory limit), check no write, and may leave half a file. The
+ * child's end is a status here: a child that failed or died is "the plotting library
+ * failed" (exit 3), a picture cut short is refused (cli_outfile_commit_rendered), and a
+ * whole one is copied into the output's temporary file and renamed into place.
  */
+#include <errno.h>
 #include <math.h>
 #include <plplot.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/types.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "cli/cli.h"
@@ -27,12 +34,14 @@ enum { NPAL = (int)(sizeof pal_r / sizeof pal_r[0]), FIRST_LINE_COLOUR = 3 };
 #define MARK "#(728)" /* a filled circle, as a PLplot Hershey escape */
 
 static double chr_factor = 1.0; /* character scale of the page being drawn */
-static const char *exit_tmp;    /* the temporary file to remove if PLplot gives up */
 
+enum { CHILD_PLEXIT = 4 }; /* the child's status when PLplot gave up (plexit) */
+
+/* In the drawing child: PLplot gives up. Its message, then the child ends (the parent
+ * says what failed and removes the scratch file). */
 static int plplot_exit(PLCHAR_VECTOR msg) {
   fprintf(stderr, "calcvar: the plotting library failed: %s\n", msg);
-  if (exit_tmp) unlink(exit_tmp);
-  return EXIT_UNSOLVED;
+  _exit(CHILD_PLEXIT);
 }
 
 int cli_plot_path_ok(const char *path) {
@@ -242,14 +251,9 @@ int cli_plot_write(cli_outfile *o, int npanels, cli_plot_panel *panels) {
   return cli_plot_write_page(o, 960, 100 + 460 * npanels, npanels, panels);
 }
 
-int cli_plot_write_page(cli_outfile *o, int width, int height, int npanels,
-                        const cli_plot_panel *panels) {
-  const char *name;
-  if (npanels < 1 || cli_outfile_render_name(o, &name) < 0) return -1;
-  /* PLplot opens the file itself, by name: hand it the temporary (or scratch) file. */
-  size_t n = strlen(o->path);
-  int svg = n >= 4 && strcmp(o->path + n - 4, ".svg") == 0;
-  exit_tmp = name;
+/* The drawing itself (in the child). */
+static void draw_page(const char *name, int svg, int width, int height, int npanels,
+                      const cli_plot_panel *panels) {
   plsexit(plplot_exit);
   plsdev(svg ? "svg" : "pngcairo");
   plsfnam(name);
@@ -265,6 +269,54 @@ int cli_plot_write_page(cli_outfile *o, int width, int height, int npanels,
   pladv(0); /* one page; every panel draws into its own viewport on it */
   for (int k = 0; k < npanels; k++) draw_panel(&panels[k]);
   plend();
-  exit_tmp = NULL;
-  return cli_outfile_commit_rendered(o);
+}
+
+/* Why the drawing child failed, from its wait status, into why; 0 when it succeeded. */
+static int child_failed(int status, char *why, size_t len) {
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return 0;
+  if (WIFSIGNALED(status))
+    snprintf(why, len, "the plotting library failed (killed by signal %d, %s)", WTERMSIG(status),
+             strsignal(WTERMSIG(status)));
+  else
+    snprintf(why, len, "the plotting library failed (status %d%s)",
+             WIFEXITED(status) ? WEXITSTATUS(status) : -1,
+             WIFEXITED(status) && WEXITSTATUS(status) == 1
+                 ? ": out of memory, or a driver it could not load?"
+                 : "");
+  return -1;
+}
+
+int cli_plot_write_page(cli_outfile *o, int width, int height, int npanels,
+                        const cli_plot_panel *panels) {
+  const char *name;
+  if (npanels < 1 || cli_outfile_render_name(o, &name) < 0) return -1;
+  size_t n = strlen(o->path);
+  int svg = n >= 4 && strcmp(o->path + n - 4, ".svg") == 0;
+  fflush(stdout); /* the child must not write the parent's buffered text again */
+  fflush(stderr);
+  pid_t pid = fork();
+  if (pid == 0) {
+    draw_page(name, svg, width, height, npanels, panels);
+    _exit(0); /* no exit handlers: they are the parent's */
+  }
+  int status = 0;
+  char why[160];
+  if (pid < 0) {
+    snprintf(why, sizeof why, "cannot start the drawing: %s", strerror(errno));
+    status = -1;
+  } else {
+    while (waitpid(pid, &status, 0) < 0)
+      if (errno != EINTR) {
+        status = -1;
+        break;
+      }
+    if (status != -1 && child_failed(status, why, sizeof why) == 0) status = 0;
+  }
+  if (status != 0) {
+    if (status == -1 && pid >= 0) snprintf(why, sizeof why, "lost the drawing process");
+    fprintf(stderr, "calcvar: cannot write %s: %s\n", o->path, why);
+    cli_outfile_abandon(o);
+    return -1;
+  }
+  return cli_outfile_commit_rendered(o, svg);
 }

@@ -1,5 +1,6 @@
 /* src/expr/ex_dag.c — node storage, hash-consing, inspection and pointwise evaluation.
  * SPDX-License-Identifier: MIT */
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -99,6 +100,19 @@ ex_id ex_intern(ex_dag *d, ex_op op, ex_id a, ex_id b, ex_id c, double v) {
     if (b >= 0) nd->dep |= d->nodes[b].dep;
     if (c >= 0) nd->dep |= d->nodes[c].dep;
   }
+  nd->lo = INT_MAX, nd->hi = -1;
+  if (op == EX_SLOT) nd->lo = nd->hi = a;
+  for (int k = 0; k < 3 && op != EX_SLOT && op != EX_NUM; k++) {
+    ex_id o = k == 0 ? a : k == 1 ? b : c;
+    if (o >= 0 && d->nodes[o].lo < nd->lo) nd->lo = d->nodes[o].lo;
+    if (o >= 0 && d->nodes[o].hi > nd->hi) nd->hi = d->nodes[o].hi;
+  }
+  nd->nonfinite = nd->dep == 0 && op != EX_SLOT && (op != EX_NUM || !isfinite(v));
+  if (op != EX_SLOT && op != EX_NUM)
+    for (int k = 0; k < 3; k++) {
+      ex_id o = k == 0 ? a : k == 1 ? b : c;
+      if (o >= 0) nd->nonfinite |= d->nodes[o].nonfinite;
+    }
   d->table[h] = d->n;
   ex_id id = d->n++;
   /* Keep the load factor at most 1/2 so probes stay short. */
@@ -136,21 +150,33 @@ int ex_is_const(const ex_dag *d, ex_id e) { return valid(d, e) && d->nodes[e].de
 
 int ex_depends_on(const ex_dag *d, ex_id e, int slot) {
   if (!valid(d, e) || slot < 0) return 0;
+  if (slot < d->nodes[e].lo || slot > d->nodes[e].hi) return 0;
+  if (slot == d->nodes[e].lo || slot == d->nodes[e].hi) return 1;
   if (!(d->nodes[e].dep & ((uint64_t)1 << (slot & 63)))) return 0;
   if (d->max_slot < 64) return 1; /* the bit mask is exact */
-  /* Slots alias modulo 64: walk the nodes below e (topological order) to decide. */
-  unsigned char *mark = cv_calloc((size_t)e + 1, 1);
-  if (!mark) return 1; /* conservative answer: may depend */
-  ex_mark_reachable(d, e, mark, 0);
+  /* Slots alias modulo 64: look through the nodes below e (ex_reach: those only). */
+  ex_id *ids;
+  int n = ex_reach(d, e, &ids);
+  if (n < 0) return 1; /* conservative answer: may depend */
   int found = 0;
-  for (int id = 0; id <= e && !found; id++)
-    if (mark[id] && d->nodes[id].op == EX_SLOT && d->nodes[id].a == slot) found = 1;
-  cv_free(mark);
+  for (int i = 0; i < n && !found; i++)
+    found = d->nodes[ids[i]].op == EX_SLOT && d->nodes[ids[i]].a == slot;
+  cv_free(ids);
   return found;
 }
 
+int ex_first_slot(const ex_dag *d, ex_id e, int from, int to) {
+  if (!valid(d, e) || to < from) return -1;
+  const ex_node *nd = &d->nodes[e];
+  if (nd->hi < from || nd->lo > to) return -1;
+  if (nd->lo >= from) return nd->lo;              /* lo <= to: the least slot is in the range */
+  for (int k = from; k <= to && k <= nd->hi; k++) /* lo < from <= hi: rare */
+    if (ex_depends_on(d, e, k)) return k;
+  return -1;
+}
+
 ex_id ex_nonfinite_const(const ex_dag *d, ex_id e) {
-  if (!valid(d, e)) return -1;
+  if (!valid(d, e) || !d->nodes[e].nonfinite) return -1; /* the common case: no walk */
   unsigned char *mark = cv_calloc((size_t)e + 1, 1);
   if (!mark) return -2;
   ex_mark_reachable(d, e, mark, 0);
@@ -239,37 +265,7 @@ void ex_mark_reachable(const ex_dag *d, ex_id e, unsigned char *mark, int skip_c
   }
 }
 
-int ex_eval(const ex_dag *d, ex_id e, const double *slots, double *value) {
-  if (!valid(d, e)) return -1;
-  unsigned char *mark = cv_calloc((size_t)e + 1, 1);
-  double *val = cv_malloc(((size_t)e + 1) * sizeof *val);
-  if (!mark || !val) {
-    cv_free(mark);
-    cv_free(val);
-    return -1;
-  }
-  ex_mark_reachable(d, e, mark, 0);
-  for (int id = 0; id <= e; id++) {
-    if (!mark[id]) continue;
-    const ex_node *nd = &d->nodes[id];
-    switch (nd->op) {
-    case EX_NUM: val[id] = nd->v; break;
-    case EX_SLOT: val[id] = slots ? slots[nd->a] : NAN; break;
-    case EX_TABLE: {
-      double u[3] = {val[nd->a], nd->b >= 0 ? val[nd->b] : 0.0, nd->c >= 0 ? val[nd->c] : 0.0};
-      ex_table_apply(d, nd, u, &val[id]); /* NaN outside the grid */
-      break;
-    }
-    default:
-      val[id] = ex_apply(nd->op, val[nd->a], nd->b >= 0 ? val[nd->b] : 0.0,
-                         nd->c >= 0 ? val[nd->c] : 0.0);
-    }
-  }
-  *value = val[e];
-  cv_free(mark);
-  cv_free(val);
-  return 0;
-}
+/* ex_eval: ex_reach.c (a walk over the reachable nodes only). */
 
 int ex_eval_const(const ex_dag *d, ex_id e, double *value) {
   if (!ex_is_const(d, e)) return -1;

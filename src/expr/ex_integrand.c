@@ -159,7 +159,7 @@ ex_integrand *ex_integrand_new_order(ex_dag *d, int n, int np, int order, ex_id 
   g->owns_tapes = 1;
   /* the partials read no slot that F does not */
   if (!(g->used = cv_calloc((size_t)np + 1, 1))) goto nomem;
-  for (int j = 0; j < np; j++) g->used[j] = (unsigned char)ex_depends_on(d, F, 1 + 2 * n + j);
+  if (ex_slots_used(d, F, 1 + 2 * n, np, g->used) < 0) goto nomem;
   g->max_need = max_need | CVAR_NEED_F | (n2 ? CVAR_NEED_Y2 : 0u);
   for (int i = 0; i < n; i++) g->depends_on_dy |= ex_depends_on(d, F, 1 + n + i);
   for (int i = 0; i < n2; i++) g->depends_on_dy |= ex_depends_on(d, F, 1 + 2 * n + np + i);

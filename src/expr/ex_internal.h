@@ -16,9 +16,14 @@
  * (derivative, substitution, evaluation, compilation) is a loop, never a deep recursion. */
 typedef struct {
   ex_op op;
-  ex_id a, b, c; /* operands, -1 when absent; for EX_SLOT, a is the slot number */
-  double v;      /* EX_NUM: the value */
-  uint64_t dep;  /* bit (s & 63) set when the node depends on slot s: 0 means constant */
+  ex_id a, b, c;           /* operands, -1 when absent; for EX_SLOT, a is the slot number */
+  double v;                /* EX_NUM: the value */
+  uint64_t dep;            /* bit (s & 63) set when the node depends on slot s: 0 means constant */
+  int lo, hi;              /* the least and the greatest slot the node depends on (lo > hi: none),
+                  * exact where `dep` aliases (ex_depends_on, ex_first_slot) */
+  unsigned char nonfinite; /* the node is, or reaches, a constant that is not a finite number
+                            * (ex_nonfinite_const): set once here, so the loader's check of
+                            * each parsed value costs nothing when there is none */
 } ex_node;
 
 struct ex_dag {
@@ -56,6 +61,9 @@ ex_id ex_make(ex_dag *d, ex_op op, ex_id a, ex_id b, ex_id c);
 /* Mark (mark[id] = 1) the nodes reachable from e; mark must hold d->n zeros. When
  * skip_conditions, the conditions of `if` and comparison operands are not entered (they
  * have zero derivative). */
+/* ex_reach.c: the ids of the nodes e reaches (e included), increasing, in a malloc'd array
+ * (*out, cv_free it); returns their number, or -1 out of memory. */
+int ex_reach(const ex_dag *d, ex_id e, ex_id **out);
 void ex_mark_reachable(const ex_dag *d, ex_id e, unsigned char *mark, int skip_conditions);
 
 /* Rebuild a node like nd on new operands through the simplifying constructors (all ops,

@@ -97,7 +97,7 @@ ex_id ex_table_call(ex_dag *d, int index, const int *ord, const ex_id *args) {
     if (o[k] > 3) return ex_num(d, 0.0); /* the fourth derivative of a cubic */
     all_num &= d->nodes[a[k]].op == EX_NUM;
   }
-  ex_node nd = {EX_TABLE, a[0], a[1], a[2], EX_TABLE_CODE(index, o[0], o[1], o[2]), 0};
+  ex_node nd = {EX_TABLE, a[0], a[1], a[2], EX_TABLE_CODE(index, o[0], o[1], o[2]), 0, 0, 0, 0};
   if (all_num) { /* fold inside the grid; outside, the call stays and fails when used */
     double u[3], v;
     for (int k = 0; k < dim; k++) u[k] = d->nodes[a[k]].v;

@@ -77,6 +77,13 @@ int ex_eval_const(const ex_dag *d, ex_id e, double *value);
  * formula on such a constant), which the folder keeps as a formula (theory (EX-1)); -1
  * when there is none, -2 when out of memory. */
 ex_id ex_nonfinite_const(const ex_dag *d, ex_id e);
+/* The least slot in [from, to] that e depends on, or -1 (exact, and without a walk over
+ * the DAG when the range holds e's least slot or misses all of e's slots). */
+int ex_first_slot(const ex_dag *d, ex_id e, int from, int to);
+/* used[k] = 1 for each slot from + k (0 <= k < count) that e depends on; other entries are
+ * left as they are. One walk over the nodes e reaches, where count calls of ex_depends_on
+ * would each walk them. Returns 0, or -1 out of memory. */
+int ex_slots_used(const ex_dag *d, ex_id e, int from, int count, unsigned char *used);
 
 /* The grammar's names (ex_names.c). An identifier is a letter or '_' followed by letters,
  * digits or '_' (a prime is not part of a name); the reserved names are pi and the
@@ -173,6 +180,10 @@ ex_id ex_node_arg(const ex_dag *d, ex_id e, int i);
  * read). Reference evaluation (straight from the DAG, libm for every operation); for many
  * points compile a tape. Returns 0, or -1 on allocation failure. */
 int ex_eval(const ex_dag *d, ex_id e, const double *slots, double *value);
+/* The same with each slot's value from slot_value(user, s) (when not NULL): no array as
+ * long as the largest slot is needed. */
+int ex_eval_with(const ex_dag *d, ex_id e, const double *slots,
+                 double (*slot_value)(void *user, int slot), void *user, double *value);
 
 /* Collect like terms (ex_collect.c): every sum in e becomes sum_k c_k t_k + c0 with each
  * distinct term once, numeric factors peeled off (2*t, t/2, -t). For display: combining

@@ -24,6 +24,9 @@ enum { SC_ERRLEN = 1024 };
 /* The largest scene file read (bytes): a scene is a page of text; the cap keeps
  * `solve /dev/zero` or a wrong file from eating the memory (docs/scenes.md). */
 enum { SC_MAX_BYTES = 4 << 20 };
+/* The largest table read ([tables] grids and batch tables, bytes): 1 GiB, above the 630 MB
+ * grid of bench/bench_table, far below what /dev/urandom or a wrong file would fill. */
+#define SC_MAX_TABLE_BYTES ((long long)1 << 30)
 
 /** One `--set name=value` override; value is a constant expression. */
 typedef struct {

@@ -139,13 +139,12 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen) {
   b->rep_used = cv_calloc((size_t)b->np + 1, 1);
   b->guess_used = cv_calloc((size_t)b->np + 1, 1);
   if (!b->rep_used || !b->guess_used) goto nomem;
-  for (int j = 0; j < b->np; j++) {
-    int slot = 1 + 2 * s->n + j;
-    for (int r = 0; r < s->nreports && !b->rep_used[j]; r++)
-      b->rep_used[j] = (unsigned char)ex_depends_on(s->dag, s->reports[r].expr, slot);
-    for (int i = 0; i < s->n && !b->guess_used[j]; i++)
-      b->guess_used[j] = s->guess[i] >= 0 && ex_depends_on(s->dag, s->guess[i], slot);
-  }
+  for (int r = 0; r < s->nreports; r++)
+    if (ex_slots_used(s->dag, s->reports[r].expr, 1 + 2 * s->n, b->np, b->rep_used) < 0) goto nomem;
+  for (int i = 0; i < s->n; i++)
+    if (s->guess[i] >= 0 &&
+        ex_slots_used(s->dag, s->guess[i], 1 + 2 * s->n, b->np, b->guess_used) < 0)
+      goto nomem;
   /* Compile once: every expression of the problem with the parameters as inputs (y'' after
    * them and the width's slot, X-7). */
   if (!(b->F =
@@ -242,9 +241,11 @@ static int build_row_tape(cv_batch *b) {
   int k = 0;
   for (int j = 0; j < np; j++) {
     ex_id e = b->given[j] ? s->params[j].expr : s->params[j].expr2;
-    for (int i = 0; i < j && e >= 0 && !b->given[j]; i++)
-      if (!b->given[i] && ex_depends_on(s->dag, e, 1 + 2 * n + i))
-        e = ex_subst(s->dag, e, 1 + 2 * n + i, def[i]);
+    /* the earlier parameters e uses, found by slot (not one test per parameter: 10^5) */
+    for (int from = 1 + 2 * n, sl; e >= 0 && !b->given[j]; from = sl + 1) {
+      if ((sl = ex_first_slot(s->dag, e, from, 2 * n + j)) < 0) break;
+      if (!b->given[sl - 1 - 2 * n]) e = ex_subst(s->dag, e, sl, def[sl - 1 - 2 * n]);
+    }
     if ((def[j] = e) < 0) goto done;
     outs[k++] = e;
   }
@@ -259,9 +260,10 @@ static int build_row_tape(cv_batch *b) {
   for (int q = 0; q < s->nints; q++) t[nt++] = s->ints[q].expr2;
   if (s->has_exact_action) t[nt++] = s->exact_action_expr;
   for (int q = 0; q < nt; q++)
-    for (int i = 0; i < np && t[q] >= 0; i++)
-      if (!b->given[i] && ex_depends_on(s->dag, t[q], 1 + 2 * n + i))
-        t[q] = ex_subst(s->dag, t[q], 1 + 2 * n + i, def[i]);
+    for (int from = 1 + 2 * n, sl; t[q] >= 0; from = sl + 1) {
+      if ((sl = ex_first_slot(s->dag, t[q], from, 2 * n + np)) < 0) break;
+      if (!b->given[sl - 1 - 2 * n]) t[q] = ex_subst(s->dag, t[q], sl, def[sl - 1 - 2 * n]);
+    }
   for (int q = 0; q < nt; q++)
     if (t[q] < 0) goto done;
   k += nt;

@@ -24,6 +24,8 @@ typedef struct {
   char *err;
   size_t errlen;
   int failed;
+  int cap[SEC_COUNT];         /* room in raw->e[sec] (grown by doubling) */
+  sc_namemap keys[SEC_COUNT]; /* the keys of each section so far: key -> index */
 } feed;
 
 static char *reader(char *str, int num, void *stream) {
@@ -60,21 +62,30 @@ static int handler(void *user, const char *section, const char *name, const char
     return 0;
   }
   sc_raw *raw = f->raw;
-  for (int i = 0; i < raw->ne[sec]; i++)
-    if (strcmp(raw->e[sec][i].key, name) == 0) {
-      sc_err(f->err, f->errlen, file, l->line, "'%s' is given twice in [%s] (first at line %d)",
-             name, section, raw->e[sec][i].line);
+  int first = sc_namemap_get(&f->keys[sec], name);
+  if (first >= 0) {
+    sc_err(f->err, f->errlen, file, l->line, "'%s' is given twice in [%s] (first at line %d)", name,
+           section, raw->e[sec][first].line);
+    f->failed = 1;
+    return 0;
+  }
+  if (raw->ne[sec] == f->cap[sec]) {
+    int ncap = f->cap[sec] ? 2 * f->cap[sec] : 16;
+    sc_entry *e = cv_realloc(raw->e[sec], (size_t)ncap * sizeof *e);
+    if (!e) {
+      sc_err(f->err, f->errlen, file, l->line, "out of memory");
       f->failed = 1;
       return 0;
     }
-  sc_entry *e = cv_realloc(raw->e[sec], (size_t)(raw->ne[sec] + 1) * sizeof *e);
-  if (!e) {
+    raw->e[sec] = e;
+    f->cap[sec] = ncap;
+  }
+  if (sc_namemap_put(&f->keys[sec], l->entry.key, raw->ne[sec]) < 0) {
     sc_err(f->err, f->errlen, file, l->line, "out of memory");
     f->failed = 1;
     return 0;
   }
-  raw->e[sec] = e;
-  e[raw->ne[sec]++] = l->entry; /* ownership moves to raw */
+  raw->e[sec][raw->ne[sec]++] = l->entry; /* ownership moves to raw */
   memset(&l->entry, 0, sizeof l->entry);
   return 1;
 }
@@ -97,8 +108,9 @@ int sc_raw_read(sc_raw *raw, const char *text, size_t len, const char *file, cha
   for (int i = 0; i < ll.n; i++)
     if (ll.l[i].is_section) raw->sec_line[ll.l[i].section] = ll.l[i].line;
 
-  feed f = {&ll, raw, 0, 0, err, errlen, 0};
+  feed f = {&ll, raw, 0, 0, err, errlen, 0, {0}, {{0}}};
   int r = ini_parse_stream(reader, &f, handler, &f);
+  for (int k = 0; k < SEC_COUNT; k++) sc_namemap_free(&f.keys[k]);
   if (r != 0 && !f.failed) {
     /* inih found a syntax error the pre-pass let through: r is the canonical line. */
     int line = r > 0 && r <= ll.n ? ll.l[r - 1].line : 0;

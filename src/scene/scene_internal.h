@@ -95,6 +95,18 @@ void sc_entry_locate(const sc_entry *e, int off, int *line, int *col);
 /* scene_names.c: the names a scene may not define (the grammar's reserved names and free). */
 int sc_is_reserved(const char *s);
 
+/* scene_namemap.c: names (borrowed) to non-negative integers, found in constant time. */
+typedef struct {
+  const char **key; /* NULL: an empty bucket */
+  int *val;
+  size_t cap, n;
+} sc_namemap;
+/* The value of name, or -1. */
+int sc_namemap_get(const sc_namemap *m, const char *name);
+/* Add name (or give it a new value): 0, or -1 out of memory. */
+int sc_namemap_put(sc_namemap *m, const char *name, int val);
+void sc_namemap_free(sc_namemap *m);
+
 /* The loader's state while it interprets the entries (scene_load.c and friends). */
 typedef enum { SC_R_PARAM, SC_R_FULL } sc_rmode;
 typedef struct {
@@ -103,10 +115,19 @@ typedef struct {
   const char *file;
   char *err;
   size_t errlen;
-  sc_rmode mode; /* what names resolve: parameters only, or everything */
-  int limit;     /* parameters (SC_R_PARAM) or definitions (SC_R_FULL) usable: index < limit */
-  int second;    /* the value being parsed may use y'' (sc_parse) */
+  sc_rmode mode;    /* what names resolve: parameters only, or everything */
+  int limit;        /* parameters (SC_R_PARAM) or definitions (SC_R_FULL) usable: index < limit */
+  int second;       /* the value being parsed may use y'' (sc_parse) */
+  sc_namemap names; /* every name defined so far: SC_NAME_CODE(kind, index) */
 } sc_loader;
+
+/* The kinds of names in sc_loader.names, and their codes there. */
+enum { SC_NAME_VARIABLE, SC_NAME_UNKNOWN, SC_NAME_PARAMETER, SC_NAME_DEFINITION, SC_NAME_KINDS };
+#define SC_NAME_CODE(kind, index) ((index)*SC_NAME_KINDS + (kind))
+/* The index of name if it is of the given kind, else -1. */
+int sc_name_find(const sc_loader *L, const char *name, int kind);
+/* Record a name that sc_check_new_name accepted: 0, or -1 (with a message) out of memory. */
+int sc_name_add(sc_loader *L, int line, const char *name, int kind, int index);
 
 /* scene_parse.c */
 ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what);

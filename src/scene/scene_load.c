@@ -81,16 +81,14 @@ int sc_check_keys(sc_loader *L, int sec, const char *const *keys, const char *li
   return 0;
 }
 
-/* Is `name` already taken by the variable, an unknown, a parameter or a definition? */
-static const char *taken(const scene *s, const char *name) {
-  if (s->variable && strcmp(name, s->variable) == 0) return "the variable";
-  for (int i = 0; i < s->n; i++)
-    if (strcmp(name, s->unknowns[i]) == 0) return "an unknown";
-  for (int i = 0; i < s->nparams; i++)
-    if (s->params[i].name && strcmp(name, s->params[i].name) == 0) return "a parameter";
-  for (int i = 0; i < s->ndefs; i++)
-    if (s->defs[i].name && strcmp(name, s->defs[i].name) == 0) return "a definition";
-  if (ex_dag_find_table(s->dag, name) >= 0) return "a table";
+/* Is `name` already taken by the variable, an unknown, a parameter, a definition or a
+ * table? (One lookup in the loader's map: a scene may define 10^5 names.) */
+static const char *taken(const sc_loader *L, const char *name) {
+  static const char *const what[SC_NAME_KINDS] = {"the variable", "an unknown", "a parameter",
+                                                  "a definition"};
+  int code = sc_namemap_get(&L->names, name);
+  if (code >= 0) return what[code % SC_NAME_KINDS];
+  if (ex_dag_find_table(L->s->dag, name) >= 0) return "a table";
   return NULL;
 }
 
@@ -107,7 +105,7 @@ int sc_check_new_name(sc_loader *L, int line, const char *name, const char *role
     sc_err(L->err, L->errlen, L->file, line, "'%s' is reserved and cannot name %s", name, role);
     return -1;
   }
-  if ((t = taken(L->s, name)) != NULL) {
+  if ((t = taken(L, name)) != NULL) {
     sc_err(L->err, L->errlen, L->file, line, "'%s' is already %s", name, t);
     return -1;
   }
@@ -131,6 +129,7 @@ static int load_scene_section(sc_loader *L) {
   if (e && sc_check_new_name(L, e->line, e->value, "variable") < 0) return -1;
   s->variable = sc_strdup(e ? e->value : "x");
   if (!s->title || !s->variable) goto nomem;
+  if (sc_name_add(L, hl, s->variable, SC_NAME_VARIABLE, 0) < 0) return -1;
 
   e = find_entry(L, SEC_SCENE, "unknowns");
   if (!e) {
@@ -153,6 +152,10 @@ static int load_scene_section(sc_loader *L) {
     }
     s->unknowns[s->n++] = list.item[i];
     list.item[i] = NULL;
+    if (sc_name_add(L, line, s->unknowns[i], SC_NAME_UNKNOWN, i) < 0) {
+      ex_list_free(&list);
+      return -1;
+    }
   }
   ex_list_free(&list);
   if (!find_entry(L, SEC_SCENE, "interval")) {
@@ -190,11 +193,10 @@ static int load_parameters(sc_loader *L, int nset, const sc_set *set) {
       sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
       return -1;
     }
+    if (sc_name_add(L, e->line, s->params[i].name, SC_NAME_PARAMETER, i) < 0) return -1;
   }
   for (int k = 0; k < nset; k++) {
-    int found = 0;
-    for (int i = 0; i < ne; i++) found |= strcmp(set[k].name, s->params[i].name) == 0;
-    if (!found) {
+    if (sc_name_find(L, set[k].name, SC_NAME_PARAMETER) < 0) {
       sc_err(L->err, L->errlen, L->file, 0,
              "--set %s=%s: '%s' is not a parameter of this "
              "scene%s",
@@ -251,6 +253,7 @@ static int load_definitions(sc_loader *L) {
       sc_err(L->err, L->errlen, L->file, e->line, "out of memory");
       return -1;
     }
+    if (sc_name_add(L, e->line, s->defs[i].name, SC_NAME_DEFINITION, i) < 0) return -1;
   }
   L->mode = SC_R_FULL;
   for (int i = 0; i < ne; i++) {
@@ -323,10 +326,12 @@ static scene *load_buffer(const char *text, size_t len, const char *name, int ns
       sc_load_report(&L) < 0 || sc_load_mesh(&L) < 0 || sc_load_solver(&L) < 0 ||
       sc_load_plot(&L) < 0 || sc_load_order2(&L) < 0) {
     sc_raw_free(&L.raw);
+    sc_namemap_free(&L.names);
     scene_free(s);
     return NULL;
   }
   sc_raw_free(&L.raw);
+  sc_namemap_free(&L.names);
   return s;
 }
 

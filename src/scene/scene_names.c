@@ -1,4 +1,4 @@
-/* src/scene/scene_names.c — the names a scene may not define.
+/* src/scene/scene_names.c — the names a scene may not define, and those it has defined.
  * SPDX-License-Identifier: MIT */
 #include <string.h>
 
@@ -8,3 +8,14 @@
  * `exp` would be shadowed by exp( ... ) or shadow it) and `free`, which [boundary] reads
  * as a natural end. */
 int sc_is_reserved(const char *s) { return ex_is_reserved(s) || strcmp(s, "free") == 0; }
+
+int sc_name_find(const sc_loader *L, const char *name, int kind) {
+  int code = sc_namemap_get(&L->names, name);
+  return code >= 0 && code % SC_NAME_KINDS == kind ? code / SC_NAME_KINDS : -1;
+}
+
+int sc_name_add(sc_loader *L, int line, const char *name, int kind, int index) {
+  if (sc_namemap_put(&L->names, name, SC_NAME_CODE(kind, index)) == 0) return 0;
+  sc_err(L->err, L->errlen, L->file, line, "out of memory");
+  return -1;
+}

@@ -26,21 +26,7 @@ const char *sc_slot_name(const scene *s, int slot, char *buf, size_t cap) {
 
 /* First slot in [from, to] that e depends on, or -1. */
 int sc_first_slot(const scene *s, ex_id e, int from, int to) {
-  for (int k = from; k <= to; k++)
-    if (ex_depends_on(s->dag, e, k)) return k;
-  return -1;
-}
-
-static int find_name(char *const *names, int n, const char *name) {
-  for (int i = 0; i < n; i++)
-    if (strcmp(names[i], name) == 0) return i;
-  return -1;
-}
-
-static int find_item(const sc_item *it, int n, const char *name) {
-  for (int i = 0; i < n; i++)
-    if (it[i].name && strcmp(it[i].name, name) == 0) return i;
-  return -1;
+  return ex_first_slot(s->dag, e, from, to);
 }
 
 /* A hint for a name that resolves to nothing: a derivative written without its prime (yp,
@@ -85,7 +71,7 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
   int i;
 
   if (strcmp(name, "pi") == 0 && primes == 0) return ex_num(d, M_PI);
-  if ((i = find_item(s->params, s->nparams, name)) >= 0) {
+  if ((i = sc_name_find(L, name, SC_NAME_PARAMETER)) >= 0) {
     if (L->mode == SC_R_PARAM && i >= L->limit) {
       snprintf(err, errlen,
                i == L->limit ? "parameter '%s' refers to itself"
@@ -105,16 +91,16 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
     }
     return ex_num(d, s->params[i].value);
   }
-  char hint[160];
-  suggest(L, name, hint, sizeof hint);
+  char hint[160]; /* computed only for a name that fails: the distances cost */
   if (L->mode == SC_R_PARAM) {
+    suggest(L, name, hint, sizeof hint);
     snprintf(err, errlen,
              "unknown name '%s' (a parameter may use only numbers, pi and "
              "earlier parameters)%s",
              name, hint);
     return -1;
   }
-  if ((i = find_item(s->defs, s->ndefs, name)) >= 0) {
+  if ((i = sc_name_find(L, name, SC_NAME_DEFINITION)) >= 0) {
     if (i >= L->limit) {
       snprintf(err, errlen,
                i == L->limit ? "definition '%s' refers to itself"
@@ -139,7 +125,7 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
     }
     return ex_slot(d, 0);
   }
-  if ((i = find_name(s->unknowns, s->n, name)) >= 0) {
+  if ((i = sc_name_find(L, name, SC_NAME_UNKNOWN)) >= 0) {
     if (primes > 1 && !L->second) {
       snprintf(err, errlen,
                "%s'': a second derivative may appear only in the integrand, [definitions], "
@@ -150,6 +136,7 @@ static ex_id resolve(ex_dag *d, const char *name, int primes, void *user, char *
     if (primes == 2) return ex_slot(d, sc_d2_slot(s, i));
     return ex_slot(d, primes ? 1 + s->n + i : 1 + i);
   }
+  suggest(L, name, hint, sizeof hint);
   snprintf(err, errlen, "unknown name '%s'%s", name, hint);
   return -1;
 }
@@ -206,14 +193,14 @@ ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const
 
 /* A constant expression (numbers, pi, parameters, definitions built from those), which
  * must be finite. Returns 0, or -1 with a message. */
+static double param_slot(void *user, int slot) {
+  const scene *s = user;
+  int i = slot - 1 - 2 * s->n;
+  return i >= 0 && i < s->nparams ? s->params[i].value : 0.0;
+}
+
 int sc_eval_params(const scene *s, ex_id e, double *value) {
-  int ns = 1 + 2 * s->n + s->nparams;
-  double *slots = cv_calloc((size_t)ns, sizeof *slots);
-  if (!slots) return -1;
-  for (int i = 0; i < s->nparams; i++) slots[1 + 2 * s->n + i] = s->params[i].value;
-  int rc = ex_eval(s->dag, e, slots, value);
-  cv_free(slots);
-  return rc;
+  return ex_eval_with(s->dag, e, NULL, param_slot, (void *)s, value);
 }
 
 int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text, const char *what,

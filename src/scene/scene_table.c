@@ -362,6 +362,36 @@ static int table_bytes(int fd, char **text, size_t *len, int *mapped) {
   return 0;
 }
 
+/* Open a [tables] file as a scene is opened (scene_file.c): a regular file only (a FIFO
+ * would block, /dev/zero never ends), of at most SC_MAX_TABLE_BYTES. A descriptor, or -1
+ * with a message. */
+static int table_open(const char *path, const char *shown, char *err, size_t errlen) {
+  struct stat st;
+  if (stat(path, &st) != 0) {
+    sc_err(err, errlen, shown, 0, "cannot open the table: %s", strerror(errno));
+    return -1;
+  }
+  int fd = S_ISREG(st.st_mode) ? open(path, O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK) : -1;
+  if (fd >= 0 && (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))) { /* replaced since stat */
+    close(fd);
+    fd = -1;
+  }
+  if (fd < 0) {
+    sc_err(err, errlen, shown, 0, "cannot read a table from %s; give a CSV file",
+           S_ISREG(st.st_mode)    ? strerror(errno)
+           : S_ISDIR(st.st_mode)  ? "a directory"
+           : S_ISFIFO(st.st_mode) ? "a FIFO (named pipe)"
+                                  : "a device or socket");
+    return -1;
+  }
+  if ((long long)st.st_size > SC_MAX_TABLE_BYTES) {
+    close(fd);
+    sc_err(err, errlen, shown, 0, "the table is larger than 1 GiB, the most calcvar reads");
+    return -1;
+  }
+  return fd;
+}
+
 cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t errlen) {
   cv_table *t = NULL;
   char *text = NULL;
@@ -375,11 +405,8 @@ cv_table *sc_table_read(const char *path, const char *shown, char *err, size_t e
   for (int k = 0; k < 3; k++) tc[k].lastlen = SIZE_MAX; /* matches no field */
   size_t nrows = 0, caprows = 0;
 
-  int fd = open(path, O_RDONLY | O_CLOEXEC);
-  if (fd < 0) {
-    sc_err(err, errlen, shown, 0, "cannot open the table: %s", strerror(errno));
-    return NULL;
-  }
+  int fd = table_open(path, shown, err, errlen);
+  if (fd < 0) return NULL;
   int bad = table_bytes(fd, &text, &len, &mapped);
   int why_bad = errno;
   close(fd);
