@@ -33,6 +33,7 @@ static void worker_free(cv_batch *b, worker *w) {
   for (int k = 0; w->ints && k < b->s->nints; k++) ex_integrand_free(w->ints[k]);
   cv_free(w->cons);
   cv_free(w->ints);
+  ex_integrand_free(w->phase);
   cv_solver_free(w->sv);
   scene_free(w->inst);
   cv_free(w->pv);
@@ -79,6 +80,7 @@ static int worker_init(cv_batch *b, worker *w) {
     if (!(w->cons[k] = ex_integrand_clone(b->cons[k]))) return -1;
   for (int k = 0; k < s->nints; k++)
     if (!(w->ints[k] = ex_integrand_clone(b->ints[k]))) return -1;
+  if (b->phase && !(w->phase = ex_integrand_clone(b->phase))) return -1;
   return 0;
 }
 
@@ -95,6 +97,7 @@ void cv_batch_free(cv_batch *b) {
   for (int k = 0; b->ints && k < b->s->nints; k++) ex_integrand_free(b->ints[k]);
   cv_free(b->cons);
   cv_free(b->ints);
+  ex_integrand_free(b->phase);
   ex_tape_free(b->rep);
   ex_tape_free(b->rowt);
   ex_tape_free(b->guesst);
@@ -171,6 +174,15 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen) {
                msg[0] ? msg : "out of memory");
       goto fail;
     }
+  if (scene_pins_shift(s)) { /* PB-2: its constant is the guess's, per row */
+    ex_id K;
+    double c;
+    if (scene_phase_condition(s, &K, &c) < 0) goto nomem;
+    if (!(b->phase = ex_integrand_new_params(s->dag, s->n, b->np, K, b->need, msg, sizeof msg))) {
+      snprintf(err, errlen, "%s: the phase condition: %s", s->file, msg[0] ? msg : "out of memory");
+      goto fail;
+    }
+  }
   if (s->nreports > 0) {
     ex_id *outs = cv_malloc((size_t)s->nreports * sizeof *outs);
     if (!outs) goto nomem;

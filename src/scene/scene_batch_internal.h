@@ -14,6 +14,7 @@ typedef struct {
   const struct cv_batch *owner;
   scene *inst;
   ex_integrand *F, **cons, **ints; /* clones of the batch's compiled objects */
+  ex_integrand *phase;             /* the phase condition's clone (PB-2), or NULL */
   cv_solver *sv;
   double *pv;      /* parameter values of the row */
   double *tw, *pb; /* report tape work; parameter batches */
@@ -32,7 +33,8 @@ struct cv_batch {
   int n, np;
   unsigned need;
   ex_integrand *F, **cons, **ints;
-  ex_tape *rep; /* [report] integrands, nslots 1 + 2n + np */
+  ex_integrand *phase; /* K of the phase condition when the scene pins the shift (PB-2) */
+  ex_tape *rep;        /* [report] integrands, nslots 1 + 2n + np */
   int nout;
   char **outname;
   int ncols;

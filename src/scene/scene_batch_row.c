@@ -76,6 +76,9 @@ cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err, size_t e
   return rc < 0 ? CVAR_EINVAL : CVAR_OK;
 }
 
+/* The phase condition's constant takes the guess of at most this many unknowns at once. */
+#define CV_BATCH_MAX_UNKNOWNS 64
+
 /* A problem over the worker's clones, ends and integral constants of its instance. */
 cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
   const scene *s = w->inst;
@@ -104,6 +107,18 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
     ex_integrand_set_params(w->ints[k], w->pv);
     bad = cv_problem_add_integral(p, ex_integrand_eval, w->ints[k], s->ints[k].value, NULL) !=
           CVAR_OK;
+  }
+  /* periodic unknowns and the phase condition, after [integrals] as in scene_problem.c
+   * (PB-1, PB-2); the condition's constant from this row's guess at the ends */
+  for (int i = 0; i < s->n && !bad; i++)
+    bad = s->bc[i].periodic && cv_problem_set_periodic(p, i, s->bc[i].shift, NULL) != CVAR_OK;
+  if (w->phase && !bad) {
+    double ab[2] = {s->a, s->b}, g[2 * CV_BATCH_MAX_UNKNOWNS], c = 0.0;
+    ex_integrand_set_params(w->phase, w->pv);
+    bad = s->n > CV_BATCH_MAX_UNKNOWNS || sc_batch_guess(2, ab, g, w) != 0;
+    for (int i = 0; i < s->n && !bad; i++)
+      c += 0.5 * (g[2 * i + 1] * g[2 * i + 1] - g[2 * i] * g[2 * i]);
+    bad = bad || cv_problem_add_integral(p, ex_integrand_eval, w->phase, c, NULL) != CVAR_OK;
   }
   (void)b;
   if (bad) {

@@ -131,6 +131,33 @@ for m in ("ccsaq", "auglag"):
 p, _ = run(BUMP % ("y - (1 - x^2) >= 0", "1"), "--method", "lbfgs")
 check("lbfgs refuses constraints", p.returncode == 2 and "cannot impose" in p.stderr, p.stderr)
 
+# batch: a bump of height H per row, y >= H (1 - x^2). The tangent from (-2, 0) touches at
+# x_t = sqrt(3) - 2 whatever H (x_t^2 + 4 x_t + 1 = 0), so the length is
+# 2 sqrt((x_t + 2)^2 + H^2 (1 - x_t^2)^2) + 2 int_0^X sqrt(1 + 4 H^2 x^2) dx with X = -x_t,
+# the integral X/2 sqrt(1 + 4 H^2 X^2) + asinh(2 H X) / (4 H).
+def bump_length(H):
+    X = -xt
+    return 2 * math.hypot(xt + 2, H * (1 - xt * xt)) + 2 * (
+        X / 2 * math.sqrt(1 + 4 * H * H * X * X) + math.asinh(2 * H * X) / (4 * H))
+
+
+BATCH = BUMP.replace("[boundary]", "[parameters]\nH = 1\n[boundary]") % (
+    "y - H*(1 - x^2) >= 0", "(H + 0.5)*(1 - x^2/4)")
+with tempfile.TemporaryDirectory() as tmp:
+    sb, tb = os.path.join(tmp, "b.scene"), os.path.join(tmp, "t.csv")
+    open(sb, "w").write(BATCH)
+    open(tb, "w").write("H\n1\n1.5\n0.5\n")
+    p = subprocess.run([calcvar, "batch", sb, tb, "--tol", "1e-10"], capture_output=True, text=True)
+    lines = p.stdout.strip().split("\n")
+    head = lines[0].split(",")
+    check("batch exit", p.returncode == 0 and len(lines) == 4, p.stdout + p.stderr)
+    for line in lines[1:]:
+        row = dict(zip(head, line.split(",")))
+        L = bump_length(float(row["H"]))
+        check("batch H=%s" % row["H"], row["status"] == "converged" and
+              abs(float(row["action"]) - L) <= 1e-9, (row, L))
+check("bump length formula", abs(bump_length(1.0) - L_BUMP) <= 1e-13, bump_length(1.0))
+
 # Bad input: FILE:LINE and exit 2.
 for G, what in (("y - (1 - x^2) >= 0 + 1", "0 on the right"), ("y - (1 - x^2) > 0", "strict"),
                 ("y - 3 >= 0", "violated at the fixed end")):

@@ -237,5 +237,29 @@ check("eight energy", drift <= 1e-9, drift)
 print("figure-eight: action %.12f, choreography %.1e, energy %.9f drift %.1e" %
       (r["action"], chor, energies[0], drift))
 
+# batch: the period per row (PB-1 and the phase condition per row, its constant from the
+# row's guess); each row's action equals a plain solve's of that period to 1e-12, and the
+# period 8 row is the libration above.
+BATCH = PEND.replace("interval  = 0, %s", "interval  = 0, T") % ("periodic", "1.5*cos(2*pi*t/T)")
+BATCH = BATCH.replace("[boundary]", "[parameters]\nT = 8\n[boundary]")
+with tempfile.TemporaryDirectory() as tmp:
+    scene_b, table = os.path.join(tmp, "b.scene"), os.path.join(tmp, "t.csv")
+    open(scene_b, "w").write(BATCH)
+    open(table, "w").write("T\n8\n10\n")
+    p = subprocess.run([calcvar, "batch", scene_b, table, "--tol", "1e-10"], capture_output=True,
+                       text=True)
+    lines = p.stdout.strip().split("\n")
+    check("batch rows", p.returncode == 0 and len(lines) == 3, p.stdout + p.stderr)
+    head = lines[0].split(",")
+    for line in lines[1:]:
+        row = dict(zip(head, line.split(",")))
+        T = row["T"]
+        q = run(PEND % (T, "periodic", "1.5*cos(2*pi*t/%s)" % T), "--tol", "1e-10", "--json", "-")
+        ref = json.loads(q.stdout)["action"]
+        check("batch T=%s" % T, row["status"] == "converged" and
+              abs(float(row["action"]) - ref) <= 1e-12, (row, ref))
+        if T == "8":
+            check("batch libration", abs(float(row["action"]) - 6.68858249672602) <= 1e-9, row)
+
 print("%d failures" % fails)
 sys.exit(1 if fails else 0)
