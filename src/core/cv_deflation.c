@@ -515,6 +515,121 @@ static cv_status all_moving_ends(cv_solver *s, const cv_problem *p, int max) {
   return st;
 }
 
+/* The starts of the search among obstacles (OB-7): y0 + k (g - y0) for the guess g and the
+ * line y0 between the end values (free ends: the other end's value, or 0), and when the
+ * guess is that line, y0 + k (b - a)/2 sin(pi (x - a)/(b - a)) for every unknown. */
+typedef struct {
+  const cv_problem *p;
+  double k;
+  int bump;
+} ob_start;
+
+static double end_line(const cv_problem *p, int i, double x) {
+  int fa = p->fixed[2 * i], fb = p->fixed[2 * i + 1];
+  double ya = p->endval[2 * i], yb = p->endval[2 * i + 1];
+  if (fa && fb) return ya + (yb - ya) * (x - p->a) / (p->b - p->a);
+  return fa ? ya : fb ? yb : 0.0;
+}
+
+static int ob_guess(int m, const double *x, double *y, void *user) {
+  const ob_start *o = user;
+  const cv_problem *p = o->p;
+  int n = p->n;
+  if (!o->bump && p->guess(m, x, y, p->guess_user)) return 1;
+  for (int i = 0; i < n; i++)
+    for (int k = 0; k < m; k++) {
+      double l = end_line(p, i, x[k]), L = p->b - p->a;
+      double g = o->bump ? l + 0.5 * L * sin(CV_PI * (x[k] - p->a) / L) : y[(size_t)i * m + k];
+      y[(size_t)i * m + k] = l + o->k * (g - l);
+    }
+  return 0;
+}
+
+/* Every stationary path among obstacles (OB-7). Deflation does not suit the active set
+ * (a deflated residual has no complementarity structure), so the search solves from a fan
+ * of starts on both sides of the line between the ends — the obstacle solve (OB-3) from
+ * each — and keeps the distinct paths: two paths are one when their values at 65 points
+ * agree within 1e-6 of their size plus their error estimates. */
+static cv_status all_obstacles(cv_solver *s, const cv_problem *p, int max) {
+  static const double ks[] = {1.0, -1.0, 2.0, -2.0, 0.5, -0.5, 3.0, -3.0};
+  enum { NS = 65 };
+  int nk = (int)(sizeof ks / sizeof ks[0]), n = p->n;
+  double t0 = cv_now(), xs[NS];
+  struct cv_pathset *ps = cv_calloc(1, sizeof *ps);
+  cv_path *v = cv_calloc((size_t)max, sizeof *v);
+  double *seen = cv_malloc((size_t)max * NS * n * sizeof *seen);
+  double *ests = cv_malloc((size_t)max * sizeof *ests);
+  double *cur = cv_malloc((size_t)NS * n * sizeof *cur);
+  cv_status st = CVAR_OK, first = CVAR_OK;
+  char msg0[sizeof s->msg] = "";
+  if (!ps || !v || !seen || !ests || !cur) {
+    cv_free(ps), cv_free(v), cv_free(seen), cv_free(ests), cv_free(cur);
+    cv_set_msg(s->msg, sizeof s->msg, "out of memory for the list of paths");
+    return s->status = CVAR_ENOMEM;
+  }
+  ps->v = v;
+  cv_search_info *info = &ps->info;
+  for (int j = 0; j < NS; j++) xs[j] = p->a + (p->b - p->a) * j / (NS - 1);
+  /* with the default guess (the line), the fan is of sine bumps */
+  int bump = p->guess == NULL;
+  for (int k = 0; k < nk && ps->n < max; k++) {
+    ob_start o = {p, ks[k], bump};
+    cv_problem pk = *p; /* the same problem with this start as its guess; nothing is freed */
+    pk.guess = ob_guess;
+    pk.guess_user = &o;
+    info->starts++;
+    st = k == 0 && !bump ? cv_solve(s, p) : cv_solve(s, &pk);
+    if (k == 0) first = st, memcpy(msg0, s->msg, sizeof msg0);
+    if (st == CVAR_ENOMEM || st == CVAR_ECANCELLED || st == CVAR_ECALLBACK) break;
+    if (st != CVAR_OK || cv_solver_eval(s, NS, xs, cur, NULL) != CVAR_OK) {
+      info->failed++;
+      continue;
+    }
+    double size = 1.0, est = isfinite(s->err_est) ? s->err_est : 0.0;
+    for (int j = 0; j < NS * n; j++) size = fmax(size, fabs(cur[j]));
+    int same = 0;
+    for (int q = 0; q < ps->n && !same; q++) {
+      double d = 0.0;
+      for (int j = 0; j < NS * n; j++) d = fmax(d, fabs(cur[j] - seen[(size_t)q * NS * n + j]));
+      same = d <= 1e-6 * size + est + ests[q];
+    }
+    if (same) {
+      info->duplicates++;
+      continue;
+    }
+    memcpy(seen + (size_t)ps->n * NS * n, cur, (size_t)NS * n * sizeof *cur);
+    ests[ps->n] = est;
+    path_take(&ps->v[ps->n++], s);
+  }
+  if (st == CVAR_ENOMEM || st == CVAR_ECANCELLED || st == CVAR_ECALLBACK)
+    cv_set_msg(info->stop, sizeof info->stop, "the search stopped: %s", s->msg);
+  else if (ps->n >= max)
+    cv_set_msg(info->stop, sizeof info->stop, "found the %d path%s asked for", max,
+               max == 1 ? "" : "s");
+  else
+    cv_set_msg(info->stop, sizeof info->stop,
+               "with obstacles the search tries %d starts: the %s scaled by 1, -1, 2, -2, 1/2, "
+               "-1/2, 3 and -3 about the line between the ends (no deflation)",
+               nk, bump ? "sine bump (b - a)/2 sin(pi (x - a)/(b - a))" : "guess");
+  info->found = ps->n;
+  if (ps->n > 0) {
+    qsort(ps->v, (size_t)ps->n, sizeof *ps->v, by_action);
+    ps->sel = 0;
+    path_give(s, &ps->v[0]);
+    st = CVAR_OK;
+  } else {
+    st = first == CVAR_OK ? CVAR_EMAXITER : first;
+    memcpy(s->msg, msg0, sizeof s->msg);
+  }
+  cv_free(seen);
+  cv_free(ests);
+  cv_free(cur);
+  s->paths = ps;
+  s->status = st;
+  s->time = cv_now() - t0;
+  return st;
+}
+
 cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
   if (!s) return CVAR_EINVAL;
   cv_pathset_free(s->paths);
@@ -529,6 +644,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
     return CVAR_EINVAL;
   }
   if (cv_ends_moving(p)) return all_moving_ends(s, p, max);
+  if (cv_kkt_has_inequalities(p)) return all_obstacles(s, p, max);
   double t0 = cv_now();
   struct cv_pathset *ps = cv_calloc(1, sizeof *ps);
   cv_path *v = cv_calloc((size_t)max, sizeof *v);

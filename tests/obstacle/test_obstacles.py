@@ -99,6 +99,16 @@ iv = r["contact"]["over"]
 check("disk contact", len(iv) == 1 and abs(iv[0][0] + 0.5) <= 3e-5 and abs(iv[0][1] - 0.5) <= 3e-5,
       iv)
 
+# --all around the disk: the path over it and its mirror image under it (OB-7), both
+# minima of length 2 sqrt(3) + pi/3.
+p, _ = run(DISK, "--all", "--tol", "1e-10", "--json", "-")
+r = json.loads(p.stdout)
+paths = r.get("solutions", [])
+check("disk --all two paths", len(paths) == 2, [q.get("action") for q in paths])
+for q in paths:
+    check("disk --all length", abs(q["action"] - (2 * math.sqrt(3) + math.pi / 3)) <= 1e-9, q)
+    check("disk --all minimum", q.get("morse_index") == 0, q)
+
 # Mesh independence of the active-set iteration (from the guess above the bump): at most
 # 70 Newton iterations in all at every size from 10^2 to 10^5 elements of degree 1
 # (measured: 9, 40, 47, 56 — the exact iteration alone converges at 10^2; above, the
