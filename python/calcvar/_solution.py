@@ -164,6 +164,7 @@ class Solution:
         self._f = fields      # read_fields(), filled on first use
         self._report = report
         self._title = title   # a Problem's own title (its scene text carries a plain one)
+        self._note = None     # (status word, sentence) of a curve_tol that was not met
         self._interp = None
         self._curve = None
         self.x = x
@@ -187,7 +188,6 @@ class Solution:
 
     unknowns = _field("unknowns", "the unknowns' names, in order")
     variable = _field("variable", "the independent variable's name")
-    message = _field("message", "the solver's sentence")
     method = _field("method", 'the method ("newton", "lbfgs", ...)')
     elements = _field("elements", "elements of the mesh")
     degree = _field("degree", "the largest element degree")
@@ -201,6 +201,12 @@ class Solution:
     multipliers = _field("mus", "{name: multiplier} of the [integrals] constraints")
     fields = _field("lambdas", "{name: multiplier field at the nodes} of the [constraints]")
     del _field
+
+    @property
+    def message(self):
+        """The solver's sentence."""
+        m = self._fields()["message"]
+        return m if self._note is None else "%s %s" % (self._note[1], m)
 
     @property
     def title(self):
@@ -330,6 +336,9 @@ class Solution:
                     rep = build_report(h)
                     if self._title is not None:
                         rep["title"] = self._title
+                    if self._note is not None:
+                        rep["status"] = self._note[0]
+                        rep["message"] = "%s %s" % (self._note[1], rep.get("message", ""))
                     self._report = rep
         return self._report
 
@@ -350,12 +359,14 @@ class Solution:
         self._fields()
         self.report  # noqa: B018 - read now: the copy has no handles to build it from
         return {"x": self.x, "values": self.values, "code": self._code, "fields": self._f,
-                "report": self._report, "title": self._title, "curve": self._curve}
+                "report": self._report, "title": self._title, "curve": self._curve,
+                "note": self._note}
 
     def __setstate__(self, st):
         self.__init__(None, st["x"], st["values"], st["code"], st["fields"], st["report"],
                       st["title"])
         self._curve = st.get("curve")
+        self._note = st.get("note")
         for a in (self.x, self.values):
             a.flags.writeable = False
 

@@ -179,7 +179,8 @@ def solve(scene: Scene, *, elements: Optional[Number] = None,
           time_limit: Optional[Number] = None, all: bool = False, max_paths: int = 8,
           work: Optional[Number] = None, guess: Any = None,
           progress: Optional[Callable[[dict], Any]] = None,
-          verbose: bool = False) -> Union[Solution, Solutions]:
+          verbose: bool = False,
+          curve_tol: Optional[Number] = None) -> Union[Solution, Solutions]:
     """Solve a scene as `calcvar solve` does and return a Solution.
 
     scene: a path (str or os.PathLike), the text of a scene (any str with a newline or
@@ -205,9 +206,21 @@ def solve(scene: Scene, *, elements: Optional[Number] = None,
     --all`: deflated Newton, at most max_paths, work limit `work` like --work) and
     returns a Solutions list, by increasing action, each with its report.
 
+    curve_tol: the target for sol(x) anywhere, not only at the nodes: solves with tol
+    (from curve_tol down) until Solution.curve_error["curve"] <= curve_tol, at most
+    CURVE_ROUNDS solves, each started from the last; if it is not met the Solution's
+    status is "max_iterations" with a sentence giving the estimate reached.
+
     Bad input raises InputError (a ValueError) with the FILE:LINE sentence. A solve that
     does not converge is not an exception: look at Solution.status / .success.
     """
+    if curve_tol is not None:
+        if tol is not None or adapt is not None or all:
+            raise bad("curve_tol chooses tol itself: give curve_tol, or tol / adapt / all")
+        return _curve_solve(scene, number(curve_tol, "curve_tol"), dict(
+            elements=elements, degree=degree, method=method, tolerance=tolerance,
+            max_iterations=max_iterations, set=set, max_nodes=max_nodes,
+            time_limit=time_limit, guess=guess, progress=progress, verbose=verbose))
     title = None
     if type(scene) is not str and isinstance(scene, Problem):
         title, scene = scene.title, scene.text
@@ -229,6 +242,37 @@ def solve(scene: Scene, *, elements: Optional[Number] = None,
         finally:
             if not h.owned:
                 h.free()
+
+
+CURVE_ROUNDS = 6   # solves curve_tol may make
+CURVE_FLOOR = 1e-15  # tol is not asked below this (the round-off floor of the estimate)
+
+
+def _curve_solve(scene, target, kw):
+    """Solves with tol from target down until the curve's estimated error is at most target
+    (the nodes are superconvergent, so tol must be smaller than the curve's target: each
+    round divides it by the ratio just measured, with a margin of 0.8)."""
+    if not target > 0:
+        raise bad("curve_tol=%r: a number > 0 is needed" % (target,))
+    t, sol = target, None
+    for k in range(1, CURVE_ROUNDS + 1):
+        sol = solve(scene, tol=t, **kw)
+        if not sol.success:
+            return sol
+        c = sol.curve_error["curve"]
+        if c <= target:
+            return sol
+        kw["guess"] = sol
+        t_last = t
+        t = t * max(min(0.8 * target / c, 0.5), 1e-4)
+        if t < CURVE_FLOOR:
+            break
+    sol._code = _lib.EMAXITER
+    sol.success = False
+    sol._note = ("max_iterations", "curve_tol %.3g was not reached: after %d solve%s the "
+                 "estimated error of sol(x) is %.3g (tol %.3g at the nodes)."
+                 % (target, k, "" if k == 1 else "s", c, t_last))
+    return sol
 
 
 def _run(h, g, scene, set, opts, err, all, max_paths, work, guess, progress, verbose, title):

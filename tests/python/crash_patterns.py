@@ -5,7 +5,8 @@ pools returning Solutions, threads on the paths of one all=True solve). Each pat
 checks its answers against the same Solution used plainly; run one pattern per process:
 
 usage: crash_patterns.py PATTERN     (deepcopy, pickle, pool_spawn, pool_fork, threads_paths,
-                                      threads_report); prints OK and exits 0, or fails.
+                                      threads_report, threads_solve); prints OK and exits 0,
+                                      or fails.
 SPDX-License-Identifier: MIT
 """
 import concurrent.futures
@@ -127,9 +128,32 @@ def threads_report():
     assert len(out) == 6 and len(set(out)) == 1, out
 
 
+def threads_solve():
+    """Four threads solving at once (the GIL is released in the solve) get the answers of
+    the same solves made one after the other, and bad input in one thread is its own."""
+    cs = [1.5, 2.0, 2.5, 3.0] * 2
+    want = {c: catenary(c).action for c in cs}
+    got, errors = [], []
+
+    def work(c):
+        got.append((c, catenary(c).action))
+        try:
+            calcvar.solve(CATENARY, set={"c": "1/0"})
+        except ValueError as e:
+            errors.append(str(e))
+
+    ts = [threading.Thread(target=work, args=(c,)) for c in cs]
+    for t in ts:
+        t.start()
+    for t in ts:
+        t.join()
+    assert sorted(got) == sorted((c, want[c]) for c in cs), got
+    assert len(errors) == len(cs)
+
+
 PATTERNS = {"deepcopy": deepcopy, "pickle": pickle_, "pool_spawn": lambda: pool("spawn"),
             "pool_fork": lambda: pool("fork"), "threads_paths": threads_paths,
-            "threads_report": threads_report}
+            "threads_report": threads_report, "threads_solve": threads_solve}
 
 if __name__ == "__main__":
     PATTERNS[sys.argv[1]]()

@@ -26,6 +26,7 @@ import math, os, sys
 exact = 2 + 2 * math.sinh(1)   # c (1 + (c/2) sinh(2/c)), c = 2
 assert sol.status == "converged" and abs(sol.action - exact) < 1e-9, (sol.action, exact)
 assert abs(sol(0.5)[0] - 2 * math.cosh(0.25)) < 1e-9
+assert sol.curve_error["curve"] < 1e-8          # a module imported on first use
 lib = calcvar._lib.lib._name
 assert lib.startswith(sys.prefix), "the library %s is not the environment's" % lib
 from importlib import metadata
@@ -49,8 +50,15 @@ def venv(tmp, name, env):
     return os.path.join(d, "bin", "python")
 
 
-def check(python, env, tmp):
+def check(python, env, tmp, src):
     out = run([python, "-c", CATENARY], env=env, cwd=tmp)  # not the source tree
+    # every file of the source package is installed (python/meson.build lists them)
+    pkg = run([python, "-c", "import calcvar, os; print(os.path.dirname(calcvar.__file__))"],
+              env=env, cwd=tmp).strip()
+    want = {f for f in os.listdir(os.path.join(src, "python", "calcvar"))
+            if not f.endswith(".in") and f != "__pycache__"}
+    missing = want - set(os.listdir(pkg))
+    assert not missing, "not installed: %s" % sorted(missing)
     print(out, end="")
     exe = os.path.join(os.path.dirname(python), "calcvar")
     print(run([exe, "--version"], env=env).splitlines()[0])
@@ -71,7 +79,7 @@ def main():
     with tempfile.TemporaryDirectory(prefix="calcvar-pip-") as tmp:
         py = venv(tmp, "env", env)
         if not wheel:
-            run([py, "-m", "pip", "install", "--no-build-isolation",
+            run([py, "-m", "pip", "install", "--no-cache-dir", "--no-build-isolation",
                  "--config-settings=compile-args=-j2", src], env=env, cwd=tmp)
         else:
             dist = os.path.join(tmp, "dist")
@@ -81,8 +89,9 @@ def main():
             whl = glob.glob(os.path.join(dist, "calcvar-*.whl"))
             assert len(whl) == 1, whl
             print("wheel:", os.path.basename(whl[0]))
-            run([py, "-m", "pip", "install", "--no-deps", whl[0]], env=env, cwd=tmp)
-        check(py, env, tmp)
+            run([py, "-m", "pip", "install", "--no-cache-dir", "--no-deps", whl[0]], env=env,
+                cwd=tmp)
+        check(py, env, tmp, src)
     print("PASS")
     return 0
 

@@ -43,3 +43,36 @@ def test_curve_error_after_tol():
     # copies keep it; a pickle carries it once read
     assert copy.deepcopy(s).curve_error == s.curve_error
     assert pickle.loads(pickle.dumps(s)).curve_error == s.curve_error
+
+
+def test_curve_tol_bounds_the_curve():
+    """The harmonic saddle q = sin(t)/sin(4) on [0, 4]: tol = 1e-10 holds at the nodes,
+    while sol(t) is 1.2e-9 off between them (measured against the exact q); curve_tol =
+    1e-10 brings the curve's estimate, and its true error (bound 1.5e-10), within 1e-10."""
+    f = os.path.join(SCENES, "harmonic_saddle.scene")
+    ts = np.linspace(0, 4, 100001)
+    exact = np.sin(ts) / np.sin(4)
+    plain = calcvar.solve(f, tol=1e-10)
+    assert plain.report["error"]["max_nodal"] <= 1e-10
+    assert np.max(np.abs(plain(ts)[0] - exact)) > 5e-10
+    s = calcvar.solve(f, curve_tol=1e-10)
+    assert s.success and s.curve_error["curve"] <= 1e-10
+    assert np.max(np.abs(s(ts)[0] - exact)) <= 1.5e-10
+    with pytest.raises(ValueError, match="curve_tol chooses tol"):
+        calcvar.solve(f, curve_tol=1e-8, tol=1e-8)
+    with pytest.raises(ValueError, match="curve_tol"):
+        calcvar.solve(f, curve_tol=0)
+
+
+def test_curve_tol_not_met_is_said(monkeypatch):
+    """With one solve allowed, curve_tol = 1e-10 is not met on the harmonic saddle: the
+    Solution says so (status max_iterations, in its message and its report)."""
+    from calcvar import _solve
+    monkeypatch.setattr(_solve, "CURVE_ROUNDS", 1)
+    s = calcvar.solve(os.path.join(SCENES, "harmonic_saddle.scene"), curve_tol=1e-10)
+    assert not s.success and s.status == "max_iterations"
+    assert s.message.startswith("curve_tol 1e-10 was not reached: after 1 solve the")
+    assert s.report["status"] == "max_iterations"
+    assert s.report["message"].startswith("curve_tol 1e-10 was not reached")
+    back = pickle.loads(pickle.dumps(s))
+    assert back.status == "max_iterations" and back.message == s.message

@@ -27,7 +27,7 @@ def _env():
 
 
 @pytest.mark.parametrize("pattern", ["deepcopy", "pickle", "pool_spawn", "pool_fork",
-                                     "threads_paths", "threads_report"])
+                                     "threads_paths", "threads_report", "threads_solve"])
 def test_crash_pattern(pattern):
     for run in range(RUNS):
         r = subprocess.run([sys.executable, os.path.join(HERE, "crash_patterns.py"), pattern],
@@ -61,3 +61,19 @@ def test_ctrl_c_stops_the_solve(mode):
         assert live == "0", "handles not freed: " + out
         assert mode == "plain" or int(steps) > 0
         assert "Exception ignored" not in err and "Traceback" not in err, err
+
+
+def test_bad_input_frees_every_handle():
+    """A solve refused at any stage (scene text, option, the core's own check) leaves no
+    handle behind."""
+    import calcvar
+    from calcvar._solution import Handles
+    before = Handles.live()
+    text = "[scene]\ninterval = 0, 1\nunknowns = y\nintegrand = y'^2\n[boundary]\ny = 0, 1\n"
+    for kw in ({"set": {"nope": 1}}, {"elements": 0}, {"degree": 9}, {"method": "x"},
+               {"guess": ([0, 1], [[0, 1], [0, 1]])}):
+        with pytest.raises((ValueError, TypeError)):
+            calcvar.solve(text, **kw)
+    with pytest.raises(ValueError):
+        calcvar.solve(text.replace("y'^2", "y'^2 +"))
+    assert Handles.live() == before
