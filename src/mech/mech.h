@@ -82,6 +82,11 @@ typedef struct {
 cv_status mech_equations_new(const mech_problem *mp, mech_equations *eq, char *err, size_t errlen);
 void mech_equations_free(mech_equations *eq);
 
+/* ---- Symmetries (mech_dense.c) --------------------------------------------------------- */
+/** The null directions of an m x n matrix of samples (row-major): unit vectors v with
+ * R v = 0 to rtol of R's scale; V holds n values each. Returns their count or -1. */
+int mech_null_directions(int n, int m, const double *R, double rtol, double *V);
+
 /* ---- Small oscillations (mech_modes.c) ------------------------------------------------ */
 
 typedef enum {

@@ -164,3 +164,29 @@ int mech_gyro_eigenvalues(int n, const double *M, const double *K, const double 
   cv_free(A);
   return info != 0 ? -1 : 0;
 }
+
+/* The directions v (|v| = 1) with R v = 0 for the m x n matrix R (row-major): the
+ * eigenvectors of R^T R whose eigenvalues are below rtol times the largest (dsyev). Writes
+ * them to V (n per direction) and returns their count, or -1 on failure. */
+int mech_null_directions(int n, int m, const double *R, double rtol, double *V) {
+  double *A = cv_malloc((size_t)n * n * sizeof *A), *lam = cv_malloc((size_t)n * sizeof *lam);
+  int lw = 8 * n + 8, info = 0, count = 0;
+  double *w = cv_malloc((size_t)lw * sizeof *w);
+  if (!A || !lam || !w) {
+    cv_free(A), cv_free(lam), cv_free(w);
+    return -1;
+  }
+  for (int i = 0; i < n; i++)
+    for (int j = 0; j < n; j++) {
+      double sum = 0.0;
+      for (int k = 0; k < m; k++) sum += R[(size_t)k * n + i] * R[(size_t)k * n + j];
+      A[(size_t)j * n + i] = sum;
+    }
+  dsyev_("V", "U", &n, A, &n, lam, w, &lw, &info);
+  double big = info == 0 ? mech_maxabs(n, lam) : NAN;
+  for (int k = 0; k < n && info == 0; k++)
+    if (fabs(lam[k]) <= rtol * big)
+      memcpy(V + (size_t)count++ * n, A + (size_t)k * n, (size_t)n * sizeof *V);
+  cv_free(A), cv_free(lam), cv_free(w);
+  return info == 0 && big > 0 ? count : -1;
+}

@@ -210,6 +210,9 @@ int scene_F_depends_on_variable(const scene *s);
  * not identically zero); the phase condition is then an integral constraint after the
  * scene's [integrals] and the periodic ones. */
 int scene_pins_shift(const scene *s);
+/** Translations of the periodic unknowns that leave F unchanged (PB-3), described with the
+ * [integrals] line that pins each into out (len bytes); returns how many. */
+int scene_translations(const scene *s, char *out, size_t len);
 /** Expression of the phase condition's K = sum_i y_i g_i'(x) and its value c (PB-2). */
 int scene_phase_condition(const scene *s, ex_id *K, double *c);
 int scene_F_depends_on_unknown(const scene *s, int i);

@@ -234,11 +234,35 @@ done:
   return rc;
 }
 
+/* A closed path whose Hessian is singular: name the symmetry (PB-3). */
+static void singular_closed_path(cli_report *r, size_t used) {
+  const scene *s = r->sc;
+  int periodic = 0;
+  for (int i = 0; i < s->n; i++) periodic |= s->bc[i].periodic;
+  if (!periodic) return;
+  char sym[600];
+  int nt = scene_translations(s, sym, sizeof sym);
+  snprintf(r->message + used, sizeof r->message - used,
+           ". On closed paths a continuous symmetry of the action leaves the Hessian singular "
+           "%s%s%s; a rotation of the unknowns (as in an N-body problem) would too: pin it "
+           "with an [integrals] line of the angular offset against the guess, "
+           "sum (y_k gx_k - x_k gy_k), 0 (docs/periodic.md)",
+           scene_pins_shift(s) ? "besides the shift, which calcvar pinned"
+                               : "(the shift along "
+                                 "the variable is "
+                                 "pinned only when every "
+                                 "unknown is periodic "
+                                 "and the guess moves)",
+           nt ? ": " : "", nt ? sym : "");
+}
+
 static void compose_message(cli_report *r, cv_solver *sv) {
   const char *detail = cv_solver_last_error(sv);
   if (r->st != CVAR_OK) {
-    snprintf(r->message, sizeof r->message, "%s",
-             detail && detail[0] ? detail : cv_strerror(r->st));
+    int k = snprintf(r->message, sizeof r->message, "%s",
+                     detail && detail[0] ? detail : cv_strerror(r->st));
+    if (r->st == CVAR_ESINGULAR && k > 0 && (size_t)k < sizeof r->message)
+      singular_closed_path(r, (size_t)k);
     return;
   }
   int k = snprintf(r->message, sizeof r->message, "Converged in %d iteration%s", r->iterations,

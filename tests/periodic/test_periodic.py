@@ -237,6 +237,18 @@ check("eight energy", drift <= 1e-9, drift)
 print("figure-eight: action %.12f, choreography %.1e, energy %.9f drift %.1e" %
       (r["action"], chor, energies[0], drift))
 
+# The figure-eight without its [integrals]: the translations of the plane leave the
+# Hessian singular; the message names both, with the lines that pin them (PB-3).
+text = open(scene).read()
+text = text[:text.index("\n[integrals]")]
+with tempfile.NamedTemporaryFile("w", suffix=".scene", delete=False) as f:
+    f.write(text)
+p = subprocess.run([calcvar, "solve", f.name], capture_output=True, text=True)
+os.unlink(f.name)
+check("free eight is singular", p.returncode == 1 and "singular" in p.stderr, p.stderr[:300])
+check("free eight names the translations", "t1 = x1 + x2 + x3, 0" in p.stderr and
+      "t2 = y1 + y2 + y3, 0" in p.stderr and "rotation" in p.stderr, p.stderr)
+
 # batch: the period per row (PB-1 and the phase condition per row, its constant from the
 # row's guess); each row's action equals a plain solve's of that period to 1e-12, and the
 # period 8 row is the libration above.
