@@ -7,14 +7,18 @@
 #include "cv_internal.h"
 
 /* OB-4: the end of a contact run whose outermost active node is xa, next to the free node
- * xo (gap go > 0), from the gap at the next free node xoo (goo): a path that leaves a smooth
- * obstacle tangentially has a gap ~ C (x - x0)^2, so sqrt(gap) is linear in x; its zero.
- * The active node itself may lie just outside the true contact (its gap, ~ C (xa - x0)^2,
- * is then below the solve's tolerance), so x0 is kept between xo and xin, the next active
- * node inwards (xa when there is none). Without a usable second free node: xa. */
-static double contact_end(double xa, double xin, double xo, double go, double xoo, double goo) {
+ * xo (gap go > 0), from the gap at the next free node xoo (goo). A path that leaves a smooth
+ * obstacle does so with its first derivative continuous (a first-order integrand: the gap
+ * grows like C (x - x0)^2) or, for a second-order integrand on C^1 elements, with its
+ * second derivative continuous too (like C |x - x0|^3): gap^(1/k), k = 2 or 3, is linear in
+ * x near x0, and x0 is its zero. The active node itself may lie just outside the true
+ * contact (its gap is then below the solve's accuracy), so x0 is kept between xo and xin,
+ * the next active node inwards (xa when there is none). Without a usable second free
+ * node: xa. */
+static double contact_end(double xa, double xin, double xo, double go, double xoo, double goo,
+                          double k) {
   if (!(go > 0) || !(goo > go) || !isfinite(xoo)) return xa;
-  double so = sqrt(go), soo = sqrt(goo);
+  double so = pow(go, 1.0 / k), soo = pow(goo, 1.0 / k);
   double x0 = xo - so * (xoo - xo) / (soo - so);
   double lo = xin < xo ? xin : xo, hi = xin < xo ? xo : xin;
   return x0 < lo ? lo : x0 > hi ? hi : x0;
@@ -24,7 +28,7 @@ static double contact_end(double xa, double xin, double xo, double go, double xo
 static cv_status node_gaps(const cv_solver *s, const cv_problem *p, int k, const double *x,
                            double *gap) {
   const cv_disc *d = &s->disc;
-  int n = d->n;
+  int n = d->herm ? d->n / 2 : d->n, step = d->herm ? 2 : 1; /* C^1: values, not slopes */
   double yb[CV_BATCH * 8], *y = n <= 8 ? yb : cv_malloc((size_t)n * CV_BATCH * sizeof *y);
   if (!y) return CVAR_ENOMEM;
   const cv_pconstraint *c = &p->pc[k];
@@ -32,7 +36,7 @@ static cv_status node_gaps(const cv_solver *s, const cv_problem *p, int k, const
   for (long j0 = 0; j0 < d->nodes && !st; j0 += CV_BATCH) {
     int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
     for (int t = 0; t < m; t++)
-      for (int i = 0; i < n; i++) y[i * m + t] = s->y[(j0 + t) * n + i];
+      for (int i = 0; i < n; i++) y[i * m + t] = s->y[(j0 + t) * d->n + step * i];
     if (c->G(m, x + j0, y, CVAR_NEED_F, gap + j0, NULL, NULL, c->user)) st = CVAR_ENONFINITE;
     for (int t = 0; t < m; t++) gap[j0 + t] *= c->sense;
   }
@@ -52,26 +56,33 @@ cv_status cv_solver_get_contact(const cv_solver *s, const cv_problem *p, int k, 
   if (!x) return CVAR_ENOMEM;
   cv_disc_fill_nodes(d, x);
   cv_status st = node_gaps(s, p, k, x, gap);
-  /* active: a nonzero multiplier (an inactive row ends with lambda = 0 exactly) */
+  /* active: a node with a multiplier that is nonzero (an inactive row ends with lambda = 0
+   * exactly) or that sits on the obstacle (a second-order problem's multiplier is a point
+   * load at each end of a contact arc and zero inside it) */
+  double gmax = 0.0, kexp = d->herm ? 3.0 : 2.0;
+  for (long j = 0; j < N; j++) gmax = cv_fmax(gmax, fabs(gap[j]));
+#define ACTIVE(j)                                                                                  \
+  (cv_disc_lidx(d, (j), k) >= 0 &&                                                                 \
+   (s->mult[(j)*d->nc + k] != 0.0 || fabs(gap[(j)]) <= 1e-12 * cv_fmax(gmax, 1.0)))
   for (long j = 0; j < N && !st;) {
-    double lj = s->mult[j * d->nc + k];
-    if (lj == 0.0 || cv_disc_lidx(d, j, k) < 0) {
+    if (!ACTIVE(j)) {
       j++;
       continue;
     }
     long j1 = j;
-    while (j1 + 1 < N && s->mult[(j1 + 1) * d->nc + k] != 0.0) j1++;
+    while (j1 + 1 < N && ACTIVE(j1 + 1)) j1++;
     double xs = x[j], xe = x[j1];
     if (j >= 1)
       xs = contact_end(x[j], x[j1 > j ? j + 1 : j], x[j - 1], gap[j - 1], j >= 2 ? x[j - 2] : NAN,
-                       j >= 2 ? gap[j - 2] : NAN);
+                       j >= 2 ? gap[j - 2] : NAN, kexp);
     if (j1 + 1 < N)
       xe = contact_end(x[j1], x[j1 > j ? j1 - 1 : j1], x[j1 + 1], gap[j1 + 1],
-                       j1 + 2 < N ? x[j1 + 2] : NAN, j1 + 2 < N ? gap[j1 + 2] : NAN);
+                       j1 + 2 < N ? x[j1 + 2] : NAN, j1 + 2 < N ? gap[j1 + 2] : NAN, kexp);
     if (*count < cap) iv[2 * *count] = xs, iv[2 * *count + 1] = xe;
     ++*count;
     j = j1 + 1;
   }
+#undef ACTIVE
   cv_free(x);
   return st;
 }

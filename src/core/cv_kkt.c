@@ -7,6 +7,14 @@
 
 #include "cv_internal.h"
 
+/* Pointwise constraints act on the values of the problem's unknowns at the nodes: with C^1
+ * elements (theory H-2) a node holds a value and a slope per unknown, and the constraint
+ * sees the values (the unknowns of the problem are half the disc's components). */
+static inline int cn_of(const cv_disc *d) { return d->herm ? d->n / 2 : d->n; }
+static inline long vdof(const cv_disc *d, long node, int i) {
+  return node * d->n + (d->herm ? 2 * i : i);
+}
+
 cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const int *colptr) {
   size_t n = (size_t)d->n, B = CV_BATCH;
   memset(k, 0, sizeof *k);
@@ -47,12 +55,12 @@ static inline long pos(const int *colptr, long r, long c) {
 static cv_status eval_constraint(cv_kkt *k, int kc, const double *Y, long j0, int m, unsigned need,
                                  double **G, double **Gy, double **Gyy) {
   const cv_disc *d = k->d;
-  int n = d->n;
+  int n = cn_of(d);
   double *x = k->cbuf, *y = x + CV_BATCH, *g = y + (size_t)n * CV_BATCH;
   double *gy = g + CV_BATCH, *gyy = gy + (size_t)n * CV_BATCH;
   for (int t = 0; t < m; t++) {
     x[t] = k->xn[j0 + t];
-    for (int i = 0; i < n; i++) y[i * m + t] = Y[(j0 + t) * n + i];
+    for (int i = 0; i < n; i++) y[i * m + t] = Y[vdof(d, j0 + t, i)];
   }
   const cv_pconstraint *c = &k->prob->pc[kc];
   int rc = c->G(m, x, y, need, g, (need & CVAR_NEED_GRAD) ? gy : NULL,
@@ -67,7 +75,7 @@ static cv_status eval_constraint(cv_kkt *k, int kc, const double *Y, long j0, in
 
 cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len) {
   const cv_disc *d = k->d;
-  int n = d->n;
+  int n = cn_of(d);
   for (int end = 0; end < 2; end++) {
     long node = end ? d->nodes - 1 : 0;
     if (cv_disc_lidx(d, node, 0) >= 0) continue; /* has multipliers: imposed by Newton */
@@ -77,7 +85,7 @@ cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len) {
           eval_constraint(k, kc, Y, node, 1, CVAR_NEED_F | CVAR_NEED_GRAD, &G, &Gy, &Gyy);
       /* Scale of G near the end values: |grad G| |y| (or 1), so the test is relative. */
       double sc = 0.0;
-      for (int i = 0; i < n && !st; i++) sc += fabs(Gy[i]) * fabs(Y[node * n + i]);
+      for (int i = 0; i < n && !st; i++) sc += fabs(Gy[i]) * fabs(Y[vdof(d, node, i)]);
       int sense = k->prob->pc[kc].sense;
       double viol = sense ? cv_fmax(0.0, -sense * (st ? NAN : G[0])) : fabs(st ? NAN : G[0]);
       if (st || !(viol <= 1e-9 * cv_fmax(1.0, sc))) {
@@ -105,8 +113,8 @@ static int decide(cv_kkt *k, const double *Ax, long node, int kc, int sense, dou
   double c = k->cw[at];
   if (isnan(c)) {
     double hd = 0.0, g2 = 0.0;
-    for (int i = 0; i < d->n && Ax; i++) {
-      int fi = cv_disc_fidx(d, node * d->n + i);
+    for (int i = 0; i < cn_of(d) && Ax; i++) {
+      int fi = cv_disc_fidx(d, vdof(d, node, i));
       double gi = gy[(size_t)i * m];
       if (fi < 0) continue;
       hd += fabs(Ax[k->colptr[fi + 1] - 1]) * gi * gi;
@@ -187,7 +195,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
   const cv_disc *d = k->d;
   const cv_problem *p = k->prob;
   const int *cp = k->colptr;
-  int n = d->n, nc = d->nc, nf = d->nfree;
+  int n = cn_of(d), nc = d->nc, nf = d->nfree; /* n: the constraints' unknowns */
   cv_status st;
   /* The assembly clears the node rows and columns as it goes; the integral multipliers'
    * rows and columns (the last ni, dense, C-3) are cleared here. */
@@ -250,7 +258,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
         double pen = sense && k->eps > 0 ? k->eps / (isnan(cw) ? 1.0 : cw) : 0.0;
         G[row] = mj * (g[t] - pen * lam);
         for (int i = 0; i < n; i++) {
-          int fi = cv_disc_fidx(d, node * n + i);
+          int fi = cv_disc_fidx(d, vdof(d, node, i));
           if (!isfinite(gy[i * m + t])) return CVAR_ENONFINITE;
           if (fi < 0) continue;
           G[fi] += mj * lam * gy[i * m + t];
@@ -258,7 +266,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
           if (!Ax) continue;
           Ax[pos(cp, fi, row)] = mj * gy[i * m + t];
           for (int i2 = i; i2 < n; i2++) { /* upper triangle: fi <= fi2 */
-            int fi2 = cv_disc_fidx(d, node * n + i2);
+            int fi2 = cv_disc_fidx(d, vdof(d, node, i2));
             double h2 = gyy[(i * n + i2) * m + t];
             if (!isfinite(h2)) return CVAR_ENONFINITE;
             if (fi2 >= 0) Ax[pos(cp, fi, fi2)] += mj * lam * h2;
@@ -284,7 +292,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
 cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M) {
   const cv_disc *d = k->d;
   const cv_problem *p = k->prob;
-  int n = d->n, nc = d->nc, nf = d->nfree;
+  int n = cn_of(d), nc = d->nc, nf = d->nfree;
   double S, *g = cv_calloc((size_t)(nf ? nf : 1), sizeof *g);
   if (!g) return CVAR_ENOMEM;
   cv_status st = cv_assemble(&k->as, p->F, p->user, Y, &S, g, k->colptr, NULL, 0.0, 0);
@@ -312,8 +320,8 @@ cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M) {
         if (row < 0) continue;
         double num = 0.0, den = 0.0, mj = d->mass[row], sc = 1.0;
         for (int i = 0; i < n; i++) {
-          int fi = cv_disc_fidx(d, node * n + i);
-          sc += fabs(gy[i * m + t] * Y[node * n + i]);
+          int fi = cv_disc_fidx(d, vdof(d, node, i));
+          sc += fabs(gy[i * m + t] * Y[vdof(d, node, i)]);
           if (fi < 0) continue;
           num += g[fi] * gy[i * m + t];
           den += gy[i * m + t] * gy[i * m + t];
@@ -328,7 +336,7 @@ cv_status cv_kkt_init_multipliers(cv_kkt *k, const double *Y, double *M) {
         if (sense && !(fabs(G[t]) <= on * sc && sense * lam <= 0)) lam = 0.0;
         M[node * nc + kc] = lam;
         for (int i = 0; i < n; i++) {
-          int fi = cv_disc_fidx(d, node * n + i);
+          int fi = cv_disc_fidx(d, vdof(d, node, i));
           if (fi >= 0) g[fi] += mj * lam * gy[i * m + t];
         }
       }
@@ -346,7 +354,7 @@ cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, dou
                                    const int *lrow, const int *var) {
   const cv_disc *d = k->d;
   const cv_problem *p = k->prob;
-  int n = d->n, nc = d->nc;
+  int n = cn_of(d), nc = d->nc;
   cv_status st = CVAR_OK;
   for (int r = 0; r < d->ni && !st; r++) {
     double I;
@@ -372,7 +380,7 @@ cv_status cv_kkt_constraint_values(cv_kkt *k, const double *Y, double *vals, dou
         if (!isfinite(g[t])) st = CVAR_ENONFINITE;
         vals[row] = g[t];
         for (int i = 0; i < n && jac; i++) {
-          int fi = cv_disc_fidx(d, node * n + i);
+          int fi = cv_disc_fidx(d, vdof(d, node, i));
           if (fi >= 0 && var[fi] >= 0) jac[(size_t)lrow[row] * ld + var[fi]] = gy[i * m + t];
         }
       }

@@ -13,12 +13,13 @@ static int guess_cb(int m, const double *x, double *y, void *user) {
 }
 
 /* An integrand object for e; with parameters as inputs they are set to their values. */
-static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *msg, size_t len) {
+static ex_integrand *compile_order(const scene *s, ex_id e, unsigned max_need, int order, char *msg,
+                                   size_t len) {
   int np = s->params_as_inputs ? s->nparams : 0;
   /* second order: y'' after the parameters and the width's slot (X-7), which F never reads
-   * when the parameters are numbers */
+   * when the parameters are numbers; a pointwise constraint is of order 1 on that layout */
   ex_integrand *g =
-      s->c1 ? ex_integrand_new_order(s->dag, s->n, s->nparams + 1, 2, e, max_need, msg, len)
+      s->c1 ? ex_integrand_new_order(s->dag, s->n, s->nparams + 1, order, e, max_need, msg, len)
             : ex_integrand_new_params(s->dag, s->n, np, e, max_need, msg, len);
   if (g && np) {
     double *v = cv_malloc((size_t)np * sizeof *v);
@@ -31,6 +32,10 @@ static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *m
     cv_free(v);
   }
   return g;
+}
+
+static ex_integrand *compile(const scene *s, ex_id e, unsigned max_need, char *msg, size_t len) {
+  return compile_order(s, e, max_need, 2, msg, len);
 }
 
 /* The smoothing hook of the core (theory HC-4): the width is the integrand's last input. */
@@ -105,14 +110,7 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
    * the derivatives the method needs. */
   for (int k = 0; k < s->ncons; k++) {
     const sc_item *it = &s->cons[k];
-    if (s->c1) { /* the node multipliers of C-1 are for C^0 elements */
-      sc_err(err, errlen, s->file, it->line,
-             "[constraints] %s: pointwise constraints are not available with y'' in the "
-             "scene (C1 elements); an integral constraint is",
-             it->name);
-      goto fail;
-    }
-    ex_integrand *g = compile(s, it->expr, max_need, msg, sizeof msg);
+    ex_integrand *g = compile_order(s, it->expr, max_need, 1, msg, sizeof msg);
     if (!g) {
       sc_err(err, errlen, s->file, it->line, "[constraints] %s: %s", it->name,
              msg[0] ? msg : "out of memory");

@@ -56,7 +56,8 @@ int scene_translations(const scene *s, char *out, size_t len) {
   ex_id outs[64];
   double *x = cv_malloc(SAMPLES * sizeof *x), *y = cv_malloc((size_t)n * SAMPLES * sizeof *y);
   double *dy = cv_malloc((size_t)n * SAMPLES * sizeof *dy);
-  double *g = cv_malloc((size_t)np * SAMPLES * sizeof *g), *R = cv_malloc((size_t)np * SAMPLES * sizeof *R);
+  double *g = cv_malloc((size_t)np * SAMPLES * sizeof *g),
+         *R = cv_malloc((size_t)np * SAMPLES * sizeof *R);
   double *V = cv_malloc((size_t)np * np * sizeof *V);
   if (!x || !y || !dy || !g || !R || !V) goto done;
   for (int k = 0; k < np; k++)

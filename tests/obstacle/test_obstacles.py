@@ -168,6 +168,33 @@ with tempfile.TemporaryDirectory() as tmp:
               abs(float(row["action"]) - L) <= 1e-9, (row, L))
 check("bump length formula", abs(bump_length(1.0) - L_BUMP) <= 1e-13, bump_length(1.0))
 
+# The Bryson-Denham problem: F = y''^2/2, y(0) = y(1) = 0, y'(0) = 1, y'(1) = -1, y <= l
+# (C1 elements with an obstacle). For l = 1/9 <= 1/6 the path is a cubic up to t = 3l, on
+# the obstacle to 1 - 3l, and the mirror cubic: action 4/(9l) = 4. With 1/3 and 2/3 element
+# ends (elements a multiple of 3) the element space holds the exact path: action to 1e-12.
+BD = """[scene]
+variable  = t
+interval  = 0, 1
+unknowns  = y
+integrand = y''^2/2
+[parameters]
+l = 1/9
+[boundary]
+y  = 0, 0
+y' = 1, -1
+[constraints]
+cap = y - l <= 0
+"""
+for E, deg in (("6", "3"), ("30", "3"), ("30", "5"), ("30", "7")):
+    p, _ = run(BD, "--elements", E, "--degree", deg, "--json", "-")
+    r = json.loads(p.stdout) if p.stdout else {}
+    check("Bryson-Denham %sx%s" % (E, deg), r.get("status") == "converged" and
+          abs(r["action"] - 4) <= 1e-12 and r["morse_index"] == 0, r.get("message"))
+    if r.get("status") == "converged":
+        (x0, x1), = r["contact"]["cap"]
+        check("Bryson-Denham contact %sx%s" % (E, deg),
+              abs(x0 - 1 / 3) <= 1e-9 and abs(x1 - 2 / 3) <= 1e-9, (x0, x1))
+
 # Bad input: FILE:LINE and exit 2.
 for G, what in (("y - (1 - x^2) >= 0 + 1", "0 on the right"), ("y - (1 - x^2) > 0", "strict"),
                 ("y - 3 >= 0", "violated at the fixed end")):
