@@ -236,6 +236,14 @@ if rc == 0:
     check("--all paths", len(sols) == 3 and kinds[0][0] == 0 and kinds[1][0] == 0 and
           kinds[2] == (1, 0.0) and abs(kinds[0][1] - kinds[1][1]) < 1e-9, kinds)
 
+# ---- an integral constraint on C1 elements: Euler's load as the multiplier of the shortening
+rc, j, err = solve_json("euler_load.scene", "--elements", "8", "--degree", "5")
+check("euler load exit", rc == 0, err)
+if rc == 0:
+    mu = j["multipliers"]["shortening"]
+    check("euler load multiplier %.12g" % mu, abs(mu + math.pi ** 2) < 1e-8, j)
+    check("euler load shape", j["error"]["max_nodal"] < 1e-8 and j["morse_index"] == 0, j)
+
 # ---- batch: rows of (q, EI) against the closed-form action and bending energy
 table = os.path.join(os.environ.get("TMPDIR", "/tmp"), "c1_rows_%d.csv" % os.getpid())
 with open(table, "w") as f:
