@@ -78,6 +78,13 @@ int sc_load_order2(sc_loader *L) {
     s->order2[i] = any;
     s->c1 |= any;
   }
+  if (s->c1 && s->degree != 1 && (s->degree % 2 == 0 || s->degree > 7)) {
+    sc_err(L->err, L->errlen, L->file, s->degree_line > 0 ? s->degree_line : 0,
+           "[mesh] degree %d: a scene with y'' is solved on C1 elements (values and slopes at "
+           "the nodes) of degree 3, 5 or 7",
+           s->degree);
+    return -1;
+  }
   for (int i = 0; s->sbc && i < s->n; i++)
     if (s->sbc[i].line && !s->order2[i]) {
       sc_err(L->err, L->errlen, L->file, s->sbc[i].line,
