@@ -191,5 +191,21 @@ for row in (list(csv.DictReader(io.StringIO(out))) if rc == 0 else []):
     check("batch row q=%g" % q_, abs(float(row["action"]) + U) < 1e-13 * U and
           abs(float(row["bending"]) - U) < 1e-13 * U, row)
 
+# ---- a slope line that depends on a parameter: batch rows and --continue reach the
+# ---- elastica of elastica.scene (t = 1) on the same mesh
+rc, j, err = solve_json("elastica.scene", "--elements", "8", "--degree", "5")
+A1 = j.get("action", math.nan)
+table = os.path.join(os.environ.get("TMPDIR", "/tmp"), "c1_family_%d.csv" % os.getpid())
+with open(table, "w") as f:
+    f.write("t\n0.5\n1\n")
+rc, out, err = run("batch", scene("elastica_family.scene"), table)
+os.unlink(table)
+rows = list(csv.DictReader(io.StringIO(out))) if rc == 0 else []
+check("family batch", rc == 0 and len(rows) == 2 and abs(float(rows[1]["action"]) - A1) < 1e-12
+      and float(rows[0]["action"]) < A1, (rc, err, rows, A1))
+rc, j, err = solve_json("elastica_family.scene", "--continue", "t=0.1:1")
+check("family --continue", rc == 0 and abs(j.get("action", math.nan) - A1) < 1e-12 and
+      j.get("morse_index") == 0, (rc, err, j.get("action"), A1))
+
 print("%d failure(s)" % failures)
 sys.exit(1 if failures else 0)
