@@ -41,7 +41,8 @@ static int carry_over(cv_solver *from, cv_solver *to, int n) {
   double *t = malloc((size_t)(E + 1) * sizeof *t);
   if (x && y && t && cv_solver_get_nodes(from, x) == CVAR_OK &&
       cv_solver_get_values(from, y) == CVAR_OK) {
-    for (int i = 0; i <= E; i++) t[i] = (x[(size_t)i * deg] - x[0]) / (x[nn - 1] - x[0]);
+    int per = E > 0 ? (nn - 1) / E : 1; /* nodes per element: deg, or (deg - 1)/2 for C1 */
+    for (int i = 0; i <= E; i++) t[i] = (x[(size_t)i * per] - x[0]) / (x[nn - 1] - x[0]);
     t[0] = 0.0;
     t[E] = 1.0;
     if (cv_solver_set_mesh(to, E, t) == CVAR_OK && cv_solver_set_degree(to, deg) == CVAR_OK &&

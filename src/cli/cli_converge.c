@@ -274,6 +274,13 @@ int cli_converge(int argc, char **argv) {
   }
   if (o.elements) s->elements = o.elements;
   if (c.ndeg == 0) c.deg[c.ndeg++] = s->degree;
+  for (int d = 0; d < c.ndeg && s->c1; d++) /* y'': C1 elements (docs/beams.md) */
+    if (c.deg[d] != 1 && (c.deg[d] % 2 == 0 || c.deg[d] > 7)) {
+      char dv[16];
+      snprintf(dv, sizeof dv, "%d", c.deg[d]);
+      rc = bad("--degree %s: a scene with y'' is solved on C1 elements of degree 3, 5 or 7", dv);
+      goto done;
+    }
   cli_apply_solver_options(&o, s);
   s->adapt = 0; /* converge studies fixed meshes: a scene's adapt or tol does not apply */
   s->tol = 0;

@@ -181,14 +181,37 @@ static void start_from_values(const cv_solver *s, const cv_disc *d, double *Y) {
   }
 }
 
-/* (H-6) The straight line between the end values (slope its gradient; a free end takes
- * the other end's value); a start or guess shifted onto fixed end values by the linear
- * blend of cv_start_values; fixed end slopes set. */
+/* The cubic Hermite basis on [0, 1] at t: values h[0..3] (value at 0, slope at 0, value at
+ * 1, slope at 1, slopes per unit t) and derivatives d[0..3]. */
+static void cubic(double t, double *h, double *d) {
+  double t2 = t * t, t3 = t2 * t;
+  h[0] = 1 - 3 * t2 + 2 * t3, h[1] = t - 2 * t2 + t3, h[2] = 3 * t2 - 2 * t3, h[3] = t3 - t2;
+  d[0] = -6 * t + 6 * t2, d[1] = 1 - 4 * t + 3 * t2, d[2] = 6 * t - 6 * t2, d[3] = 3 * t2 - 2 * t;
+}
+
+/* Add to unknown i of Y the cubic with values va, vb and slopes sa, sb at the ends. */
+static void add_cubic(const cv_disc *d, double *Y, int i, double va, double sa, double vb,
+                      double sb) {
+  int nc = d->n;
+  double L = d->b - d->a, h[4], dh[4];
+  if (va == 0.0 && sa == 0.0 && vb == 0.0 && sb == 0.0) return;
+  for (long j = 0; j < d->nodes; j++) {
+    double t = (cv_disc_node_x(d, j) - d->a) / L;
+    cubic(t, h, dh);
+    Y[j * nc + 2 * i] += va * h[0] + sa * L * h[1] + vb * h[2] + sb * L * h[3];
+    Y[j * nc + 2 * i + 1] += (va * dh[0] + sa * L * dh[1] + vb * dh[2] + sb * L * dh[3]) / L;
+  }
+}
+
+/* (H-9) Without a start or guess: the cubic through the end values and slopes (a free
+ * value takes the other end's, a free slope the chord's: with no slope fixed, the straight
+ * line of cv_start_values). A start or guess that misses fixed end values or slopes is
+ * moved onto them by adding the cubic with the misses at the ends (smooth, unlike an
+ * overwritten end node: a kink there is a poor Newton start, cv_start_values). */
 cv_status cv_hermite_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y,
                                   int line) {
   int n = p->n, nc = d->n;
   long last = d->nodes - 1;
-  double L = d->b - d->a;
   if (s->start && !line) {
     if (s->start_len == d->ndof)
       cv_dcopy(Y, s->start, (size_t)d->ndof);
@@ -205,28 +228,24 @@ cv_status cv_hermite_start_values(cv_solver *s, const cv_problem *p, const cv_di
     cv_status st = guess_nodes(s, p, d, Y);
     if (st) return st;
   } else {
+    cv_dzero(Y, (size_t)d->ndof);
     for (int i = 0; i < n; i++) {
       int fa = p->fixed[2 * i], fb = p->fixed[2 * i + 1];
-      double ya = p->endval[2 * i], yb = p->endval[2 * i + 1];
+      double ya = p->endval[2 * i], yb = p->endval[2 * i + 1], L = d->b - d->a;
       if (!fa) ya = fb ? yb : 0.0;
       if (!fb) yb = ya;
-      for (long j = 0; j <= last; j++) {
-        double t = (cv_disc_node_x(d, j) - d->a) / L;
-        Y[j * nc + 2 * i] = ya + (yb - ya) * t;
-        Y[j * nc + 2 * i + 1] = (yb - ya) / L;
-      }
+      double chord = (yb - ya) / L;
+      add_cubic(d, Y, i, ya, p->sfixed[2 * i] ? p->sendval[2 * i] : chord, yb,
+                p->sfixed[2 * i + 1] ? p->sendval[2 * i + 1] : chord);
     }
   }
   for (int i = 0; i < n; i++) {
-    double da = p->fixed[2 * i] ? p->endval[2 * i] - Y[2 * i] : 0.0;
-    double db = p->fixed[2 * i + 1] ? p->endval[2 * i + 1] - Y[last * nc + 2 * i] : 0.0;
-    if (da != 0.0 || db != 0.0)
-      for (long j = 0; j <= last; j++) {
-        double t = (cv_disc_node_x(d, j) - d->a) / L;
-        Y[j * nc + 2 * i] += da * (1.0 - t) + db * t;
-        Y[j * nc + 2 * i + 1] += (db - da) / L;
-      }
-    if (p->fixed[2 * i]) Y[2 * i] = p->endval[2 * i];
+    double va = p->fixed[2 * i] ? p->endval[2 * i] - Y[2 * i] : 0.0;
+    double vb = p->fixed[2 * i + 1] ? p->endval[2 * i + 1] - Y[last * nc + 2 * i] : 0.0;
+    double sa = p->sfixed[2 * i] ? p->sendval[2 * i] - Y[2 * i + 1] : 0.0;
+    double sb = p->sfixed[2 * i + 1] ? p->sendval[2 * i + 1] - Y[last * nc + 2 * i + 1] : 0.0;
+    add_cubic(d, Y, i, va, sa, vb, sb);
+    if (p->fixed[2 * i]) Y[2 * i] = p->endval[2 * i]; /* exactly */
     if (p->fixed[2 * i + 1]) Y[last * nc + 2 * i] = p->endval[2 * i + 1];
     if (p->sfixed[2 * i]) Y[2 * i + 1] = p->sendval[2 * i];
     if (p->sfixed[2 * i + 1]) Y[last * nc + 2 * i + 1] = p->sendval[2 * i + 1];

@@ -34,7 +34,7 @@ int cv_hermite_node_degree(int degree, char *msg, size_t len);
 cv_status cv_hermite_disc_init(cv_disc *d, int nq);
 /* Lumped weights of the slope unknowns (H-5), after the value weights are in place. */
 void cv_hermite_scale_mass(cv_disc *d);
-/* Starting values and slopes (cv_start_values for C^1 elements). */
+/* Starting values and slopes (cv_start_values for C^1 elements, theory H-9). */
 cv_status cv_hermite_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y,
                                   int line);
 /* y, y', y'' of every unknown (n = the problem's) on element e at reference s. */

@@ -76,16 +76,12 @@ static int decide(cv_solver *s, const double *eta, double thresh, int *r) {
 
 cv_status cv_hermite_adapt(cv_solver *s, const cv_problem *p) {
   cv_status st;
-  cv_solver *f = cv_solver_new(&st), *w = cv_solver_new(&st);
+  cv_solver *w = cv_solver_new(&st); /* the last enriched solve: the next round's start */
   cv_meshspec spec0 = s->mesh;
   int degree0 = s->degree, E = 0, r = 1, stalled = 0, warm = 0;
   double tol = s->adapt_tol, best = INFINITY, t0 = cv_now(), *t = NULL, *eta = NULL;
   long iters = 0;
-  if (!f || !w) {
-    cv_solver_free(f);
-    cv_solver_free(w);
-    return CVAR_ENOMEM;
-  }
+  if (!w) return CVAR_ENOMEM;
   /* the start: the caller's C1 degree (--adapt: it stays), else cubic (--tol raises it) */
   if (s->degree >= 3 && s->degree % 2 == 1 && s->degree <= 2 * CV_HERMITE_MAX_R + 1)
     r = (s->degree - 1) / 2;
@@ -178,7 +174,6 @@ cleanup:
   s->degree = degree0;
   cv_free(t);
   cv_free(eta);
-  cv_solver_free(f);
   cv_solver_free(w);
   return st;
 }

@@ -246,7 +246,7 @@ const char *cv_batch_output_name(const cv_batch *b, int k) {
 static int build_row_tape(cv_batch *b) {
   scene *s = b->s;
   int n = s->n, np = b->np, rc = -1;
-  int cap = np + 2 + 2 * n + s->nints + 1;
+  int cap = np + 2 + 4 * n + s->nints + 1;
   ex_id *def = cv_malloc(((size_t)np + 1) * sizeof *def);
   ex_id *outs = cv_malloc((size_t)cap * sizeof *outs);
   if (!def || !outs) goto done;
@@ -271,6 +271,9 @@ static int build_row_tape(cv_batch *b) {
       if (!s->bc[i].free_end[end]) t[nt++] = s->bc[i].expr[end];
   for (int q = 0; q < s->nints; q++) t[nt++] = s->ints[q].expr2;
   if (s->has_exact_action) t[nt++] = s->exact_action_expr;
+  for (int i = 0; s->sbc && i < n; i++) /* slopes of the slope lines, after the rest */
+    for (int end = 0; end < 2 && s->sbc[i].line; end++)
+      if (!s->sbc[i].free_end[end]) t[nt++] = s->sbc[i].expr[end];
   for (int q = 0; q < nt; q++)
     for (int from = 1 + 2 * n, sl; t[q] >= 0; from = sl + 1) {
       if ((sl = ex_first_slot(s->dag, t[q], from, 2 * n + np)) < 0) break;

@@ -60,6 +60,13 @@ int sc_batch_set_row(const cv_batch *b, scene *inst, double *pv, double *rv, dou
     }
   }
   if (inst->has_exact_action) inst->exact_action = rv[k++];
+  for (int i = 0; inst->sbc && i < n; i++) /* slopes (the row tape's last outputs) */
+    for (int end = 0; end < 2 && inst->sbc[i].line; end++)
+      if (!inst->sbc[i].free_end[end] && !isfinite(inst->sbc[i].value[end] = rv[k++])) {
+        snprintf(err, errlen, "%s:%d: [boundary] %s' at %s is not a finite number", inst->file,
+                 inst->sbc[i].line, inst->unknowns[i], end ? "b" : "a");
+        return -1;
+      }
   return 0;
 }
 

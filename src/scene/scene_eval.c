@@ -149,6 +149,16 @@ int scene_set_parameters(scene *s, const unsigned char *given, const double *val
         return -1;
       }
     }
+  for (int i = 0; s->sbc && i < s->n; i++) /* slope lines (second derivatives) */
+    for (int end = 0; end < 2 && s->sbc[i].line; end++) {
+      if (s->sbc[i].free_end[end]) continue;
+      if (sc_eval_params(s, s->sbc[i].expr[end], &s->sbc[i].value[end]) < 0) goto nomem;
+      if (!isfinite(s->sbc[i].value[end])) {
+        sc_err(err, errlen, s->file, s->sbc[i].line, "[boundary] %s' at %s is not a finite number",
+               s->unknowns[i], end ? "b" : "a");
+        return -1;
+      }
+    }
   for (int k = 0; k < s->nints; k++) {
     if (sc_eval_params(s, s->ints[k].expr2, &s->ints[k].value) < 0) goto nomem;
     if (!isfinite(s->ints[k].value)) {
@@ -175,12 +185,14 @@ scene *scene_instance_new(const scene *s) {
   c->params = cv_malloc(((size_t)s->nparams + 1) * sizeof *c->params);
   c->bc = cv_malloc(((size_t)s->n + 1) * sizeof *c->bc);
   c->ints = cv_malloc(((size_t)s->nints + 1) * sizeof *c->ints);
-  if (!c->params || !c->bc || !c->ints) {
+  c->sbc = s->sbc ? cv_malloc((size_t)s->n * sizeof *c->sbc) : NULL; /* its own slopes */
+  if (!c->params || !c->bc || !c->ints || (s->sbc && !c->sbc)) {
     scene_free(c);
     return NULL;
   }
   memcpy(c->params, s->params, (size_t)s->nparams * sizeof *c->params);
   memcpy(c->bc, s->bc, (size_t)s->n * sizeof *c->bc);
   memcpy(c->ints, s->ints, (size_t)s->nints * sizeof *c->ints);
+  if (s->sbc) memcpy(c->sbc, s->sbc, (size_t)s->n * sizeof *c->sbc);
   return c;
 }

@@ -30,6 +30,7 @@ void scene_free(scene *s) {
     cv_free(s->params);
     cv_free(s->bc);
     cv_free(s->ints);
+    cv_free(s->sbc);
     cv_free(s);
     return;
   }

@@ -15,7 +15,8 @@ int sc_uses_second(const scene *s, ex_id e, int *which) {
   return 0;
 }
 
-/* `y' = a, b`: each a constant expression or `free` (parameters as inputs: numbers only). */
+/* `y' = a, b`: each a constant expression or `free` (with the parameters as inputs, the
+ * expression is kept and evaluated again for each parameter set, as the values' are). */
 int sc_load_slope_line(sc_loader *L, const sc_entry *e, int k) {
   scene *s = L->s;
   if (!s->sbc && !(s->sbc = cv_calloc((size_t)s->n, sizeof *s->sbc))) {
@@ -50,12 +51,6 @@ int sc_load_slope_line(sc_loader *L, const sc_entry *e, int k) {
     }
     snprintf(what, sizeof what, "[boundary] %s at %s", e->key, end ? "b" : "a");
     rc = sc_parse_const_node(L, e, list.off[end], t, what, &b->value[end], &b->expr[end]);
-    if (rc == 0 && s->params_as_inputs &&
-        sc_first_slot(s, b->expr[end], 1 + 2 * s->n, 2 * s->n + s->nparams) >= 0) {
-      sc_err(L->err, L->errlen, L->file, e->line,
-             "%s: a slope may not depend on a parameter when the parameters vary (batch)", what);
-      rc = -1;
-    }
   }
   ex_list_free(&list);
   return rc;
@@ -77,6 +72,13 @@ int sc_load_order2(sc_loader *L) {
       any = ex_depends_on(s->dag, s->reports[k].expr, slot);
     s->order2[i] = any;
     s->c1 |= any;
+  }
+  if (s->c1 && s->degree != 1 && (s->degree % 2 == 0 || s->degree > 7)) {
+    sc_err(L->err, L->errlen, L->file, s->degree_line > 0 ? s->degree_line : 0,
+           "[mesh] degree %d: a scene with y'' is solved on C1 elements (values and slopes at "
+           "the nodes) of degree 3, 5 or 7",
+           s->degree);
+    return -1;
   }
   for (int i = 0; s->sbc && i < s->n; i++)
     if (s->sbc[i].line && !s->order2[i]) {

@@ -153,7 +153,7 @@ ex_id sc_parse(sc_loader *L, const sc_entry *e, int off, const char *text, const
   }
   /* y'' where a second-order integrand may have it (SCENES.md): the integrand, definitions,
    * integrals and reports, named by the callers' `what` */
-  L->second = strcmp(what, "integrand") == 0 || strncmp(what, "[definitions]", 13) == 0 ||
+  L->second = strcmp(what, "integrand") == 0 || strncmp(what, "definition '", 12) == 0 ||
               strncmp(what, "[integrals] ", 12) == 0 || strncmp(what, "[report]", 8) == 0;
   ex_id r = ex_parse(L->s->dag, text, resolve, L, 1, msg, sizeof msg);
   if (r >= 0) {

@@ -118,74 +118,10 @@ for name in ("foundation.scene", "mixed.scene"):
         check("%s degree %d order %.2f (expected %d)" % (name, deg, order, deg + 1),
               abs(order - (deg + 1)) < 0.5, errs)
 
-# ---- --tol on the clamped elastica, against shooting (pure Python, independent of
-# ---- calcvar): the first integral F_y' - d/dx F_y'' = C of y''^2 / (1 + y'^2)^(5/2) gives
-# ---- y''' = (5 p q^2 / w - C w^(5/2)) / 2, w = 1 + p^2; unknowns y''(0) and C
-
-
-def rhs(z, C):
-    y, p, q = z
-    w = 1 + p * p
-    return (p, q, 0.5 * (5 * p * q * q / w - C * w ** 2.5))
-
-
-def rk4(z, h, C):
-    k1 = rhs(z, C)
-    k2 = rhs([a + 0.5 * h * b for a, b in zip(z, k1)], C)
-    k3 = rhs([a + 0.5 * h * b for a, b in zip(z, k2)], C)
-    k4 = rhs([a + h * b for a, b in zip(z, k3)], C)
-    return [a + h / 6 * (b + 2 * c + 2 * d + e) for a, b, c, d, e in zip(z, k1, k2, k3, k4)]
-
-
-def shoot(q0, C, xs, hmax):
-    """y at the abscissae xs (increasing, from 0), and y, y' at 1."""
-    z, x, out = [0.0, 0.0, q0], 0.0, []
-    for xt in list(xs) + [1.0]:
-        m = max(1, int(math.ceil((xt - x) / hmax)))
-        h = (xt - x) / m
-        for _ in range(m):
-            z = rk4(z, h, C)
-        x = xt
-        out.append(z[0])
-    return out[:-1], z
-
-
-def residual(u, hmax):
-    try:
-        _, z = shoot(u[0], u[1], [], hmax)
-        return [z[0] - 0.5, z[1] - 2.0]
-    except OverflowError:  # a trial that blows up: rejected by the damping below
-        return [math.inf, math.inf]
-
-
-def reference(xs, hmax):
-    """Damped Newton on (y''(0), C), from a start that a coarse scan of the shots shows near
-    (the shot (1, 0) ends at y = 0.68, y' = 2.08)."""
-    u = [1.0, 0.0]
-    r = residual(u, hmax)
-    for _ in range(60):
-        J = []
-        for k in range(2):
-            v = list(u)
-            dv = 1e-7 * max(1.0, abs(v[k]))
-            v[k] += dv
-            rk = residual(v, hmax)
-            J.append([(rk[0] - r[0]) / dv, (rk[1] - r[1]) / dv])
-        det = J[0][0] * J[1][1] - J[1][0] * J[0][1]
-        du = [(r[0] * J[1][1] - r[1] * J[1][0]) / det, (r[1] * J[0][0] - r[0] * J[0][1]) / det]
-        lam = 1.0
-        while lam > 1e-6:
-            v = [u[0] - lam * du[0], u[1] - lam * du[1]]
-            rv = residual(v, hmax)
-            if max(map(abs, rv)) < max(map(abs, r)) or max(map(abs, r)) < 1e-15:
-                break
-            lam *= 0.5
-        u, r = v, rv
-        if max(abs(d) for d in du) < 1e-14 or max(map(abs, r)) < 1e-15:
-            break
-    y, _ = shoot(u[0], u[1], xs, hmax)
-    return y
-
+# ---- --tol on the clamped elastica, against shooting (elastica_ref.py: pure Python,
+# ---- independent of calcvar)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import elastica_ref  # noqa: E402
 
 for T in (1e-6, 1e-8, 1e-10):
     rc, out, err = run("solve", scene("elastica.scene"), "--tol", str(T), "--json",
@@ -195,9 +131,7 @@ for T in (1e-6, 1e-8, 1e-10):
         continue
     pts = [(float(a), float(b)) for a, b, _ in list(csv.reader(io.StringIO(out)))[1:]]
     xs = [x for x, _ in pts]
-    r1, r2 = reference(xs, 1.0 / 1500), reference(xs, 1.0 / 3000)
-    ref = [b + (b - a) / 15 for a, b in zip(r1, r2)]  # Richardson on RK4
-    ref_err = max(abs(a - b) for a, b in zip(ref, r2))
+    ref, ref_err = elastica_ref.reference(xs)
     check("elastica reference accuracy %.2g" % ref_err, ref_err < 1e-12)
     true = max(abs(y - r) for (_, y), r in zip(pts, ref))
     rc, j, _ = solve_json("elastica.scene", "--tol", str(T))
@@ -236,6 +170,14 @@ if rc == 0:
     check("--all paths", len(sols) == 3 and kinds[0][0] == 0 and kinds[1][0] == 0 and
           kinds[2] == (1, 0.0) and abs(kinds[0][1] - kinds[1][1]) < 1e-9, kinds)
 
+# ---- an integral constraint on C1 elements: Euler's load as the multiplier of the shortening
+rc, j, err = solve_json("euler_load.scene", "--elements", "8", "--degree", "5")
+check("euler load exit", rc == 0, err)
+if rc == 0:
+    mu = j["multipliers"]["shortening"]
+    check("euler load multiplier %.12g" % mu, abs(mu + math.pi ** 2) < 1e-8, j)
+    check("euler load shape", j["error"]["max_nodal"] < 1e-8 and j["morse_index"] == 0, j)
+
 # ---- batch: rows of (q, EI) against the closed-form action and bending energy
 table = os.path.join(os.environ.get("TMPDIR", "/tmp"), "c1_rows_%d.csv" % os.getpid())
 with open(table, "w") as f:
@@ -248,6 +190,22 @@ for row in (list(csv.DictReader(io.StringIO(out))) if rc == 0 else []):
     U = q_ * q_ * 1.5 ** 5 / (40 * EI_)
     check("batch row q=%g" % q_, abs(float(row["action"]) + U) < 1e-13 * U and
           abs(float(row["bending"]) - U) < 1e-13 * U, row)
+
+# ---- a slope line that depends on a parameter: batch rows and --continue reach the
+# ---- elastica of elastica.scene (t = 1) on the same mesh
+rc, j, err = solve_json("elastica.scene", "--elements", "8", "--degree", "5")
+A1 = j.get("action", math.nan)
+table = os.path.join(os.environ.get("TMPDIR", "/tmp"), "c1_family_%d.csv" % os.getpid())
+with open(table, "w") as f:
+    f.write("t\n0.5\n1\n")
+rc, out, err = run("batch", scene("elastica_family.scene"), table)
+os.unlink(table)
+rows = list(csv.DictReader(io.StringIO(out))) if rc == 0 else []
+check("family batch", rc == 0 and len(rows) == 2 and abs(float(rows[1]["action"]) - A1) < 1e-12
+      and float(rows[0]["action"]) < A1, (rc, err, rows, A1))
+rc, j, err = solve_json("elastica_family.scene", "--continue", "t=0.1:1")
+check("family --continue", rc == 0 and abs(j.get("action", math.nan) - A1) < 1e-12 and
+      j.get("morse_index") == 0, (rc, err, j.get("action"), A1))
 
 print("%d failure(s)" % failures)
 sys.exit(1 if failures else 0)
