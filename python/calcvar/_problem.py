@@ -29,7 +29,9 @@ def _setting(v, what):
     if isinstance(v, str):
         check_text(v, what)
         return v
-    return repr(number(v, what))
+    x = number(v, what)
+    # counts (elements, degree, max_iterations) are read as whole numbers: 4, not 4.0
+    return str(int(x)) if float(x).is_integer() and abs(x) < 2**53 else repr(x)
 
 
 class Problem:
@@ -85,7 +87,10 @@ class Problem:
                     raise bad("%s must be a dict" % title)
                 lines.append("[%s]" % title)
                 for k, v in items.items():
-                    lines.append("%s = %s" % (name(k, title), fmt(k, v, "[%s] %s" % (title, k))))
+                    # a slope line "y'" of a second-order unknown (docs/beams.md)
+                    slope = title == "boundary" and isinstance(k, str) and k.endswith("'")
+                    key = name(k[:-1], title) + "'" if slope else name(k, title)
+                    lines.append("%s = %s" % (key, fmt(k, v, "[%s] %s" % (title, k))))
 
         def ex(k, v, what):
             return expr(v, what)

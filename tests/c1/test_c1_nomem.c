@@ -77,8 +77,9 @@ static int step(int k, double tol) {
   if (!pb)
     truth(what, err[0] != '\0', "NULL problem without a message");
   else if (st != CVAR_OK)
-    truth(what, st == CVAR_ENOMEM || st == CVAR_EDEPENDENCY || st == CVAR_ECALLBACK ||
-                    st == CVAR_EMAXITER,
+    truth(what,
+          st == CVAR_ENOMEM || st == CVAR_EDEPENDENCY || st == CVAR_ECALLBACK ||
+              st == CVAR_EMAXITER,
           cv_status_name(st));
   else
     ok = rc == 0;
