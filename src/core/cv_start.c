@@ -29,17 +29,26 @@ static __attribute__((noinline)) cv_status guess_values(cv_solver *s, const cv_p
   for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
     int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
     for (int k = 0; k < m; k++) xb[k] = cv_disc_node_x(d, j0 + k);
-    int rc = p->guess(m, xb, yb, p->guess_user);
-    for (int k = 0; k < m && rc == 0; k++)
+    int rc = p->guess(m, xb, yb, p->guess_user), bad = -1, comp = 0;
+    for (int k = 0; k < m && rc == 0 && bad < 0; k++)
       for (int i = 0; i < n; i++) {
-        if (!isfinite(yb[i * m + k])) rc = 1;
+        if (!isfinite(yb[i * m + k]) && bad < 0) bad = k, comp = i;
         Y[(j0 + k) * n + i] = yb[i * m + k];
       }
-    if (rc) {
+    if (rc || bad >= 0) { /* the abscissa itself: the core knows no variable's name */
+      if (rc)
+        cv_set_msg(s->msg, sizeof s->msg,
+                   "the initial guess's callback failed (returned %d) on the nodes from %.17g "
+                   "to %.17g",
+                   rc, xb[0], xb[m - 1]);
+      else
+        cv_set_msg(
+            s->msg, sizeof s->msg,
+            "the initial guess of unknown number %d is %g at the node %.17g of the interval; "
+            "give a [guess] that is finite on the whole interval",
+            comp + 1, yb[comp * m + bad], xb[bad]);
       cv_free(yb);
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "the initial guess is not finite (or its callback failed) near x = %g", xb[0]);
-      return CVAR_ECALLBACK;
+      return rc ? CVAR_ECALLBACK : CVAR_ENONFINITE;
     }
   }
   cv_free(yb);
