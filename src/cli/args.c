@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli/cli.h"
 
@@ -187,9 +188,35 @@ int cli_args_parse(const char *cmd, int argc, char **argv, cli_opts *o) {
     return bad(cmd, "--max and --work belong to --all; give --all too");
   if (o->json && o->csv && strcmp(o->json, "-") == 0 && strcmp(o->csv, "-") == 0)
     return bad(cmd, "--json - and --csv - cannot both write to stdout");
-  if (o->json && o->csv && strcmp(o->json, o->csv) == 0 && strcmp(o->json, "-") != 0)
+  if (o->json && o->csv && strcmp(o->json, "-") != 0 && cli_same_output(o->json, o->csv))
     return bad(cmd, "--json and --csv name the same file '%s'", o->json);
   return 0;
+}
+
+/* The directory of path (the part before its last '/', or ".") into *st; 0 when it cannot
+ * be read. *base: the name after the last '/'. */
+static int dir_of(const char *path, struct stat *st, const char **base) {
+  const char *slash = strrchr(path, '/');
+  char dir[4096];
+  size_t ld = slash ? (size_t)(slash - path) : 0;
+  if (ld >= sizeof dir) return 0;
+  memcpy(dir, path, ld);
+  dir[ld] = '\0';
+  *base = slash ? slash + 1 : path;
+  return stat(slash ? (ld ? dir : "/") : ".", st) == 0;
+}
+
+int cli_same_output(const char *a, const char *b) {
+  struct stat sa, sb;
+  int ha = stat(a, &sa) == 0, hb = stat(b, &sb) == 0;
+  /* a device (/dev/null) or a pipe is written, not replaced: two outputs may share it */
+  if (ha && !S_ISREG(sa.st_mode) && !S_ISDIR(sa.st_mode)) return 0;
+  if (strcmp(a, b) == 0) return 1;
+  if (ha && hb) return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino; /* ./f and f */
+  struct stat da, db; /* not written yet: the same directory and name */
+  const char *na, *nb;
+  return dir_of(a, &da, &na) && dir_of(b, &db, &nb) && da.st_dev == db.st_dev &&
+         da.st_ino == db.st_ino && strcmp(na, nb) == 0;
 }
 
 /* For commands that only read a scene (equations, modes): reject solve-only options. */

@@ -156,6 +156,9 @@ typedef struct {
   double err, err_v, order, order_v;
   int no_est_at; /* where r.message says why there is no estimate (HP-3), or -1 */
 } cli_conv_row;
+/* Whether two output paths name one file that writing both would clobber: the same path or
+ * the same regular file under two names; a device such as /dev/null may take both. */
+int cli_same_output(const char *a, const char *b);
 int cli_converge_text(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_converge_json(FILE *f, const cli_conv_row *rows, int nrows);
 int cli_plot_converge(cli_outfile *o, const cli_conv_row *rows, int nrows);

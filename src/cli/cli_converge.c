@@ -263,7 +263,7 @@ int cli_converge(int argc, char **argv) {
     rc = bad("%s is an option of solve, not of converge", notmine);
     goto done;
   }
-  if (c.svg && o.json && strcmp(c.svg, o.json) == 0) {
+  if (c.svg && o.json && cli_same_output(c.svg, o.json)) {
     rc = bad("--json and --svg name the same file '%s'", c.svg);
     goto done;
   }

@@ -13,11 +13,13 @@
 #define RESCUE_MESHES 4
 #define RESCUE_GROWTH 4
 
-/* Failures of the search for a path (not of the input, memory or the caller's cancel),
- * with the iteration limit counted only when the caller did not choose it below 20. */
+/* Failures of the search for a path (not of the input, memory or the caller's cancel; not a
+ * non-finite or singular start, which no mesh changes), with the iteration limit counted
+ * only when the caller did not choose it below 20. */
 static int rescuable(const cv_solver *s, cv_status st) {
-  return st == CVAR_ESTALL || st == CVAR_EDIVERGED || st == CVAR_ENONFINITE ||
-         st == CVAR_ESINGULAR || (st == CVAR_EMAXITER && s->maxit >= 20);
+  return st == CVAR_ESTALL || st == CVAR_EDIVERGED ||
+         ((st == CVAR_ENONFINITE || st == CVAR_ESINGULAR) && s->iterations > 0) ||
+         (st == CVAR_EMAXITER && s->maxit >= 20);
 }
 
 /* s's last mesh as the rounds hold one: boundaries on [0, 1] and a degree per element. */

@@ -22,6 +22,7 @@
 #define DEFL_MAXIT    25   /* deflated Newton iterations per start */
 #define WORK_FLOOR    8    /* the first solve counts as at least this many iterations */
 #define EIG_DIRS      3    /* lowest Hessian eigen-directions per path (DF-4) */
+#define HARM_DIRS     3    /* harmonics sin(k pi t), k = 1..3, per unknown and path (DF-6) */
 #define MIN_TRIES     2    /* perturbations every path gets before the work limit may stop (DF-4) */
 #define EIG_STEPS     4    /* block inverse-iteration steps */
 #define MAX_BACKTRACK 12   /* deflated line search: a step cut below 2^-12 is no progress */
@@ -376,6 +377,30 @@ static int low_modes(defl *w, const double *Y, double *V) {
   return nv;
 }
 
+/* DF-6: after the nv soft modes in V, the harmonics sin(k pi t) (k = 1..HARM_DIRS) of each
+ * unknown alone, mass-normalised: directions that do not depend on the path's Hessian, so
+ * that a path whose soft modes all lead back to it is still left in several shapes. Returns
+ * the total count. */
+static int add_harmonics(const defl *w, double *V, int nv) {
+  const cv_disc *d = w->d;
+  int nf = w->nf;
+  for (int i = 0; i < d->n; i++)
+    for (int k = 1; k <= HARM_DIRS; k++) {
+      double *v = V + (size_t)nv * nf, nrm = 0.0;
+      for (int f = 0; f < nf; f++) {
+        int gi = w->gof[f];
+        double t = gi < 0 ? 0.0 : (cv_disc_node_x(d, gi / d->n) - d->a) / w->len;
+        v[f] = gi >= 0 && gi % d->n == i ? sin(k * CV_PI * t) : 0.0;
+        nrm += d->mass[f] * v[f] * v[f];
+      }
+      if (!(nrm > 0.0)) continue; /* that unknown has no free value */
+      nrm = sqrt(nrm);
+      for (int f = 0; f < nf; f++) v[f] /= nrm;
+      nv++;
+    }
+  return nv;
+}
+
 /* ---- the search ---- */
 
 /* Max nodal difference of the solver's current solution from A (values on the search mesh
@@ -727,7 +752,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
    * the EIG_DIRS softest Hessian directions of the paths found, by promise: the next start
    * is the least-tried path's next perturbation (a new path's first ones come at once),
    * ties to the lower Morse index; on each path all +-1/2 ones before the +-3/2 ones. */
-  static const double amp[] = {0.5, 1.5};
+  static const double amp[] = {0.0625, 0.25, 0.5, 1.5};
   int namp = 2 * (int)(sizeof amp / sizeof amp[0]);
   int phase = 0;
   for (;;) {
@@ -740,8 +765,13 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
     for (int j = 0; j < w.nknown; j++)
       if ((nmodes[j] < 0 || cursor[j] < namp * nmodes[j]) && cursor[j] < least) least = cursor[j];
     if (work - found_at >= budget && least >= MIN_TRIES) {
-      cv_set_msg(info->stop, sizeof info->stop, "the work limit was reached (%d Newton iterations)",
-                 work);
+      int planned = 0; /* DF-6: how much of the planned starts the search covered */
+      for (int j = 0; j < w.nknown; j++)
+        planned += namp * (nmodes[j] >= 0 ? nmodes[j] : EIG_DIRS + HARM_DIRS * ds.n);
+      cv_set_msg(info->stop, sizeof info->stop,
+                 "the work limit (%d Newton iterations) stopped it after %d of the %d starts "
+                 "planned around the paths found; a larger --work searches further",
+                 work, info->starts, planned + 1 + (p->guess || start0 ? 1 : 0));
       break;
     }
     /* the next start into Y */
@@ -770,17 +800,20 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
             (cursor[j] == cursor[k] && ps->v[j].morse < ps->v[k].morse))
           k = j;
       }
-      if (k < 0) {
+      if (k < 0) { /* DF-6: every planned start, which is not every start there is */
+        int dirs = 0;
+        for (int j = 0; j < w.nknown; j++) dirs += nmodes[j];
         cv_set_msg(info->stop, sizeof info->stop,
-                   "every start was tried (the guess, the straight line and %d perturbations "
-                   "of each path found)",
-                   EIG_DIRS * namp);
+                   "all %d planned starts were tried: the guess, and around the %d paths found "
+                   "%d directions (soft modes, harmonics) at %d amplitudes, 1/16 to 3/2 of the "
+                   "path's size, both signs",
+                   info->starts, w.nknown, dirs, namp / 2);
         break;
       }
       if (nmodes[k] < 0) {
-        V[k] = cv_malloc((size_t)EIG_DIRS * ds.nfree * sizeof **V);
+        V[k] = cv_malloc((size_t)(EIG_DIRS + HARM_DIRS * ds.n) * ds.nfree * sizeof **V);
         if (!V[k]) goto nomem;
-        nmodes[k] = low_modes(&w, w.known[k], V[k]);
+        nmodes[k] = add_harmonics(&w, V[k], low_modes(&w, w.known[k], V[k]));
         continue;
       }
       int c = cursor[k]++, grp = c / (2 * nmodes[k]), mode = c % (2 * nmodes[k]) / 2;

@@ -412,9 +412,11 @@ CV_HOT void cv_solver_drop_results(cv_solver *s);
 CV_HOT cv_status cv_start_setup(cv_solver *s, const cv_problem *p);
 CV_HOT cv_status cv_start_values(cv_solver *s, const cv_problem *p, const cv_disc *d, double *Y,
                                  int line);
-/* After a solve: is the integrand at end `end` (0 = a, 1 = b) nearly singular, so that
- * the end element's rule under-integrates it (theory Q-3)? *rel: the relative change of
- * the action under the singular-end rule there. */
+/* After a solve: does the end element at end `end` (0 = a, 1 = b) under-integrate the
+ * action (theory Q-3)? 0: no; CV_END_INTEGRAND: the integrand is nearly singular there;
+ * CV_END_PATH: the integrand is smooth but the path bends on a scale below the element
+ * (Q-3a). *rel: the relative change of the action under the singular-end rule there. */
+enum { CV_END_INTEGRAND = 1, CV_END_PATH = 2 };
 CV_HOT int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
                                    double action, double *rel);
 /* The paths found by cv_solve_all (cv_deflation.c); NULL is a no-op. */

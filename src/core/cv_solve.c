@@ -478,13 +478,17 @@ static __attribute__((noinline, cold)) cv_status resolve_singular_ends(cv_solver
   st = solve_once(s, p);
   char first[sizeof s->note];
   memcpy(first, s->note, sizeof first);
+  /* Q-3a: the integrand itself, or only the path, varies below the end element */
+  int integrand = un[0] == CV_END_INTEGRAND || un[1] == CV_END_INTEGRAND;
   cv_set_msg(s->note, sizeof s->note,
-             "the integrand is nearly singular at %s (the singular-end rule changed the "
-             "action by %.1e of itself there), so it is integrated as singular; %s",
+             "%s %s (the singular-end rule changed the action by %.1e of itself there), so "
+             "%s integrated as singular; %s",
+             integrand ? "the integrand is nearly singular at"
+                       : "the path bends on a scale below the end element at",
              un[0] && un[1] ? "both ends"
              : un[0]        ? "the start"
                             : "the end",
-             fmax(rel[0], rel[1]), first);
+             fmax(rel[0], rel[1]), un[0] && un[1] ? "they are" : "it is", first);
   s->near_sing[0] = s->near_sing[1] = 0;
   return st;
 }

@@ -30,17 +30,26 @@ static __attribute__((noinline)) cv_status guess_values(cv_solver *s, const cv_p
   for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
     int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
     for (int k = 0; k < m; k++) xb[k] = cv_disc_node_x(d, j0 + k);
-    int rc = p->guess(m, xb, yb, p->guess_user);
-    for (int k = 0; k < m && rc == 0; k++)
+    int rc = p->guess(m, xb, yb, p->guess_user), bad = -1, comp = 0;
+    for (int k = 0; k < m && rc == 0 && bad < 0; k++)
       for (int i = 0; i < n; i++) {
-        if (!isfinite(yb[i * m + k])) rc = 1;
+        if (!isfinite(yb[i * m + k]) && bad < 0) bad = k, comp = i;
         Y[(j0 + k) * n + i] = yb[i * m + k];
       }
-    if (rc) {
+    if (rc || bad >= 0) { /* the abscissa itself: the core knows no variable's name */
+      if (rc)
+        cv_set_msg(s->msg, sizeof s->msg,
+                   "the initial guess's callback failed (returned %d) on the nodes from %.17g "
+                   "to %.17g",
+                   rc, xb[0], xb[m - 1]);
+      else
+        cv_set_msg(
+            s->msg, sizeof s->msg,
+            "the initial guess of unknown number %d is %g at the node %.17g of the interval; "
+            "give a [guess] that is finite on the whole interval",
+            comp + 1, yb[comp * m + bad], xb[bad]);
       cv_free(yb);
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "the initial guess is not finite (or its callback failed) near x = %g", xb[0]);
-      return CVAR_ECALLBACK;
+      return rc ? CVAR_ECALLBACK : CVAR_ENONFINITE;
     }
   }
   cv_free(yb);
@@ -162,13 +171,13 @@ cv_status cv_start_setup(cv_solver *s, const cv_problem *p) {
 }
 
 /* The discrete integral of F over element e with rule r (reference points, weights and
- * basis tables). buf: q (2 n + 2) doubles. Returns 0 when F fails or is not finite. */
-CV_HOT static int element_integral(const cv_problem *p, const cv_disc *d, const double *Y, long e,
+ * basis tables), from the element's nodal values Ye. buf: q (2 n + 2) doubles. Returns 0
+ * when F fails or is not finite. */
+CV_HOT static int element_integral(const cv_problem *p, const cv_disc *d, const double *Ye, long e,
                                    const cv_rule *r, double *buf, double *S) {
   int n = p->n, P1 = cv_disc_edeg(d, e) + 1, q = r->q;
   double x0 = d->xe[e], h = d->xe[e + 1] - x0, *x = buf, *y = x + q, *dy = y + (size_t)n * q;
   double *F = dy + (size_t)n * q;
-  const double *Ye = Y + (size_t)cv_disc_enode(d, e) * n;
   for (int k = 0; k < q; k++) {
     x[k] = x0 + 0.5 * (r->tau[k] + 1.0) * h;
     for (int i = 0; i < n; i++) {
@@ -189,16 +198,13 @@ CV_HOT static int element_integral(const cv_problem *p, const cv_disc *d, const 
   return rc == 0 && isfinite(sum);
 }
 
-/* |integral under the element's own rule - under the singular-end rule at the end| over
- * element e (Q-2: x = c +- u^2, qs Gauss points in u); INFINITY if F fails. *own: the
- * element's integral under its own rule. */
-/* The gap of element e between its own rule and r1 (see rule_gap). */
-CV_HOT static double gap_with(const cv_problem *p, const cv_disc *d, const double *Y, long e,
+/* The gap of element e (nodal values Ye) between its own rule and r1 (see rule_gap). */
+CV_HOT static double gap_with(const cv_problem *p, const cv_disc *d, const double *Ye, long e,
                               const cv_rule *r1, double *buf, double *own) {
   double S0, S1;
   cv_rule r0 = cv_disc_rule(d, e);
   int ok =
-      element_integral(p, d, Y, e, &r0, buf, &S0) && element_integral(p, d, Y, e, r1, buf, &S1);
+      element_integral(p, d, Ye, e, &r0, buf, &S0) && element_integral(p, d, Ye, e, r1, buf, &S1);
   *own = ok ? fabs(S0) : 0.0;
   return ok ? fabs(S1 - S0) : INFINITY;
 }
@@ -206,7 +212,7 @@ CV_HOT static double gap_with(const cv_problem *p, const cv_disc *d, const doubl
 /* The singular-end rule on an element not touching the end, built here (rarely needed:
  * out of line with its tables, so that the frames of a plain solve stay small). */
 static __attribute__((noinline, cold)) double gap_inner(const cv_problem *p, const cv_disc *d,
-                                                        const double *Y, long e, int end,
+                                                        const double *Ye, long e, int end,
                                                         double *buf, double *own) {
   const cv_refelem *re = cv_disc_eref(d, e); /* the element's own degree (HP-1) */
   int qs = re->qs, P1 = re->p + 1;
@@ -222,7 +228,7 @@ static __attribute__((noinline, cold)) double gap_inner(const cv_problem *p, con
     cv_lagrange(re->p, re->xi, tau[k], B + k * P1, D + k * P1);
   }
   cv_rule r1 = {qs, tau, om, B, D};
-  return gap_with(p, d, Y, e, &r1, buf, own);
+  return gap_with(p, d, Ye, e, &r1, buf, own);
 }
 
 /* |integral under the element's own rule - under the singular-end rule at the end| over
@@ -230,26 +236,104 @@ static __attribute__((noinline, cold)) double gap_inner(const cv_problem *p, con
  * element's integral under its own rule. */
 CV_HOT static double rule_gap(const cv_problem *p, const cv_disc *d, const double *Y, long e,
                               int end, double *buf, double *own) {
-  if (e != (end ? d->E - 1 : 0)) return gap_inner(p, d, Y, e, end, buf, own);
+  const double *Ye = Y + (size_t)cv_disc_enode(d, e) * d->n;
+  if (e != (end ? d->E - 1 : 0)) return gap_inner(p, d, Ye, e, end, buf, own);
   const cv_refelem *re = cv_disc_eref(d, e);
   cv_rule r1 = cv_end_rule(re->p, re->qs, end); /* the element touching the end: constants */
-  return gap_with(p, d, Y, e, &r1, buf, own);
+  return gap_with(p, d, Ye, e, &r1, buf, own);
+}
+
+/* Q-3: how many elements next to the end element a smooth integrand's gaps are compared
+ * with (on coarse elements the gaps of a smooth F differ between neighbours by orders of
+ * magnitude, as its quadrature errors cancel or not: the Caldirola-Kanai oscillator on 4
+ * elements of degree 2 had 1.2e-5 at one end element, 7.6e-10 at its neighbour and 1.2e-5
+ * at the other end's) */
+#define Q3_NEIGHBOURS 16
+
+/* The largest gap of the up to Q3_NEIGHBOURS elements next to the end element, short of the
+ * other end's element (out of line: only when the end element's gap is large). */
+static __attribute__((noinline, cold)) double neighbours_gap(const cv_problem *p, const cv_disc *d,
+                                                             const double *Y, int end,
+                                                             double *buf) {
+  double m = 0.0, own;
+  for (long k = 1; k <= Q3_NEIGHBOURS && k < d->E - 1; k++) { /* not the other end's */
+    double g = rule_gap(p, d, Y, end ? d->E - 1 - k : k, end, buf, &own);
+    if (isfinite(g) && g > m) m = g;
+  }
+  return m;
+}
+
+/* Q-3a: relative gap on the end piece [c, c + frac h] of element e (values Ye) between the
+ * element's Gauss rule laid on the piece and the singular-end substitution x = c +- u^2
+ * laid on it; INFINITY when F fails. */
+static double piece_gap(const cv_problem *p, const cv_disc *d, const double *Ye, long e, int end,
+                        double frac, double *buf) {
+  const cv_refelem *re = cv_disc_eref(d, e);
+  int P1 = re->p + 1, q = re->q, qs = re->qs;
+  double t[CV_MAX_QUAD], w[CV_MAX_QUAD], tau[CV_MAX_QUAD], om[CV_MAX_QUAD], S[2];
+  double B[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)], D[CV_MAX_QUAD * (CV_MAX_DEGREE + 1)];
+  double sf = sqrt(frac), sgn = end ? -1.0 : 1.0, c = end ? 1.0 : -1.0;
+  for (int k = 0; k < 2; k++) {
+    int m = k ? qs : q;
+    cv_gauss_legendre(m, t, w);
+    for (int j = 0; j < m; j++) {
+      if (k) { /* tau = c +- 2 v^2, v in [0, sqrt(frac)] */
+        double v = 0.5 * sf * (t[j] + 1.0);
+        tau[j] = c + sgn * 2.0 * v * v, om[j] = 2.0 * v * sf * w[j];
+      } else { /* Gauss on [c, c +- 2 frac] */
+        tau[j] = c + sgn * frac * (t[j] + 1.0), om[j] = frac * w[j];
+      }
+      cv_lagrange(re->p, re->xi, tau[j], B + j * P1, D + j * P1);
+    }
+    cv_rule r = {m, tau, om, B, D};
+    if (!element_integral(p, d, Ye, e, &r, buf, &S[k])) return INFINITY;
+  }
+  return fabs(S[1] - S[0]) / (fabs(S[0]) > DBL_MIN ? fabs(S[0]) : DBL_MIN);
+}
+
+/* Q-3a: is it the integrand that varies below the end element, or only the path? Along the
+ * straight path between the end element's end values (the integrand alone, without the
+ * path's bending), the relative gap of the whole element and of its end sixteenth: an
+ * integrand nearly singular at the end (on a scale far below the element) keeps much of its
+ * gap on the piece (measured: 1e-4 to 5e-3 of it on the brachistochrone's far ends), a
+ * smooth one loses the q-point rule's 16^(2q). CV_END_INTEGRAND when the straight path has
+ * at least a tenth of the path's gap and keeps more than 16^(-q) of it on the piece; else
+ * CV_END_PATH (out of line: only for an unresolved end). Yl: (p + 1) n values. */
+static __attribute__((noinline, cold)) int end_kind(const cv_problem *p, const cv_disc *d,
+                                                    const double *Y, int end, double rel,
+                                                    double *buf, double *Yl) {
+  long e = end ? d->E - 1 : 0;
+  int n = d->n, pe = cv_disc_edeg(d, e);
+  const double *Ye = Y + (size_t)cv_disc_enode(d, e) * n, *xi = cv_disc_eref(d, e)->xi;
+  for (int l = 0; l <= pe; l++)
+    for (int i = 0; i < n; i++) {
+      double t = 0.5 * (xi[l] + 1.0);
+      Yl[l * n + i] = (1.0 - t) * Ye[i] + t * Ye[pe * n + i];
+    }
+  double whole = piece_gap(p, d, Yl, e, end, 1.0, buf);
+  double tip = piece_gap(p, d, Yl, e, end, 1.0 / 16.0, buf);
+  double keeps = pow(16.0, -cv_disc_eref(d, e)->q); /* half-way, in orders, to 16^(-2q) */
+  return !(whole < 0.1 * rel) && !(tip < keeps * whole) ? CV_END_INTEGRAND : CV_END_PATH;
 }
 
 /* A nearly singular end (theory Q-3): F finite at the end value but varying on a scale
  * far below the end element (the brachistochrone to (10, 0.01): 1/sqrt(y) with y coming
  * up to 0.01 at slope -18). The element's rule then under-integrates it and the minimiser
  * exploits that. The end element's integral under its own rule is compared with the
- * singular-end rule (Q-2) at that end, and so is its neighbour's: the end is unresolved
+ * singular-end rule (Q-2) at that end, and so are its neighbours': the end is unresolved
  * when the end element's gap exceeds 1e-8 of the action (or of the element's own integral,
- * for an action near zero) and 100 times its neighbour's
- * (a smooth F on coarse elements has gaps of one size everywhere), or F cannot be
- * evaluated at the finer points. *rel: the end element's gap relative to the action. */
+ * for an action near zero) and 100 times the largest of the Q3_NEIGHBOURS next elements'
+ * (a smooth F on coarse elements has gaps of one size near the end), or F cannot be
+ * evaluated at the finer points. Returns 0 (resolved), CV_END_INTEGRAND (the integrand
+ * varies on that scale along the straight path between the element's end values too:
+ * Q-3a) or CV_END_PATH (only the path does: it bends on a scale below the element, as a
+ * ray leaving nearly vertically; the integrand is smooth). *rel: the end element's gap
+ * relative to the action. */
 CV_HOT int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const double *Y, int end,
                                    double action, double *rel) {
   *rel = 0.0;
   if ((end ? d->sing_b : d->sing_a) || d->herm) return 0; /* C^1: Gauss rules only */
-  long e = end ? d->E - 1 : 0, e1 = end ? d->E - 2 : 1;
+  long e = end ? d->E - 1 : 0;
   int q = d->ref.qs > d->ref.q ? d->ref.qs : d->ref.q;
   /* The points of one element: on the stack for one or a few unknowns (the check of every
    * solve runs after Newton, whose deeper frames have touched these stack pages; a heap
@@ -258,13 +342,20 @@ CV_HOT int cv_start_end_unresolved(const cv_problem *p, const cv_disc *d, const 
   double local[4 * CV_MAX_QUAD], *buf = len <= sizeof local / sizeof *local ? local : NULL;
   if (!buf) buf = cv_malloc(len * sizeof *buf);
   if (!buf) return 0;
-  double own, own1;
+  double own;
   double gap = rule_gap(p, d, Y, e, end, buf, &own), next = 0.0;
   /* no libm call on the path of every solve (each first call binds a symbol) */
   double scale = fabs(action) > own ? fabs(action) : own;
   *rel = gap / (scale > DBL_MIN ? scale : DBL_MIN);
-  /* the neighbour only when the end element's gap is large (rarely: a solve's cost) */
-  if (!(*rel <= 1e-8) && d->E > 1 && isfinite(gap)) next = rule_gap(p, d, Y, e1, end, buf, &own1);
+  int kind = 0;
+  /* the neighbours only when the end element's gap is large (rarely: a few solves' cost) */
+  if (!(*rel <= 1e-8) && d->E > 1 && isfinite(gap)) next = neighbours_gap(p, d, Y, end, buf);
+  if (!(*rel <= 1e-8) && !(gap <= 100.0 * next)) {
+    kind = CV_END_INTEGRAND; /* F fails at the finer points: the integrand's */
+    double *Yl = isfinite(gap) ? cv_malloc((size_t)(CV_MAX_DEGREE + 1) * d->n * sizeof *Yl) : NULL;
+    if (Yl) kind = end_kind(p, d, Y, end, gap / (own > DBL_MIN ? own : DBL_MIN), buf, Yl);
+    cv_free(Yl);
+  }
   if (buf != local) cv_free(buf);
-  return !(*rel <= 1e-8) && !(gap <= 100.0 * next);
+  return kind;
 }
