@@ -679,7 +679,10 @@ typedef struct {
   double action;          /**< the discrete action */
   int morse_index;        /**< -1 when unknown (a method other than Newton) */
   double error_max_nodal; /**< against [exact]; NaN without it */
-  double error_estimate;  /**< of an adaptive solve; NaN otherwise */
+  double error_estimate;  /**< as `calcvar solve` reports it: the rounds' estimate of a
+                               --tol or --adapt solve, else, without [exact], the enriched
+                               solve's (theory HP-2); NaN with [exact] and no --tol, or when
+                               there is no bound (the message says why, HP-3) */
   double *outputs;        /**< see above */
   int warm;               /**< 1: started from the previous row's solution */
   char message[400];      /**< the report's sentence */

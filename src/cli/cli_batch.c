@@ -37,7 +37,7 @@ static void usage(FILE *f) {
         "  --set name=value, --adapt TOL, --tol T, --time-limit S, --max-nodes N\n"
         "                       as for calcvar solve, for every row\n"
         "Output: the input columns, status, action, iterations, time_s, morse_index,\n"
-        "error_max_nodal (with [exact]), error_estimate (with --adapt, always with --tol),\n"
+        "error_max_nodal (with [exact]), error_estimate (without [exact], always with --tol),\n"
         "one column per [report] entry and integral multiplier (mu_NAME), message.\n"
         "exit status: 0 every row converged, 1 some did not, 2 bad input\n",
         f);
@@ -636,8 +636,9 @@ int cli_batch_run(const cli_opts *o, const char *table_path, const char *out_pat
   cli_batch_cols cols = {nc, 0, 0, cv_batch_num_outputs(b)};
   const scene *sc = scene_batch_scene(b);
   for (int i = 0; i < sc->n; i++) cols.err_nodal |= sc->exact[i] >= 0;
-  /* the estimate where it applies: --adapt without [exact], and --tol always (its target) */
-  cols.err_est = (!cols.err_nodal && sc->adapt > 0) || sc->tol > 0;
+  /* the figure `solve` reports for the row: the estimate without [exact], and with --tol
+   * always (its target) */
+  cols.err_est = !cols.err_nodal || sc->tol > 0;
   if (f) {
     for (int c = 0; c < nc; c++) fprintf(f, "%s,", t.names[c]);
     fprintf(f, "status,action,iterations,time_s,morse_index");

@@ -214,6 +214,21 @@ static double nodal_error(worker *w) {
   return e;
 }
 
+/* A row solved without --tol, --adapt or [exact] gets the estimate `solve` reports (theory
+ * HP-2: one enriched solve from the row's solution), or, when that gives no bound (HP-3),
+ * none and the reason in why. */
+static void plain_estimate(worker *w, const cv_problem *p, cv_batch_result *r, char *why,
+                           size_t len) {
+  double ev;
+  if (cv_solver_estimate_error(w->sv, p, &r->error_estimate, &ev, why, len) != CVAR_OK ||
+      !isfinite(r->error_estimate)) {
+    r->error_estimate = NAN;
+    if (!why[0]) snprintf(why, len, "the error estimate is not finite");
+  } else {
+    why[0] = '\0';
+  }
+}
+
 /* The start of a warm row (theory (B-2)): the previous solution, shifted by the line that
  * moves its fixed end values onto this row's (node by node on the same layout). */
 static int warm_start(worker *w) {
@@ -326,7 +341,7 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
   r->action = r->error_max_nodal = r->error_estimate = NAN;
   r->morse_index = -1;
   for (int k = 0; outputs && k < b->nout; k++) outputs[k] = NAN;
-  char err[400];
+  char err[400], why[400] = "";
   cv_problem *p = NULL;
   const char *note = NULL;
   if (sc_batch_set_row(b, w->inst, w->pv, w->rv, w->rw, vals, err, sizeof err) < 0) {
@@ -393,6 +408,8 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
     if (b->any_exact) r->error_max_nodal = nodal_error(w);
     if (w->inst->adapt > 0 || w->inst->tol > 0)
       r->error_estimate = cv_solver_get_error_estimate(w->sv);
+    else if (!b->any_exact)
+      plain_estimate(w, p, r, why, sizeof why);
     if (outputs) {
       if (b->rep && eval_reports(b, w, outputs) < 0)
         for (int k = 0; k < w->inst->nreports; k++) outputs[k] = NAN;
@@ -403,6 +420,12 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
     if (b->warm) keep_for_warm(w, row);
   }
   compose_message(r, w->sv, morse, nfree, degenerate, note);
+  if (why[0]) { /* as `solve` says it (HP-3) */
+    size_t k = strlen(r->message);
+    put(r->message, sizeof r->message, &k, " no error estimate: ");
+    put(r->message, sizeof r->message, &k, why);
+    put(r->message, sizeof r->message, &k, ".");
+  }
 done:
   cv_problem_free(p);
   r->time_s = sc_batch_now() - t0;
