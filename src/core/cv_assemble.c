@@ -280,9 +280,11 @@ static inline void k_row(double *restrict Ka, const double *restrict vy, const d
   for (int b = a; b < nl; b++) Ka[b] += bl * vy[b] + dl * vp[b];
 }
 
-static __attribute__((noinline)) CV_VECTORIZE double
-batch_general(cv_assembler *as, const cv_rule *r, int e0, int ne, int p, double *g,
-              const int *colptr, double *Ax, double hscale, double *bad) {
+static __attribute__((noinline)) CV_VECTORIZE double batch_general(cv_assembler *as,
+                                                                   const cv_rule *r, int e0, int ne,
+                                                                   int p, double *g,
+                                                                   const int *colptr, double *Ax,
+                                                                   double hscale, double *bad) {
   const cv_disc *d = as->disc;
   int n = d->n, P1 = p + 1, nl = P1 * n, q = r->q, m = ne * q;
   double Ssum = 0.0, chk = 0.0, *K = as->K;
