@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/cv_reuse.h"
 #include "scene/scene_batch_internal.h"
 
 /* Parameter values of a row into inst (every parameter: given ones from the row, the
@@ -249,6 +250,32 @@ static int warm_start(worker *w) {
   return st == CVAR_OK ? 0 : -1;
 }
 
+/* --tol (theory HP-9): keep the mesh this row hands to the next one on this worker (its
+ * own final mesh, or a coarser one when it is finer than tol needs) and, for --warm, the
+ * solution at that mesh's nodes. Without them the next row starts as `solve` does. */
+static void keep_mesh(const cv_batch *b, worker *w, int row) {
+  int E = 0, *deg = NULL, coarsened = 0;
+  double *t = NULL, *y = NULL;
+  cv_free(w->hp_t);
+  cv_free(w->hp_deg);
+  w->hp_t = NULL, w->hp_deg = NULL, w->hp_E = 0;
+  w->prev_row = -2;
+  if (cv_reuse_mesh(w->sv, &E, &t, &deg, b->warm ? &y : NULL, &coarsened) != CVAR_OK) return;
+  w->hp_E = E, w->hp_t = t, w->hp_deg = deg;
+  if (!y) return;
+  const scene *s = w->inst;
+  int len = 1;
+  for (int e = 0; e < E; e++) len += deg[e];
+  cv_free(w->prev);
+  w->prev = y;
+  w->prev_len = len * s->n;
+  for (int i = 0; i < s->n; i++) {
+    w->prev_end[i] = s->bc[i].value[0];
+    w->prev_end[s->n + i] = s->bc[i].value[1];
+  }
+  w->prev_row = row;
+}
+
 static void keep_for_warm(worker *w, int row) {
   const scene *s = w->inst;
   int len = cv_solver_get_num_nodes(w->sv) * s->n;
@@ -360,23 +387,39 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
     snprintf(r->message, sizeof r->message, "%s", err);
     goto done;
   }
-  int warm = b->warm && w->inst->adapt <= 0 && w->inst->tol <= 0 && w->prev_row == row - 1 &&
+  int tol = w->inst->tol > 0, reuse = tol && w->hp_E > 0;
+  if (reuse && cv_solver_set_mesh_hp(w->sv, w->hp_E, w->hp_t, w->hp_deg) != CVAR_OK) {
+    reuse = 0; /* the scene's own start mesh, as configured */
+    if (scene_solver_configure(w->inst, w->sv, err, sizeof err) != CVAR_OK) {
+      r->status = CVAR_EINVAL;
+      snprintf(r->message, sizeof r->message, "%s", err);
+      goto done;
+    }
+  }
+  /* a warm start follows the previous row on this worker; under --tol on the mesh that row
+   * handed on (HP-9), whose nodes its values are at */
+  int warm = b->warm && w->inst->adapt <= 0 && (!tol || reuse) && w->prev_row == row - 1 &&
              w->prev_len > 0;
   cv_solver_set_start(w->sv, 0, NULL);
   if (warm && warm_start(w) < 0) warm = 0;
   cv_status st = cv_solve(w->sv, p);
-  if (warm && st != CVAR_OK) {
-    /* the neighbour's solution led astray: the scene's own start, as `solve` would */
-    char why[64];
-    snprintf(why, sizeof why, "%s", cv_status_name(st));
+  if ((warm || reuse) && st != CVAR_OK) {
+    /* the neighbour's solution or mesh led astray: the scene's own start, as `solve` would */
+    char failed[64];
+    snprintf(failed, sizeof failed, "%s", cv_status_name(st));
     cv_solver_set_start(w->sv, 0, NULL);
+    if (reuse && scene_solver_configure(w->inst, w->sv, err, sizeof err) != CVAR_OK) {
+      r->status = CVAR_EINVAL;
+      snprintf(r->message, sizeof r->message, "%s", err);
+      goto done;
+    }
     st = cv_solve(w->sv, p);
-    warm = 0;
-    static _Thread_local char nb[160];
+    static _Thread_local char nb[200];
     snprintf(nb, sizeof nb,
-             "(The warm start from row %d failed (%s); solved from the "
-             "scene's guess.)",
-             row, why);
+             "(Started from the previous row's %s, the solve failed (%s); "
+             "solved from the scene's %s.)",
+             warm ? "solution" : "mesh", failed, reuse ? "mesh and guess" : "guess");
+    warm = 0, reuse = 0;
     note = nb;
   }
   r->warm = warm;
@@ -417,7 +460,10 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
         if (cv_solver_get_multiplier(w->sv, k, &outputs[w->inst->nreports + k]) != CVAR_OK)
           outputs[w->inst->nreports + k] = NAN;
     }
-    if (b->warm) keep_for_warm(w, row);
+    if (tol)
+      keep_mesh(b, w, row);
+    else if (b->warm)
+      keep_for_warm(w, row);
   }
   compose_message(r, w->sv, morse, nfree, degenerate, note);
   if (why[0]) { /* as `solve` says it (HP-3) */
