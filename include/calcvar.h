@@ -716,7 +716,10 @@ CVAR_API cv_status cv_batch_set_mesh(cv_batch *b, int elements, int degree);
  * scene invalid (e.g. an interval with a >= b). */
 CVAR_API cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err, size_t errlen);
 /** Solve nrows rows (row r is rows[r*ncols .. r*ncols+ncols-1]); res[r] receives row r
- * whatever order the threads took them in. CVAR_OK when the rows were all attempted (each
+ * whatever order the threads took them in. Under the scene's [mesh] tol each row starts
+ * its rounds from the mesh the previous converged row on its thread handed on (its final
+ * mesh, or a coarser one when that is finer than tol needs; theory HP-9), verified by the
+ * estimate; with warm starts on, also from that row's path. CVAR_OK when the rows were all attempted (each
  * has its own status), else an error for the whole call (e.g. CVAR_ENOMEM). */
 CVAR_API cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_result *res);
 /**@}*/

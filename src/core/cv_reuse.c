@@ -126,4 +126,3 @@ cv_status cv_reuse_mesh(const cv_solver *s, int *E, double **t, int **deg, doubl
   }
   return st;
 }
-
