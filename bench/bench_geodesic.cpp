@@ -30,6 +30,9 @@
 #ifndef CV_DATA
 #define CV_DATA "bench/data"
 #endif
+#ifndef CV_EXAMPLES
+#define CV_EXAMPLES "examples/scenes"
+#endif
 
 static double now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -162,7 +165,7 @@ int main(int argc, char **argv) {
   double us_gs = t_gs > 0 ? 1e6 * t_gs / N : NAN;
   std::printf("  GeodSolve -i (text in, text out)  %8.2f us/line\n", us_gs);
 
-  std::string scene = std::string(CV_DATA) + "/wgs84_geodesic.scene";
+  std::string scene = std::string(CV_EXAMPLES) + "/wgs84_geodesic_adapted.scene";
   // The way before the batch: one process per pair (200 pairs suffice to time it).
   {
     long M = N < 200 ? N : 200;

@@ -799,7 +799,10 @@ typedef struct {
   double action;          /**< the discrete action */
   int morse_index;        /**< -1 when unknown (a method other than Newton) */
   double error_max_nodal; /**< against [exact]; NaN without it */
-  double error_estimate;  /**< of an adaptive solve; NaN otherwise */
+  double error_estimate;  /**< as `calcvar solve` reports it: the rounds' estimate of a
+                               --tol or --adapt solve, else, without [exact], the enriched
+                               solve's (theory HP-2); NaN with [exact] and no --tol, or when
+                               there is no bound (the message says why, HP-3) */
   double *outputs;        /**< see above */
   int warm;               /**< 1: started from the previous row's solution */
   char message[400];      /**< the report's sentence */
@@ -833,7 +836,10 @@ CVAR_API cv_status cv_batch_set_mesh(cv_batch *b, int elements, int degree);
  * scene invalid (e.g. an interval with a >= b). */
 CVAR_API cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err, size_t errlen);
 /** Solve nrows rows (row r is rows[r*ncols .. r*ncols+ncols-1]); res[r] receives row r
- * whatever order the threads took them in. CVAR_OK when the rows were all attempted (each
+ * whatever order the threads took them in. Under the scene's [mesh] tol each row starts
+ * its rounds from the mesh the previous converged row on its thread handed on (its final
+ * mesh, or a coarser one when that is finer than tol needs; theory HP-9), verified by the
+ * estimate; with warm starts on, also from that row's path. CVAR_OK when the rows were all attempted (each
  * has its own status), else an error for the whole call (e.g. CVAR_ENOMEM). */
 CVAR_API cv_status cv_batch_solve(cv_batch *b, int nrows, const double *rows, cv_batch_result *res);
 /**@}*/

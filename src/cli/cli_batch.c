@@ -39,7 +39,7 @@ static void usage(FILE *f) {
         "  --set name=value, --adapt TOL, --tol T, --time-limit S, --max-nodes N\n"
         "                       as for calcvar solve, for every row\n"
         "Output: the input columns, status, action, iterations, time_s, morse_index,\n"
-        "error_max_nodal (with [exact]), error_estimate (with --adapt, always with --tol),\n"
+        "error_max_nodal (with [exact]), error_estimate (without [exact], always with --tol),\n"
         "one column per [report] entry and integral multiplier (mu_NAME), message.\n"
         "exit status: 0 every row converged, 1 some did not, 2 bad input, 3 the output\n"
         "could not be written\n",
@@ -789,8 +789,9 @@ static int batch_output(batch_run *r, const char *table_path) {
   cli_batch_cols cols = {r->t.ncols, 0, 0, cv_batch_num_outputs(r->b)};
   const scene *sc = scene_batch_scene(r->b);
   for (int i = 0; i < sc->n; i++) cols.err_nodal |= sc->exact[i] >= 0;
-  /* the estimate where it applies: --adapt without [exact], and --tol always (its target) */
-  cols.err_est = (!cols.err_nodal && sc->adapt > 0) || sc->tol > 0;
+  /* the figure `solve` reports for the row: the estimate without [exact], and with --tol
+   * always (its target) */
+  cols.err_est = !cols.err_nodal || sc->tol > 0;
   r->cols = cols;
   FILE *f = r->f;
   if (f) {

@@ -28,12 +28,19 @@ struct cv_ldlt {
   double *ax, *u; /* A, and U = L^T with D(j) in place of U(j,j), column by column */
   long minor;     /* first zero pivot, n if none */
   long mono;      /* columns 0 .. mono - 1 have nondecreasing first rows */
+  int tri;        /* every column has at most 2 entries: a tridiagonal matrix */
 };
 
 /* Up to this many unknowns the skyline factor is used (tests may lower it to 0 to
  * compare with CHOLMOD). Above it CHOLMOD: its analysis is paid once per mesh and its
  * numeric factor is as fast (docs/performance.md). */
 int cv_ldlt_skyline_max = 512;
+/* Above that, the skyline factor is still used when the envelope is narrow — at most this
+ * many entries per column (degree 1 with one or two unknowns, degree 2 with one; theory
+ * N-7): its factor is then the Thomas algorithm's work, while CHOLMOD's analysis and
+ * factor allocation were a third of a degree-1 solve of 10^6 elements
+ * (docs/performance.md). Tests set it to 0 to compare with CHOLMOD. */
+int cv_ldlt_skyline_band = 4;
 
 /* Below this many unknowns the analysis takes under ~3 ms and a thread is not worth it. */
 #define ASYNC_ANALYSIS_MIN 50000
@@ -74,7 +81,8 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
     return CVAR_EINVAL;
   }
   cv_ldlt *L;
-  if (nfree <= cv_ldlt_skyline_max) {
+  if (nfree <= cv_ldlt_skyline_max ||
+      (d->ni == 0 && nnz <= (long)cv_ldlt_skyline_band * (nfree > 0 ? nfree : 1))) {
     /* One zeroed block: the object, A, U and the column pointers, with the exact count of
      * entries (one more pass over the columns): one allocation instead of four, and fewer
      * heap bytes for the first solve in a process to touch (docs/performance.md). */
@@ -90,6 +98,8 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
     nnz = cv_disc_pattern(d, L->colp, gof);
     L->minor = nfree;
     L->mono = nfree;
+    L->tri = 1;
+    for (int c = 0; c < nfree && L->tri; c++) L->tri = L->colp[c + 1] - L->colp[c] <= 2;
     for (int c = 1, f0 = 0; c < nfree; c++) {
       int f = c + 1 - (L->colp[c + 1] - L->colp[c]);
       if (f < f0) {
@@ -181,6 +191,53 @@ int cv_ldlt_matches(const cv_ldlt *L, const cv_disc *d, const int *gof) {
  * A zero pivot is treated as CHOLMOD treats it (N-5): the first sets minor, from there on
  * every pivot is 0 and no column with a zero pivot contributes, so inertia, pivot test and
  * solves see the same factor as with CHOLMOD. */
+/* The same rule on a tridiagonal envelope (degree 1, one unknown): column j holds
+ * A(j-1, j) and A(j, j), so g = A(j-1, j), u = g / d_{j-1}, d_j = A(j, j) - u g — the
+ * Thomas algorithm's elimination, in the same operations as the general loop below. */
+typedef struct {
+  int neg;
+  long bad;
+  double lo, hi;
+} pivot_stats;
+
+/* The pivot statistics of cv_ldlt_factor for pivot d of the diagonal entry a (theory N-5). */
+static inline void pivot_count(pivot_stats *ps, long j, double dj, double a_jj) {
+  double ajj = fabs(a_jj);
+  if (dj < 0) ps->neg++;
+  if ((!isfinite(dj) || !isfinite(ajj)) && ps->bad < 0) ps->bad = j;
+  double a = fabs(dj), rel = ajj > 0 ? a / ajj : (a > 0 ? 1.0 : 0.0);
+  if (!(rel >= ps->lo)) ps->lo = rel; /* a NaN pivot makes lo NaN */
+  if (a > ps->hi) ps->hi = a;
+}
+
+/* ... with the pivot statistics taken in the same pass (one pass over the factor's memory
+ * instead of two: at 10^6 unknowns each pass streams 36 MB). */
+static void skyline_factor_tri(cv_ldlt *L, pivot_stats *ps) {
+  const int *cp = L->colp;
+  const double *ax = L->ax;
+  double *u = L->u;
+  long n = L->n, minor = n;
+  double dprev = 0.0;
+  for (long j = 0; j < n; j++) {
+    int pj = cp[j], len = cp[j + 1] - pj;
+    double dj = ax[pj + len - 1];
+    if (len == 2) {
+      double g = ax[pj];
+      double uij = dprev == 0.0 ? 0.0 : g / dprev; /* a zero pivot contributes nothing */
+      u[pj] = uij;
+      dj -= dprev == 0.0 ? 0.0 : uij * g;
+    }
+    if (j >= minor)
+      dj = 0.0;
+    else if (dj == 0.0)
+      minor = j;
+    u[pj + len - 1] = dj;
+    dprev = dj;
+    pivot_count(ps, j, dj, ax[pj + len - 1]);
+  }
+  L->minor = minor;
+}
+
 static void skyline_factor(cv_ldlt *L) {
   const int *cp = L->colp;
   const double *ax = L->ax;
@@ -236,34 +293,31 @@ static cv_status factor_cholmod(cv_ldlt *L, char *msg, size_t len) {
 }
 
 cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg, size_t len) {
-  if (L->sky) {
-    skyline_factor(L);
+  pivot_stats ps = {0, -1, INFINITY, 0.0};
+  if (L->sky && L->tri) {
+    skyline_factor_tri(L, &ps);
   } else {
-    cv_status st = factor_cholmod(L, msg, len);
-    if (st) return st;
+    if (L->sky) {
+      skyline_factor(L);
+    } else {
+      cv_status st = factor_cholmod(L, msg, len);
+      if (st) return st;
+    }
+    const int *cp = cv_ldlt_colptr(L);
+    const int *Lp = L->sky ? NULL : L->L->p;
+    const double *Ax = cv_ldlt_values(L), *Lx = L->sky ? L->u : L->L->x;
+    /* Simplicial LDL^T: D(j) is the first entry of column j of L (CHOLMOD), the last of
+     * column j of U (skyline). The pivot is compared with the diagonal entry A(j,j) (the
+     * last entry of column j of the upper triangle): |D(j)| / |A(j,j)| is dimensionless
+     * and independent of the mesh width, so a small value marks a (nearly) degenerate
+     * direction, not merely a small element (theory N-5). */
+    for (long j = 0; j < L->n; j++)
+      pivot_count(&ps, j, L->sky ? Lx[cp[j + 1] - 1] : Lx[Lp[j]], Ax[cp[j + 1] - 1]);
   }
-  int nneg = 0;
-  long bad = -1;
-  double lo = INFINITY, hi = 0.0;
-  const int *cp = cv_ldlt_colptr(L);
-  const int *Lp = L->sky ? NULL : L->L->p;
-  const double *Ax = cv_ldlt_values(L), *Lx = L->sky ? L->u : L->L->x;
-  /* Simplicial LDL^T: D(j) is the first entry of column j of L (CHOLMOD), the last of
-   * column j of U (skyline). The pivot is compared with the diagonal entry A(j,j) (the last
-   * entry of column j of the upper triangle): |D(j)| / |A(j,j)| is dimensionless and
-   * independent of the mesh width, so a small value marks a (nearly) degenerate direction,
-   * not merely a small element (theory N-5). */
-  for (long j = 0; j < L->n; j++) {
-    double dj = L->sky ? Lx[cp[j + 1] - 1] : Lx[Lp[j]], ajj = fabs(Ax[cp[j + 1] - 1]);
-    if (dj < 0) nneg++;
-    if (!isfinite(dj) || !isfinite(ajj)) bad = bad < 0 ? j : bad;
-    double a = fabs(dj), rel = ajj > 0 ? a / ajj : (a > 0 ? 1.0 : 0.0);
-    if (!(rel >= lo)) lo = rel; /* a NaN pivot makes lo NaN */
-    if (a > hi) hi = a;
-  }
-  *neg = nneg;
-  *dmin = L->n ? lo : 1.0;
-  *dmax = hi;
+  long bad = ps.bad;
+  *neg = ps.neg;
+  *dmin = L->n ? ps.lo : 1.0;
+  *dmax = ps.hi;
   /* The assembly checks each element's entries; only a sum of finite ones that overflows
    * arrives here (cv_assemble). */
   if (bad >= 0) {

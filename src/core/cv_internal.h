@@ -211,9 +211,10 @@ CV_HOT void cv_ldlt_free(cv_ldlt *L);
 /* 1 when L (with its gof) is the matrix of disc's pattern: a new solve on the same mesh,
  * degrees, unknowns and constraints keeps the factor and its analysis. */
 int cv_ldlt_matches(const cv_ldlt *L, const cv_disc *d, const int *gof);
-/* Systems of up to this many unknowns use the skyline LDL^T (theory N-7), larger ones
- * CHOLMOD; tests set it to compare the two. */
-extern int cv_ldlt_skyline_max;
+/* Systems of up to cv_ldlt_skyline_max unknowns, and larger ones without integral
+ * multipliers whose envelope has at most cv_ldlt_skyline_band entries per column, use the
+ * skyline LDL^T (theory N-7), the others CHOLMOD; tests set both to compare the two. */
+extern int cv_ldlt_skyline_max, cv_ldlt_skyline_band;
 const int *cv_ldlt_colptr(const cv_ldlt *L); /* nfree + 1 column pointers */
 double *cv_ldlt_values(cv_ldlt *L);          /* Ax, length colptr[nfree] */
 /* Factor numerically (analysis happens on the first call). Returns CVAR_OK, or

@@ -47,6 +47,8 @@ static void worker_free(cv_batch *b, worker *w) {
   cv_free(w->qv);
   cv_free(w->prev);
   cv_free(w->prev_end);
+  cv_free(w->hp_t);
+  cv_free(w->hp_deg);
   cv_free(w->rv);
   cv_free(w->rw);
   cv_free(w->gv);
@@ -421,11 +423,11 @@ cv_status scene_batch_for_each(cv_batch *b, int n, int block, scene_batch_item_f
 int scene_batch_block(const cv_batch *b, int n) {
   int T = b->nthreads < n ? b->nthreads : n;
   if (T < 1) T = 1;
-  /* Warm starts follow the previous row on the same thread: blocks of consecutive rows,
-   * about 8 per thread (the threads still finish together). Without them, small blocks:
-   * the last ones even out the threads' ends (a claim is one atomic add, a row tens of
-   * microseconds). */
-  int per = b->warm ? 8 * T : 64 * T;
+  /* Warm starts and --tol's handed-on meshes (theory HP-9) follow the previous row on the
+   * same thread: blocks of consecutive rows, about 8 per thread (the threads still finish
+   * together). Without them, small blocks: the last ones even out the threads' ends (a
+   * claim is one atomic add, a row tens of microseconds). */
+  int per = b->warm || b->s->tol > 0 ? 8 * T : 64 * T;
   return n / per > 0 ? n / per : 1;
 }
 

@@ -24,8 +24,12 @@ typedef struct {
   double *prev; /* warm start: last converged nodal values */
   int prev_len, prev_row;
   double *prev_end; /* its end values [2n] */
-  double *rv, *rw;  /* row tape outputs and work */
-  double *gv, *gw;  /* guess tape outputs (one batch each) and work */
+  /* --tol: the mesh the last converged row handed on (theory HP-9), on [0, 1] */
+  int hp_E;
+  double *hp_t;
+  int *hp_deg;
+  double *rv, *rw; /* row tape outputs and work */
+  double *gv, *gw; /* guess tape outputs (one batch each) and work */
 } worker;
 
 struct cv_batch {

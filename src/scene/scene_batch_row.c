@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/cv_reuse.h"
 #include "scene/scene_batch_internal.h"
 
 /* Parameter values of a row into inst (every parameter: given ones from the row, the
@@ -247,6 +248,21 @@ static double nodal_error(worker *w) {
   return e;
 }
 
+/* A row solved without --tol, --adapt or [exact] gets the estimate `solve` reports (theory
+ * HP-2: one enriched solve from the row's solution), or, when that gives no bound (HP-3),
+ * none and the reason in why. */
+static void plain_estimate(worker *w, const cv_problem *p, cv_batch_result *r, char *why,
+                           size_t len) {
+  double ev;
+  if (cv_solver_estimate_error(w->sv, p, &r->error_estimate, &ev, why, len) != CVAR_OK ||
+      !isfinite(r->error_estimate)) {
+    r->error_estimate = NAN;
+    if (!why[0]) snprintf(why, len, "the error estimate is not finite");
+  } else {
+    why[0] = '\0';
+  }
+}
+
 /* The start of a warm row (theory (B-2)): the previous solution, shifted by the line that
  * moves its fixed end values onto this row's (node by node on the same layout). */
 static int warm_start(worker *w) {
@@ -265,6 +281,32 @@ static int warm_start(worker *w) {
   cv_status st = cv_solver_set_start(w->sv, w->prev_len, y);
   cv_free(y);
   return st == CVAR_OK ? 0 : -1;
+}
+
+/* --tol (theory HP-9): keep the mesh this row hands to the next one on this worker (its
+ * own final mesh, or a coarser one when it is finer than tol needs) and, for --warm, the
+ * solution at that mesh's nodes. Without them the next row starts as `solve` does. */
+static void keep_mesh(const cv_batch *b, worker *w, int row) {
+  int E = 0, *deg = NULL, coarsened = 0;
+  double *t = NULL, *y = NULL;
+  cv_free(w->hp_t);
+  cv_free(w->hp_deg);
+  w->hp_t = NULL, w->hp_deg = NULL, w->hp_E = 0;
+  w->prev_row = -2;
+  if (cv_reuse_mesh(w->sv, &E, &t, &deg, b->warm ? &y : NULL, &coarsened) != CVAR_OK) return;
+  w->hp_E = E, w->hp_t = t, w->hp_deg = deg;
+  if (!y) return;
+  const scene *s = w->inst;
+  int len = 1;
+  for (int e = 0; e < E; e++) len += deg[e];
+  cv_free(w->prev);
+  w->prev = y;
+  w->prev_len = len * s->n;
+  for (int i = 0; i < s->n; i++) {
+    w->prev_end[i] = s->bc[i].value[0];
+    w->prev_end[s->n + i] = s->bc[i].value[1];
+  }
+  w->prev_row = row;
 }
 
 static void keep_for_warm(worker *w, int row) {
@@ -359,7 +401,7 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
   r->action = r->error_max_nodal = r->error_estimate = NAN;
   r->morse_index = -1;
   for (int k = 0; outputs && k < b->nout; k++) outputs[k] = NAN;
-  char err[400];
+  char err[400], why[400] = "";
   cv_problem *p = NULL;
   const char *note = NULL;
   if (sc_batch_set_row(b, w->inst, w->pv, w->rv, w->rw, vals, err, sizeof err) < 0) {
@@ -378,23 +420,39 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
     snprintf(r->message, sizeof r->message, "%s", err);
     goto done;
   }
-  int warm = b->warm && w->inst->adapt <= 0 && w->inst->tol <= 0 && w->prev_row == row - 1 &&
+  int tol = w->inst->tol > 0, reuse = tol && w->hp_E > 0;
+  if (reuse && cv_solver_set_mesh_hp(w->sv, w->hp_E, w->hp_t, w->hp_deg) != CVAR_OK) {
+    reuse = 0; /* the scene's own start mesh, as configured */
+    if (scene_solver_configure(w->inst, w->sv, err, sizeof err) != CVAR_OK) {
+      r->status = CVAR_EINVAL;
+      snprintf(r->message, sizeof r->message, "%s", err);
+      goto done;
+    }
+  }
+  /* a warm start follows the previous row on this worker; under --tol on the mesh that row
+   * handed on (HP-9), whose nodes its values are at */
+  int warm = b->warm && w->inst->adapt <= 0 && (!tol || reuse) && w->prev_row == row - 1 &&
              w->prev_len > 0;
   cv_solver_set_start(w->sv, 0, NULL);
   if (warm && warm_start(w) < 0) warm = 0;
   cv_status st = cv_solve(w->sv, p);
-  if (warm && st != CVAR_OK) {
-    /* the neighbour's solution led astray: the scene's own start, as `solve` would */
-    char why[64];
-    snprintf(why, sizeof why, "%s", cv_status_name(st));
+  if ((warm || reuse) && st != CVAR_OK) {
+    /* the neighbour's solution or mesh led astray: the scene's own start, as `solve` would */
+    char failed[64];
+    snprintf(failed, sizeof failed, "%s", cv_status_name(st));
     cv_solver_set_start(w->sv, 0, NULL);
+    if (reuse && scene_solver_configure(w->inst, w->sv, err, sizeof err) != CVAR_OK) {
+      r->status = CVAR_EINVAL;
+      snprintf(r->message, sizeof r->message, "%s", err);
+      goto done;
+    }
     st = cv_solve(w->sv, p);
-    warm = 0;
-    static _Thread_local char nb[160];
+    static _Thread_local char nb[200];
     snprintf(nb, sizeof nb,
-             "(The warm start from row %d failed (%s); solved from the "
-             "scene's guess.)",
-             row, why);
+             "(Started from the previous row's %s, the solve failed (%s); "
+             "solved from the scene's %s.)",
+             warm ? "solution" : "mesh", failed, reuse ? "mesh and guess" : "guess");
+    warm = 0, reuse = 0;
     note = nb;
   }
   r->warm = warm;
@@ -426,6 +484,8 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
     if (b->any_exact) r->error_max_nodal = nodal_error(w);
     if (w->inst->adapt > 0 || w->inst->tol > 0)
       r->error_estimate = cv_solver_get_error_estimate(w->sv);
+    else if (!b->any_exact)
+      plain_estimate(w, p, r, why, sizeof why);
     if (outputs) {
       if (b->rep && eval_reports(b, w, outputs) < 0)
         for (int k = 0; k < w->inst->nreports; k++) outputs[k] = NAN;
@@ -433,9 +493,18 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
         if (cv_solver_get_multiplier(w->sv, k, &outputs[w->inst->nreports + k]) != CVAR_OK)
           outputs[w->inst->nreports + k] = NAN;
     }
-    if (b->warm) keep_for_warm(w, row);
+    if (tol)
+      keep_mesh(b, w, row);
+    else if (b->warm)
+      keep_for_warm(w, row);
   }
   compose_message(r, w->sv, morse, nfree, degenerate, note);
+  if (why[0]) { /* as `solve` says it (HP-3) */
+    size_t k = strlen(r->message);
+    put(r->message, sizeof r->message, &k, " no error estimate: ");
+    put(r->message, sizeof r->message, &k, why);
+    put(r->message, sizeof r->message, &k, ".");
+  }
 done:
   cv_problem_free(p);
   r->time_s = sc_batch_now() - t0;

@@ -1,6 +1,7 @@
 /* tests/batch/test_batch_api.c — the C API of the batch engine (cv_batch, issue 18): one
  * compiled scene, many parameter sets, on two threads, with and without warm starts; every
- * row against its closed form. Usage: test_batch_api DATA_DIR. SPDX-License-Identifier: MIT */
+ * row against its closed form; --tol rows on reused meshes against rows solved from scratch
+ * (issue 28). Usage: test_batch_api DATA_DIR [WGS84_SCENE]. SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,6 +26,55 @@ static double exact_action(double A, double B, double L, double c) {
 }
 
 enum { ROWS = 64 };
+
+/* --tol through the C API (the scene's [mesh] tol = 1e-10): a sweep of WGS84 geodesics on
+ * one thread, each row starting from the mesh the row before handed on (theory HP-9), and
+ * the same rows each solved from scratch by a batch of one row: lengths to 1e-6 m (both
+ * within the tolerance of the path; the length is stationary), estimates at most 1e-10,
+ * the same with warm starts. */
+enum { SWEEP = 16 };
+static void tol_reuse(const char *scene) {
+  char err[512];
+  const char *cols[] = {"lat1", "lon1", "lat2", "lon2"};
+  double rows[SWEEP * 4], len[3][SWEEP];
+  cv_batch_result res[SWEEP];
+  for (int r = 0; r < SWEEP; r++) {
+    rows[4 * r] = 60, rows[4 * r + 1] = 0, rows[4 * r + 3] = 120;
+    rows[4 * r + 2] = -60 + 126 * fabs(sin(3.141592653589793 * r / SWEEP));
+  }
+  for (int mode = 0; mode < 3; mode++) { /* from scratch, reused, reused and warm */
+    cv_batch *b = cv_batch_new(scene, err, sizeof err);
+    if (!b || cv_batch_set_columns(b, 4, cols, err, sizeof err) != CVAR_OK) {
+      printf("FAIL %s: %s\n", scene, err);
+      failures++;
+      cv_batch_free(b);
+      return;
+    }
+    cv_batch_set_warm_start(b, mode == 2);
+    for (int r = 0; r < SWEEP; r++) res[r].outputs = &len[mode][r];
+    if (mode == 0) /* one row per call on a new batch: nothing to reuse */
+      for (int r = 0; r < SWEEP; r++) {
+        cv_batch *one = cv_batch_new(scene, err, sizeof err);
+        check("one-row batch",
+              one && cv_batch_set_columns(one, 4, cols, err, sizeof err) == CVAR_OK &&
+                  cv_batch_solve(one, 1, rows + 4 * r, &res[r]) == CVAR_OK,
+              0, r);
+        cv_batch_free(one);
+      }
+    else
+      check("solve returns OK", cv_batch_solve(b, SWEEP, rows, res) == CVAR_OK, 0, mode);
+    for (int r = 0; r < SWEEP; r++) {
+      check("tol row converged", res[r].status == CVAR_OK && res[r].has_result, CVAR_OK,
+            res[r].status);
+      check("tol row estimate <= 1e-10", res[r].error_estimate <= 1e-10, 1e-10,
+            res[r].error_estimate);
+      if (mode > 0)
+        check("reused mesh: length as from scratch to 1e-6 m",
+              fabs(len[mode][r] - len[0][r]) <= 1e-6, len[0][r], len[mode][r]);
+    }
+    cv_batch_free(b);
+  }
+}
 
 int main(int argc, char **argv) {
   char path[4096], err[512];
@@ -89,6 +139,7 @@ int main(int argc, char **argv) {
     }
   }
   cv_batch_free(b);
+  if (argc > 2) tol_reuse(argv[2]);
   printf("%d checks, %d failures\n", checks, failures);
   return failures ? 1 : 0;
 }

@@ -49,12 +49,12 @@ static void compare(int n, int E, int p, int integ, int zero_at) {
   }
   int nf = d.nfree, *g1 = malloc(nf * sizeof *g1), *g2 = malloc(nf * sizeof *g2);
   cv_ldlt *A = NULL, *B = NULL;
-  int keep = cv_ldlt_skyline_max;
+  int keep = cv_ldlt_skyline_max, keep_band = cv_ldlt_skyline_band;
   cv_ldlt_skyline_max = 1 << 30;
   cv_ldlt_new(&d, g1, &A, msg, sizeof msg);
-  cv_ldlt_skyline_max = 0;
+  cv_ldlt_skyline_max = 0, cv_ldlt_skyline_band = 0; /* CHOLMOD, narrow band or not */
   cv_ldlt_new(&d, g2, &B, msg, sizeof msg);
-  cv_ldlt_skyline_max = keep;
+  cv_ldlt_skyline_max = keep, cv_ldlt_skyline_band = keep_band;
   const int *ca = cv_ldlt_colptr(A), *cb = cv_ldlt_colptr(B);
   CHECK(!memcmp(ca, cb, (nf + 1) * sizeof *ca) && !memcmp(g1, g2, nf * sizeof *g1), "same pattern");
   CHECK(cv_ldlt_matches(A, &d, g1) && cv_ldlt_matches(B, &d, g2), "matches its own disc");
