@@ -184,8 +184,8 @@ int main(int argc, char **argv) {
       us_lib);
   Result rf = run("lat/lon scene, 4 elements of degree 8", fixed, "", csv, tmp + "/fixed.csv", ref,
                   runs, us_gs, us_lib);
-  run("pair-adapted scene, shipped mesh (1 element of degree 5)", ad, "", csv, tmp + "/ad.csv",
-      ref, runs, us_gs, us_lib);
+  run("pair-adapted scene, shipped mesh (1 element of degree 5)", ad, "", csv, tmp + "/ad.csv", ref,
+      runs, us_gs, us_lib);
   run("pair-adapted scene, --tol 1e-10", ad, "--tol 1e-10", csv, tmp + "/adtol.csv", ref, runs,
       us_gs, us_lib);
   if (rf.wrong > 0)

@@ -382,8 +382,11 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     int done = 0;
     char why[400];
     st = cv_estimate_enriched(s, p, f, &est, NULL, &floor_, why, sizeof why);
+    int obstacles = cv_kkt_has_inequalities(p);
+    if (!st && obstacles) est = fmax(est, cv_contact_gap_term(s, p, NULL)); /* OB-8 */
     /* the indicators only when another round may follow */
     if (!st && est > tol) st = cv_estimate_indicators(s, f, eta, sigma, where);
+    if (!st && est > tol && obstacles) cv_contact_gap_term(s, p, eta);
     iters_ref += f->iterations;
     if (st == CVAR_ENOMEM) goto cleanup;
     if (st) {

@@ -24,23 +24,38 @@ static double contact_end(double xa, double xin, double xo, double go, double xo
   return x0 < lo ? lo : x0 > hi ? hi : x0;
 }
 
-/* s G_k at every node into gap (>= 0 where the constraint holds). */
+/* s G_k at every node into gap (>= 0 where the constraint holds); with gn != NULL the
+ * gap in units of the unknowns, gap / |grad G|, into gn. */
+static cv_status node_gaps2(const cv_solver *s, const cv_problem *p, int k, const double *x,
+                            double *gap, double *gn);
 static cv_status node_gaps(const cv_solver *s, const cv_problem *p, int k, const double *x,
                            double *gap) {
+  return node_gaps2(s, p, k, x, gap, NULL);
+}
+
+static cv_status node_gaps2(const cv_solver *s, const cv_problem *p, int k, const double *x,
+                            double *gap, double *gn) {
   const cv_disc *d = &s->disc;
   int n = d->herm ? d->n / 2 : d->n, step = d->herm ? 2 : 1; /* C^1: values, not slopes */
-  double yb[CV_BATCH * 8], *y = n <= 8 ? yb : cv_malloc((size_t)n * CV_BATCH * sizeof *y);
+  double *y = cv_malloc(2 * (size_t)n * CV_BATCH * sizeof *y), *gy = y + (size_t)n * CV_BATCH;
   if (!y) return CVAR_ENOMEM;
   const cv_pconstraint *c = &p->pc[k];
   cv_status st = CVAR_OK;
+  unsigned need = CVAR_NEED_F | (gn ? CVAR_NEED_GRAD : 0u);
   for (long j0 = 0; j0 < d->nodes && !st; j0 += CV_BATCH) {
     int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
     for (int t = 0; t < m; t++)
       for (int i = 0; i < n; i++) y[i * m + t] = s->y[(j0 + t) * d->n + step * i];
-    if (c->G(m, x + j0, y, CVAR_NEED_F, gap + j0, NULL, NULL, c->user)) st = CVAR_ENONFINITE;
-    for (int t = 0; t < m; t++) gap[j0 + t] *= c->sense;
+    if (c->G(m, x + j0, y, need, gap + j0, gn ? gy : NULL, NULL, c->user)) st = CVAR_ENONFINITE;
+    for (int t = 0; t < m; t++) {
+      gap[j0 + t] *= c->sense;
+      if (!gn) continue;
+      double g2 = 0.0;
+      for (int i = 0; i < n; i++) g2 += gy[i * m + t] * gy[i * m + t];
+      gn[j0 + t] = g2 > 0 ? gap[j0 + t] / sqrt(g2) : INFINITY;
+    }
   }
-  if (y != yb) cv_free(y);
+  cv_free(y);
   return st;
 }
 
@@ -85,4 +100,36 @@ cv_status cv_solver_get_contact(const cv_solver *s, const cv_problem *p, int k, 
 #undef ACTIVE
   cv_free(x);
   return st;
+}
+
+/* OB-8: what the error estimate of a solve with obstacles cannot see. The enriched solve
+ * of HP-2 puts its contact ends at or next to the same nodes, so a contact end misplaced
+ * by up to the spacing d of the nodes next to it moves both solves alike; the path's error
+ * from it is of the order of the gap C d^2 (C d^3 on C^1 elements) that the first free node
+ * beside each contact run keeps. Returns the largest such gap, in units of the unknowns
+ * (gap / |grad G|), and (eta not NULL) raises the indicator of the elements on either side
+ * of that node to it, so that --tol refines there. */
+double cv_contact_gap_term(const cv_solver *s, const cv_problem *p, double *eta) {
+  const cv_disc *d = &s->disc;
+  long N = d->nodes;
+  double term = 0.0;
+  double *x = cv_malloc(3 * (size_t)N * sizeof *x), *gap = x + N, *gn = gap + N;
+  if (!x) return INFINITY;
+  cv_disc_fill_nodes(d, x);
+  for (int k = 0; k < p->nc; k++) {
+    if (!p->pc[k].sense || node_gaps2(s, p, k, x, gap, gn)) continue;
+    for (long j = 1; j < N; j++) {
+      int act = s->mult[j * d->nc + k] != 0.0, prev = s->mult[(j - 1) * d->nc + k] != 0.0;
+      if (act == prev || cv_disc_lidx(d, j, k) < 0 || cv_disc_lidx(d, j - 1, k) < 0) continue;
+      long free_node = act ? j - 1 : j; /* the free node beside a run's end */
+      double t = gn[free_node] > 0 ? gn[free_node] : 0.0;
+      term = cv_fmax(term, t);
+      if (!eta) continue;
+      long e0 = cv_disc_node_elem(d, j - 1), e1 = cv_disc_node_elem(d, j);
+      eta[e0] = cv_fmax(eta[e0], t);
+      eta[e1] = cv_fmax(eta[e1], t);
+    }
+  }
+  cv_free(x);
+  return term;
 }

@@ -541,6 +541,7 @@ cv_status cv_solver_estimate_error(const cv_solver *s, const cv_problem *p, doub
     st = cv_hermite_estimate(s, p, f, est, est_vertex, NULL, msg, len);
   else
     st = cv_estimate_enriched(s, p, f, est, est_vertex, NULL, msg, len);
+  if (!st && cv_kkt_has_inequalities(p)) *est = fmax(*est, cv_contact_gap_term(s, p, NULL));
   cv_solver_free(f);
   return st;
 }

@@ -301,6 +301,9 @@ cv_status cv_kkt_active_init(cv_kkt *k);
  * assembly); returns how many decisions changed, or -1 when a constraint cannot be
  * evaluated there. */
 long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M);
+/* OB-8 (cv_contact.c): the gap kept by the free node beside each contact end, the error
+ * the enriched solve cannot see; raises eta (may be NULL) of the elements around it. */
+double cv_contact_gap_term(const cv_solver *s, const cv_problem *p, double *eta);
 /* OB-5: 1 when the step from Y to Yt takes an inactive node that satisfies an inequality
  * (slack g > 0) further than OB_CROSS g past the obstacle: the line search shortens it, so
  * that a path does not jump across an obstacle whose constraint gradient is small inside. */
