@@ -7,7 +7,7 @@ command -v groff >/dev/null 2>&1 || { echo "groff not installed: skipped"; exit 
 warnings=$(groff -man -Tutf8 -ww -z "$1" 2>&1)
 [ -z "$warnings" ] || { echo "$warnings"; echo "FAIL: groff warnings"; exit 1; }
 text=$(groff -man -Tutf8 -P-cbou "$1" 2>/dev/null)
-for word in NAME SYNOPSIS DESCRIPTION OPTIONS "EXIT STATUS" "calcvar solve"; do
+for word in NAME SYNOPSIS DESCRIPTION OPTIONS "EXIT STATUS" "calcvar solve" "calcvar batch" SIGNALS; do
   printf '%s' "$text" | grep -q "$word" || { echo "FAIL: '$word' missing"; exit 1; }
 done
 echo "$1 renders: $(printf '%s\n' "$text" | wc -l) lines"

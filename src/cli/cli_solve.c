@@ -185,6 +185,7 @@ int cli_solve(int argc, char **argv) {
     st = r.st = CVAR_ENONFINITE;
     r.status = cli_status_string(st);
     r.has_morse = 0;
+    r.has_err_est = 0; /* an estimate of a path that is no solution would be a claim */
     r.kind = NULL;
     snprintf(r.message, sizeof r.message,
              "the integrand is singular at %s = %.6g inside the interval: along the path "

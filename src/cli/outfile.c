@@ -206,9 +206,16 @@ int cli_outfile_open_inputs(cli_outfile *o, const char *path, const char *const 
   if (exists && !S_ISREG(st.st_mode)) return open_stream(o, o->dest);
   identify(o, &st, exists);
   size_t dn = strlen(o->dest);
-  if (!(o->tmp = malloc(dn + 16))) return fail(o, "out of memory");
+  if (!(o->tmp = malloc(dn + 24))) return fail(o, "out of memory");
+  /* NAME.tmp.XXXXXX beside the target; for a name within 11 bytes of the file system's
+   * limit on a name (255), a shorter one in the same directory */
+  const char *slash = strrchr(o->dest, '/');
+  size_t base = strlen(slash ? slash + 1 : o->dest), dir = dn - base;
   memcpy(o->tmp, o->dest, dn);
-  memcpy(o->tmp + dn, ".tmp.XXXXXX", 12);
+  if (base + 11 > 255)
+    memcpy(o->tmp + dir, ".calcvar.tmp.XXXXXX", 20);
+  else
+    memcpy(o->tmp + dn, ".tmp.XXXXXX", 12);
   int fd = cli_mkstemp(o->tmp);
   if (fd < 0) {
     int e = errno;

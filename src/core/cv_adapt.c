@@ -464,6 +464,11 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     }
   }
 cleanup:
+  /* a failed allocation between solves leaves the last solve's "converged in N
+   * iterations" in the message: say what happened instead (issue 27, item 15) */
+  if (st == CVAR_ENOMEM && !strstr(s->msg, "out of memory"))
+    cv_set_msg(s->msg, sizeof s->msg, "out of memory in %s, round %d (%d elements)",
+               s->hp ? "automatic accuracy" : "adaptive refinement", s->rounds, E);
   if (rescued[0]) prefix_msg(s, rescued);
   s->ends_passed[0] = s->ends_passed[1] = 0; /* the next plain solve checks its ends */
   s->iterations = (int)(iters > 2000000000L ? 2000000000L : iters); /* all rounds */

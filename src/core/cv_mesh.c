@@ -67,16 +67,20 @@ cv_status cv_mesh_build(const cv_meshspec *m, double a, double b, int *Eout, dou
     E = total;
     cv_free(cnt);
   } else {
-    xe = cv_malloc((size_t)(E + nb + 1) * sizeof *xe);
+    xe = cv_malloc(((size_t)E + (size_t)nb + 1) * sizeof *xe); /* E may be INT_MAX */
     if (!xe) {
       st = CVAR_ENOMEM;
       goto cleanup;
     }
     if (m->kind == CV_MESH_UNIFORM) /* the common case, without a call per boundary */
-      for (int i = 0; i <= E; i++) xe[i] = a + L * ((double)i / E);
+      for (int i = 0; i < E; i++) xe[i] = a + L * ((double)i / E);
     else
-      for (int i = 0; i <= E; i++)
+      for (int i = 0; i < E; i++)
         xe[i] = a + L * (m->kind == CV_MESH_USER ? m->t[i] : graded_t(m, i));
+    /* the last boundary outside the loop: i <= E would overflow at E = INT_MAX */
+    xe[E] = a + L * (m->kind == CV_MESH_UNIFORM ? 1.0
+                     : m->kind == CV_MESH_USER  ? m->t[E]
+                                                : graded_t(m, E));
     xe[0] = a;
     xe[E] = b;
     /* Insert each breakpoint that is not already a boundary (to 1e-13 relative). */

@@ -94,6 +94,10 @@ void sc_entry_locate(const sc_entry *e, int off, int *line, int *col);
 
 /* scene_names.c: the names a scene may not define (the grammar's reserved names and free). */
 int sc_is_reserved(const char *s);
+/* Whether s is UTF-8 text (a title goes into the JSON report). */
+int sc_is_utf8(const char *s);
+/* The most unknowns a scene may have (the compiled integrand's own limit). */
+enum { SC_MAX_UNKNOWNS = 1000 };
 
 /* scene_namemap.c: names (borrowed) to non-negative integers, found in constant time. */
 typedef struct {

@@ -125,6 +125,10 @@ static int load_scene_section(sc_loader *L) {
   if (sc_check_keys(L, SEC_SCENE, keys, "title, variable, interval, unknowns, integrand") < 0)
     return -1;
   const sc_entry *e = find_entry(L, SEC_SCENE, "title");
+  if (e && !sc_is_utf8(e->value)) { /* the JSON report (and Python) need UTF-8 text */
+    sc_err(L->err, L->errlen, L->file, e->line, "the title is not UTF-8 text");
+    return -1;
+  }
   s->title = sc_strdup(e ? e->value : L->file);
   e = find_entry(L, SEC_SCENE, "variable");
   if (e && sc_check_new_name(L, e->line, e->value, "variable") < 0) return -1;
@@ -139,6 +143,12 @@ static int load_scene_section(sc_loader *L) {
   }
   ex_list list;
   if (ex_list_split(e->value, &list) < 0) goto nomem;
+  if (list.n > SC_MAX_UNKNOWNS) {
+    sc_err(L->err, L->errlen, L->file, e->line, "at most %d unknowns, got %d", SC_MAX_UNKNOWNS,
+           list.n);
+    ex_list_free(&list);
+    return -1;
+  }
   s->unknowns = cv_calloc((size_t)list.n, sizeof *s->unknowns);
   if (!s->unknowns) {
     ex_list_free(&list);
@@ -288,6 +298,11 @@ static int load_interval_integrand(sc_loader *L) {
   if (!(s->a < s->b)) {
     sc_err(L->err, L->errlen, L->file, e->line, "interval needs a < b, got a = %.17g, b = %.17g",
            s->a, s->b);
+    goto done;
+  }
+  if (!isfinite(s->b - s->a)) { /* -1e308, 1e308: the length overflows */
+    sc_err(L->err, L->errlen, L->file, e->line,
+           "interval: the length b - a of [%g, %g] is larger than the largest double", s->a, s->b);
     goto done;
   }
   e = find_entry(L, SEC_SCENE, "integrand");

@@ -19,3 +19,19 @@ int sc_name_add(sc_loader *L, int line, const char *name, int kind, int index) {
   sc_err(L->err, L->errlen, L->file, line, "out of memory");
   return -1;
 }
+
+int sc_is_utf8(const char *s) {
+  const unsigned char *p = (const unsigned char *)s;
+  while (*p) {
+    int more = *p < 0x80             ? 0
+               : (*p & 0xe0) == 0xc0 ? 1
+               : (*p & 0xf0) == 0xe0 ? 2
+               : (*p & 0xf8) == 0xf0 ? 3
+                                     : -1;
+    if (more < 0 || (more == 1 && *p < 0xc2) || (more == 3 && *p > 0xf4)) return 0;
+    p++;
+    for (int k = 0; k < more; k++, p++)
+      if ((*p & 0xc0) != 0x80) return 0;
+  }
+  return 1;
+}

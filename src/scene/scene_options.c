@@ -115,9 +115,10 @@ int sc_load_mesh(sc_loader *L) {
       s->tol_line = e->line;
     } else if (strcmp(k, "grading") == 0) {
       if (sc_parse_const(L, e, 0, e->value, "grading", &s->grading) < 0) return -1;
-      if (!(s->grading >= 1)) {
+      if (!(s->grading >= 1 && s->grading <= 20)) {
         sc_err(L->err, L->errlen, L->file, e->line,
-               "grading is the exponent k >= 1 of x = a + (b - a) t^k, got %g", s->grading);
+               "grading is the exponent k of x = a + (b - a) t^k, from 1 to 20, got %g",
+               s->grading);
         return -1;
       }
     } else { /* grading_at */

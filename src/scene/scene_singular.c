@@ -10,6 +10,13 @@
  * the solution, F is then sampled at x* +- d for d = 1e-3 and 1e-5 (times b - a): growth
  * like |x - x*|^(-alpha) with alpha >= 0.85 (a ratio >= 50 over the factor 100) means the
  * action diverges there.
+ *
+ * A pole that the syntax does not show (tan(pi x), 1/cos, a table, a callback) is found
+ * from the values (scene_interior_singularity only, the command's `solve`): |F| along the
+ * solution on the same grid, its largest interior value narrowed by zooming in (64 samples
+ * between the neighbours of the largest, six times), then the same growth test there. A
+ * smooth peak (a boundary layer) is flat near its top and grows by a factor near 1, far
+ * below 50; y'^2 + y^2 tan(pi x) on [0, 1] grows like |x - 1/2|^(-1) and is caught.
  */
 #include <float.h>
 #include <math.h>
@@ -146,10 +153,69 @@ int scene_interior_singularity_of(const scene *s, cv_solver *sv, int nc, const e
   return 0;
 }
 
+/* |F| along the solution at the npts points x (NaN where it cannot be evaluated: a pole
+ * hit exactly is infinite). 0, or -1 out of memory. */
+static int f_along(const scene *s, cv_solver *sv, int npts, const double *x, double *v) {
+  int n = s->n;
+  double *y = cv_malloc((size_t)2 * n * (size_t)npts * sizeof *y);
+  int ok = y && cv_solver_eval(sv, npts, x, y, y + (size_t)n * npts) == CVAR_OK &&
+           sc_eval_exprs(s, 1, &s->F, npts, x, y, y + (size_t)n * npts, v) == 0;
+  cv_free(y);
+  for (int k = 0; ok && k < npts; k++) v[k] = isnan(v[k]) ? INFINITY : fabs(v[k]);
+  return ok ? 0 : -1;
+}
+
+/* Index of the largest of v[from..to] (the first). */
+static int argmax(const double *v, int from, int to) {
+  int best = from;
+  for (int k = from + 1; k <= to; k++)
+    if (v[k] > v[best]) best = k;
+  return best;
+}
+
+/* Where |F| along the solution is largest strictly inside (a, b), narrowed down: 1 and *xs,
+ * 0 when F cannot be evaluated along it, -1 out of memory. */
+static int value_peak(const scene *s, cv_solver *sv, double *xs) {
+  enum { ZOOM = 64 };
+  double a = s->a, b = s->b, h = (b - a) / GRID;
+  double *x = cv_malloc((GRID + 1) * sizeof *x), *v = cv_malloc((GRID + 1) * sizeof *v);
+  int rc = x && v ? 0 : -1;
+  for (int k = 0; rc == 0 && k <= GRID; k++) x[k] = a + h * k;
+  if (rc == 0 && f_along(s, sv, GRID + 1, x, v) < 0) rc = -2;
+  if (rc == 0) {
+    int k = argmax(v, 1, GRID - 1);
+    double lo = x[k - 1], hi = x[k + 1];
+    for (int round = 0; round < 6 && rc == 0; round++) { /* ZOOM + 1 points in (lo, hi) */
+      double step = (hi - lo) / ZOOM;
+      for (int j = 0; j <= ZOOM; j++) x[j] = lo + step * j;
+      if (f_along(s, sv, ZOOM + 1, x, v) < 0) rc = -2;
+      int j = rc == 0 ? argmax(v, 0, ZOOM) : 0;
+      lo = x[j > 0 ? j - 1 : 0], hi = x[j < ZOOM ? j + 1 : ZOOM];
+      *xs = x[j];
+    }
+    if (rc == 0) rc = *xs > a + 1e-9 * (b - a) && *xs < b - 1e-9 * (b - a);
+  }
+  cv_free(x);
+  cv_free(v);
+  return rc == -2 ? 0 : rc;
+}
+
 int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double *alpha) {
   ex_id *c = NULL;
   int nc = scene_singular_candidates(s, &c);
   int rc = nc < 0 ? -1 : scene_interior_singularity_of(s, sv, nc, c, xs, alpha);
   cv_free(c);
-  return rc;
+  if (rc != 0) return rc;
+  double x0; /* no pole the syntax shows: look for one in the values */
+  int z = value_peak(s, sv, &x0);
+  if (z <= 0) return z;
+  double L = s->b - s->a, g1 = f_near(s, sv, x0, 1e-3 * L), g2 = f_near(s, sv, x0, 1e-5 * L);
+  if (isnan(g1) || isnan(g2)) return 0;
+  double al = g1 > 0 && isfinite(g2) ? log(g2 / g1) / log(100.0) : INFINITY;
+  if (!(al < 0.85)) {
+    *xs = x0;
+    *alpha = al;
+    return 1;
+  }
+  return 0;
 }
