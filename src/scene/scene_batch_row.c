@@ -99,6 +99,7 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
           CVAR_OK;
   }
   (void)b;
+  if (!bad) bad = scene_problem_set_ends(s, p, NULL, 0) < 0; /* [ends] (scene_ends.c) */
   if (bad) {
     cv_problem_free(p);
     return NULL;

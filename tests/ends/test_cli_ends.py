@@ -155,6 +155,17 @@ for flags in [(), ("--tol", "1e-8")]:
         check(what + " path %d max_nodal" % (k + 1),
               s.get("error", {}).get("max_nodal", 1) <= 1e-10, 1e-10, s.get("error"))
 
+# batch: a radius per row, each row's length sqrt(13) - r (the end found per row).
+r = subprocess.run([calcvar, "batch", os.path.join(scenes, "point_to_circle_r.scene"),
+                    os.path.join(scenes, "radius.csv"), "--threads", "2"],
+                   capture_output=True, text=True, timeout=300)
+check("batch exit status", r.returncode == 0, 0, "%d (%s)" % (r.returncode, r.stderr.strip()))
+table = list(csv.DictReader(r.stdout.splitlines()))
+check("batch rows", len(table) == 4, 4, len(table))
+for row in table:
+    near("batch r=%s length" % row.get("r"), float(row.get("action") or "nan"),
+         math.sqrt(13) - float(row.get("r")), 1e-12)
+
 # No stationary end point: exit 1 and a sentence, never a converged report.
 j, rows = solve("collapse.scene", expect_rc=1)
 check("collapse status", j.get("status") not in (None, "converged"), "not converged",
