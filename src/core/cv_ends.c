@@ -62,13 +62,21 @@ void cv_ends_state_free(cv_solver *s) {
 }
 
 const cv_problem *cv_ends_solved(const cv_solver *s, const cv_problem *p) {
-  if (!s || !s->ends || s->ends->src != p) return p;
+  if (!s || !s->ends || !s->have || !cv_ends_moving(p) || p->n != s->disc.n) return p;
+  /* p's own data (it may be another problem of the same scene: `solve --continue` reports
+   * on a fresh one), at the interval and end value of the path the solver holds */
   struct cv_ends_state *st = s->ends;
-  if (s->have) { /* the interval and end value of the path the solver holds (cv_solve_all) */
-    st->q.a = s->disc.a, st->q.b = s->disc.b;
-    if (st->k >= 0)
-      st->endval[2 * st->k + st->end] =
-          s->y[(size_t)(st->end ? s->disc.nodes - 1 : 0) * p->n + st->k];
+  int n = p->n, k = st->k, end = st->end;
+  memcpy(st->fixed, p->fixed, 2 * (size_t)n * sizeof *st->fixed);
+  memcpy(st->endval, p->endval, 2 * (size_t)n * sizeof *st->endval);
+  st->src = p;
+  st->q = *p;
+  st->q.fixed = st->fixed, st->q.endval = st->endval;
+  for (int e = 0; e < 2; e++) st->q.move[e] = (cv_end_motion){CV_END_FIXED, NULL, NULL, NULL};
+  st->q.a = s->disc.a, st->q.b = s->disc.b;
+  if (k >= 0) {
+    st->fixed[2 * k + end] = 1;
+    st->endval[2 * k + end] = s->y[(size_t)(end ? s->disc.nodes - 1 : 0) * n + k];
   }
   return &st->q;
 }
