@@ -54,6 +54,7 @@ int cv_ends_moving(const cv_problem *p) {
 void cv_ends_state_free(cv_solver *s) {
   if (!s) return;
   s->ends_dim = 0;
+  s->ends_neg = 0;
   if (!s->ends) return;
   cv_free(s->ends->fixed);
   cv_free(s->ends->endval);
@@ -364,15 +365,16 @@ static cv_status iterate(ends_run *R, double x, double yk) {
   /* The curvature of the reduced action (ME-4): from the residuals, or one probe. */
   double d2 = NAN, L = R->st->q.b - R->st->q.a;
   if (!curvature(hs, hr, nh, L, &d2)) {
-    double px = x, py = yk, ds = 1e-3 * L, pr, psc;
-    if ((st = move_along(R, &px, &py, tx, ty, &ds)) || (st = solve_at(R, px, py)) ||
-        (st = outer_residual(R, tx, ty, &pr, &psc)) || (st = solve_at(R, x, yk)))
-      return st;
+    double px = x, py = yk, ds = 1e-3 * L, pr, psc, ptx, pty;
+    if ((st = move_along(R, &px, &py, tx, ty, &ds)) || (st = solve_at(R, px, py))) return st;
+    if (tangent(R, px, &ptx, &pty) != 0) return CVAR_ESINGULAR; /* the probe's own tangent */
+    if ((st = outer_residual(R, ptx, pty, &pr, &psc))) return st;
     if (R->k >= 0) R->y[R->k] = yk;
+    if ((st = solve_at(R, x, yk))) return st;
     d2 = (pr - r) / ds;
   }
-  int morse = s->morse, degenerate = !(fabs(d2) * L * L > 1e-9 * fmax(fabs(s->action), 1e-300));
-  if (morse >= 0 && d2 < 0) s->morse = morse + 1;
+  int degenerate = !(fabs(d2) * L * L > 1e-9 * fmax(fabs(s->action), 1e-300));
+  s->ends_neg = !degenerate && d2 < 0; /* added by cv_solver_get_morse_index (ME-4) */
   if (degenerate && s->method == CVAR_METHOD_NEWTON) s->degenerate = 1;
   s->ends_dim = 1;
   char inner[sizeof s->msg], at[96] = "";
@@ -458,7 +460,7 @@ done:
   cv_free(R.t), cv_free(R.Y), cv_free(R.deg), cv_free(R.y);
   if (R.st) {
     s->ends = R.st;
-    if (st != CVAR_OK) s->ends_dim = 0;
+    if (st != CVAR_OK) s->ends_dim = 0, s->ends_neg = 0;
   }
   if (R.solves > 1) s->iterations = (int)(R.iters > 2000000000L ? 2000000000L : R.iters);
   return st;

@@ -155,6 +155,20 @@ for flags in [(), ("--tol", "1e-8")]:
         check(what + " path %d max_nodal" % (k + 1),
               s.get("error", {}).get("max_nodal", 1) <= 1e-10, 1e-10, s.get("error"))
 
+# Without [exact]: both paths of --all get their error estimate (the enriched solve of the
+# inner problem on the solved interval; the far side's index 1 is the end's, ME-4).
+j, rows = solve("point_to_circle_r.scene", "--all")
+for k, s in enumerate(j.get("solutions", [])):
+    check("point_to_circle_r --all path %d error_estimate" % (k + 1),
+          s.get("error_estimate", 1) <= 1e-12, "<= 1e-12", s.get("error_estimate"))
+
+# A degenerate family (every radius of a circle from its centre): reported as degenerate,
+# never as a minimum.
+j, rows = solve("centred_circle.scene")
+check("centred_circle stationary_kind", j.get("stationary_kind") == "degenerate", "degenerate",
+      j.get("stationary_kind"))
+near("centred_circle length", j.get("action"), 2.0, 1e-12)
+
 # batch: a radius per row, each row's length sqrt(13) - r (the end found per row).
 r = subprocess.run([calcvar, "batch", os.path.join(scenes, "point_to_circle_r.scene"),
                     os.path.join(scenes, "radius.csv"), "--threads", "2"],
