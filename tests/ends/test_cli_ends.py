@@ -169,6 +169,22 @@ check("centred_circle stationary_kind", j.get("stationary_kind") == "degenerate"
       j.get("stationary_kind"))
 near("centred_circle length", j.get("action"), 2.0, 1e-12)
 
+# Both ends move (ME-6): between two circles, plain and under --tol 1e-10; measured end
+# points within 2.1e-13 and paths within 5.2e-13 of the exact segment.
+a2, b2 = 2 / math.sqrt(5), 6 - 2 / math.sqrt(5)
+for flags in [(), ("--tol", "1e-10")]:
+    j, rows = solve("two_circles.scene", *flags)
+    what = "two_circles " + " ".join(flags)
+    common(what, j, rows, [(a2, 1e-11), (b2, 1e-11)], (math.sqrt(45) - 2, 1e-11))
+    check(what + " error.max_nodal", j.get("error", {}).get("max_nodal", 1) <= 1e-11, 1e-11,
+          j.get("error"))
+# An autonomous integrand with both ends free: a family of shifts, reported degenerate.
+j, rows = solve("shift_family.scene")
+check("shift_family stationary_kind", j.get("stationary_kind") == "degenerate", "degenerate",
+      j.get("stationary_kind"))
+iv = j.get("interval", [0, 0])
+near("shift_family duration", iv[1] - iv[0], T, 1e-5)
+
 # batch: a radius per row, each row's length sqrt(13) - r (the end found per row).
 r = subprocess.run([calcvar, "batch", os.path.join(scenes, "point_to_circle_r.scene"),
                     os.path.join(scenes, "radius.csv"), "--threads", "2"],
