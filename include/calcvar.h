@@ -199,8 +199,9 @@ CVAR_API cv_status cv_problem_set_free_end(cv_problem *p, int k, int end);
  * condition, which calcvar derives and imposes itself: the interval given to
  * cv_problem_new is where the search starts, and cv_solver_get_interval gives the solved
  * one. One end or both may move; the Morse index counts the ends' motion too, and
- * cv_solve_all searches along it. The problem may have no pointwise or integral
- * constraints (cv_solve returns CVAR_EINVAL with a sentence otherwise). */
+ * cv_solve_all searches along it. Integral constraints are allowed (their multipliers
+ * enter the condition); pointwise ones are not (cv_solve returns CVAR_EINVAL with a
+ * sentence). */
 /**@{*/
 /** An end curve at one point: *G = G(x, y), *Gx = dG/dx and Gy[i] = dG/dy_i (n values).
  * Return 0 on success, nonzero when G cannot be evaluated there. */

@@ -603,9 +603,8 @@ cv_status cv_ends_run(cv_solver *s, const cv_problem *p, double shift) {
   double *buf = NULL;
   memset(&R, 0, sizeof R);
   R.s = s, R.p = p, R.n = p->n;
-  if (p->nc > 0 || p->ni > 0) {
-    cv_set_msg(s->msg, sizeof s->msg,
-               "a moving end with pointwise or integral constraints is not supported");
+  if (p->nc > 0) {
+    cv_set_msg(s->msg, sizeof s->msg, "a moving end with pointwise constraints is not supported");
     return s->status = CVAR_EINVAL;
   }
   if (!p->F) {

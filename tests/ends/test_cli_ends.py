@@ -169,6 +169,17 @@ check("centred_circle stationary_kind", j.get("stationary_kind") == "degenerate"
       j.get("stationary_kind"))
 near("centred_circle length", j.get("action"), 2.0, 1e-12)
 
+# A free end with an integral constraint: H of L = F + mu K (ME-2). T^2 = 3 sqrt(2),
+# mu = -2 sqrt(2)/T, action 4T/3. Default mesh: T off by 1.0e-4 (O(h^2)); --tol 1e-10: 0.
+Ta = math.sqrt(3 * math.sqrt(2))
+for flags, tol in [((), 5e-4), (("--tol", "1e-10"), 1e-10)]:
+    j, rows = solve("free_time_area.scene", *flags)
+    what = "free_time_area " + " ".join(flags)
+    common(what, j, rows, [(0, 0), (Ta, tol)], (4 * Ta / 3, tol))
+    near(what + " multiplier", j.get("multipliers", {}).get("area"), -2 * math.sqrt(2) / Ta, tol)
+    check(what + " error.max_nodal", j.get("error", {}).get("max_nodal", 1) <= 10 * tol, 10 * tol,
+          j.get("error"))
+
 # Both ends move (ME-6): between two circles, plain and under --tol 1e-10; measured end
 # points within 2.1e-13 and paths within 5.2e-13 of the exact segment.
 a2, b2 = 2 / math.sqrt(5), 6 - 2 / math.sqrt(5)
