@@ -16,9 +16,8 @@
 #include "cv_internal.h"
 
 struct cv_ends_state {
-  const cv_problem *src; /* the problem whose end moved */
-  cv_problem q;          /* its fixed-interval problem at the solved end (shares src's data) */
-  int *fixed;            /* q's own end conditions */
+  cv_problem q; /* the fixed-interval problem at the solved ends (shares the problem's data) */
+  int *fixed;   /* q's own end conditions */
   double *endval;
   int k[2]; /* per end: the unknown whose value follows its curve (-1: none; -2: fixed end) */
 };
@@ -70,18 +69,22 @@ void cv_ends_state_free(cv_solver *s) {
   s->ends = NULL;
 }
 
+/* q: p with its own copy of the end conditions and no moving end (the interval is p's). */
+static void state_load(struct cv_ends_state *st, const cv_problem *p) {
+  memcpy(st->fixed, p->fixed, 2 * (size_t)p->n * sizeof *st->fixed);
+  memcpy(st->endval, p->endval, 2 * (size_t)p->n * sizeof *st->endval);
+  st->q = *p;
+  st->q.fixed = st->fixed, st->q.endval = st->endval;
+  for (int e = 0; e < 2; e++) st->q.move[e] = (cv_end_motion){CV_END_FIXED, NULL, NULL, NULL};
+}
+
 const cv_problem *cv_ends_solved(const cv_solver *s, const cv_problem *p) {
   if (!s || !s->ends || !s->have || !cv_ends_moving(p) || p->n != s->disc.n) return p;
   /* p's own data (it may be another problem of the same scene: `solve --continue` reports
    * on a fresh one), at the interval and end value of the path the solver holds */
   struct cv_ends_state *st = s->ends;
   int n = p->n;
-  memcpy(st->fixed, p->fixed, 2 * (size_t)n * sizeof *st->fixed);
-  memcpy(st->endval, p->endval, 2 * (size_t)n * sizeof *st->endval);
-  st->src = p;
-  st->q = *p;
-  st->q.fixed = st->fixed, st->q.endval = st->endval;
-  for (int e = 0; e < 2; e++) st->q.move[e] = (cv_end_motion){CV_END_FIXED, NULL, NULL, NULL};
+  state_load(st, p);
   st->q.a = s->disc.a, st->q.b = s->disc.b;
   for (int end = 0; end < 2; end++) {
     int k = st->k[end];
@@ -104,13 +107,7 @@ static struct cv_ends_state *state_new(const cv_problem *p) {
     cv_free(st);
     return NULL;
   }
-  memcpy(st->fixed, p->fixed, 2 * (size_t)p->n * sizeof *st->fixed);
-  memcpy(st->endval, p->endval, 2 * (size_t)p->n * sizeof *st->endval);
-  st->src = p;
-  st->q = *p;
-  st->q.fixed = st->fixed;
-  st->q.endval = st->endval;
-  for (int e = 0; e < 2; e++) st->q.move[e] = (cv_end_motion){CV_END_FIXED, NULL, NULL, NULL};
+  state_load(st, p);
   return st;
 }
 
