@@ -214,5 +214,11 @@ check("collapse status", j.get("status") not in (None, "converged"), "not conver
 check("collapse message", "collapses" in j.get("message", ""), "... collapses ...",
       j.get("message"))
 
+j, rows = solve("runaway.scene", expect_rc=1)
+check("runaway status", j.get("status") not in (None, "converged"), "not converged",
+      j.get("status"))
+check("runaway message", "runs away" in j.get("message", ""), "... runs away ...",
+      j.get("message"))
+
 print("%d checks, %d failures" % (checks, failures))
 sys.exit(1 if failures else 0)
