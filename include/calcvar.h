@@ -216,13 +216,15 @@ CVAR_API cv_status cv_problem_set_end_value(cv_problem *p, int k, int end, doubl
 /** Leave unknown k free at one end (0 = a, 1 = b): the natural boundary condition
  * dF/dy'_k = 0 holds there at the solution. */
 CVAR_API cv_status cv_problem_set_free_end(cv_problem *p, int k, int end);
-/** \name Moving ends (docs/moving-ends.md; theory ME-1 .. ME-4)
+/** \name Moving ends (docs/moving-ends.md; theory ME-1 .. ME-6)
  * An end of the interval may itself be unknown: free, or constrained to a curve
  * G(x, y) = 0. The solve then also finds where that end lies, from the transversality
  * condition, which calcvar derives and imposes itself: the interval given to
  * cv_problem_new is where the search starts, and cv_solver_get_interval gives the solved
- * one. At most one end may move; the problem may have no pointwise or integral constraints
- * (cv_solve returns CVAR_EINVAL with a sentence otherwise). */
+ * one. One end or both may move; the Morse index counts the ends' motion too, and
+ * cv_solve_all searches along it. Integral constraints are allowed (their multipliers
+ * enter the condition); pointwise ones are not (cv_solve returns CVAR_EINVAL with a
+ * sentence). */
 /**@{*/
 /** An end curve at one point: *G = G(x, y), *Gx = dG/dx and Gy[i] = dG/dy_i (n values).
  * Return 0 on success, nonzero when G cannot be evaluated there. */

@@ -237,6 +237,8 @@ int cli_all_run(const cli_opts *o, scene *s, cv_problem *p, cv_solver *sv, int a
           printf(", error %.3g", r[k].err_nodal);
         else if (r[k].has_err_est)
           printf(", estimate %.3g", r[k].err_est);
+        if (r[k].has_interval) /* a moving end: where this path's ends are */
+          printf(", interval [%.12g, %.12g]", r[k].interval[0], r[k].interval[1]);
         printf("\n");
       }
   }

@@ -38,7 +38,7 @@ typedef struct {
   cv_disc disc;
   double *y, *mult;
   double action, gnorm, gfloor, err_est, time;
-  int iterations, morse, degenerate, rounds, csteps;
+  int iterations, morse, degenerate, rounds, csteps, ends_neg;
   char msg[640];
 } cv_path;
 
@@ -71,7 +71,7 @@ static void path_take(cv_path *q, cv_solver *s) {
   q->action = s->action, q->gnorm = s->gnorm, q->gfloor = s->gfloor, q->err_est = s->err_est,
   q->time = s->time;
   q->iterations = s->iterations, q->morse = s->morse, q->degenerate = s->degenerate;
-  q->rounds = s->rounds, q->csteps = s->csteps;
+  q->rounds = s->rounds, q->csteps = s->csteps, q->ends_neg = s->ends_neg;
   memcpy(q->msg, s->msg, sizeof q->msg);
   memset(&s->disc, 0, sizeof s->disc);
   s->y = s->mult = NULL;
@@ -87,7 +87,7 @@ static void path_give(cv_solver *s, cv_path *q) {
   s->action = q->action, s->gnorm = q->gnorm, s->gfloor = q->gfloor, s->err_est = q->err_est,
   s->time = q->time;
   s->iterations = q->iterations, s->morse = q->morse, s->degenerate = q->degenerate;
-  s->rounds = q->rounds, s->csteps = q->csteps;
+  s->rounds = q->rounds, s->csteps = q->csteps, s->ends_neg = q->ends_neg;
   memcpy(s->msg, q->msg, sizeof s->msg);
   s->status = CVAR_OK;
   s->have = 1;

@@ -35,11 +35,39 @@ static int dense_solve(int n, double *A, double *x) {
   return 0;
 }
 
-/* F and its partials at one point (x, y, v); o's buffers as the callback wants them. */
-static int eval_point(const cv_problem *q, double x, const double *y, const double *v,
-                      unsigned need, cv_partials *o) {
-  int rc = q->F(1, &x, y, v, need, o, q->user);
-  if (rc != 0 || !isfinite(o->F[0])) return -1;
+/* The Lagrangian L = F + sum_r mu_r K_r of the integral constraints (theory C-2) and the
+ * partials `need` asks for at m <= CV_BATCH points, into o (laid out as the callbacks'). */
+static int eval_lagrangian(const cv_problem *q, const double *mu, int m, const double *x,
+                           const double *y, const double *v, unsigned need, cv_partials *o) {
+  int n = q->n;
+  if (q->F(m, x, y, v, need, o, q->user) != 0) return -1;
+  if (q->ni == 0) return 0;
+  size_t nm = (size_t)n * m, nnm = (size_t)n * nm;
+  double *buf = cv_malloc(((size_t)m + 2 * nm + 3 * nnm) * sizeof *buf);
+  if (!buf) return -1;
+  int rc = 0;
+  for (int r = 0; r < q->ni && rc == 0; r++) {
+    cv_partials k = {buf, NULL, NULL, NULL, NULL, NULL};
+    if (need & CVAR_NEED_GRAD) k.Fy = buf + m, k.Fp = k.Fy + nm;
+    if (need & CVAR_NEED_HESS) k.Fyy = buf + m + 2 * nm, k.Fyp = k.Fyy + nnm, k.Fpp = k.Fyp + nnm;
+    if (q->ic[r].K(m, x, y, v, need, &k, q->ic[r].user) != 0) {
+      rc = -1;
+      break;
+    }
+    for (int j = 0; j < m; j++) o->F[j] += mu[r] * k.F[j];
+    for (size_t j = 0; (need & CVAR_NEED_GRAD) && j < nm; j++)
+      o->Fy[j] += mu[r] * k.Fy[j], o->Fp[j] += mu[r] * k.Fp[j];
+    for (size_t j = 0; (need & CVAR_NEED_HESS) && j < nnm; j++)
+      o->Fyy[j] += mu[r] * k.Fyy[j], o->Fyp[j] += mu[r] * k.Fyp[j], o->Fpp[j] += mu[r] * k.Fpp[j];
+  }
+  cv_free(buf);
+  return rc;
+}
+
+/* L and its partials at one point (x, y, v). */
+static int eval_point(const cv_problem *q, const double *mu, double x, const double *y,
+                      const double *v, unsigned need, cv_partials *o) {
+  if (eval_lagrangian(q, mu, 1, &x, y, v, need, o) != 0 || !isfinite(o->F[0])) return -1;
   return 0;
 }
 
@@ -69,7 +97,9 @@ static cv_status end_reaction(const cv_solver *s, const cv_problem *q, int end, 
     }
   }
   cv_partials o = {F, Fy, Fp, NULL, NULL, NULL};
-  if (q->F(m, x, y, dy, CVAR_NEED_F | CVAR_NEED_GRAD, &o, q->user) != 0) return CVAR_ENONFINITE;
+  const double *mu = s->mult + (size_t)d->nodes * q->nc; /* the integrals' multipliers */
+  if (eval_lagrangian(q, mu, m, x, y, dy, CVAR_NEED_F | CVAR_NEED_GRAD, &o) != 0)
+    return CVAR_ENONFINITE;
   for (int i = 0; i < n; i++) {
     double sum = 0.0;
     for (int k = 0; k < m; k++)
@@ -83,15 +113,16 @@ static cv_status end_reaction(const cv_solver *s, const cv_problem *q, int end, 
 
 /* y' at the end from the momenta: Newton on F_y'(x, y, v) = P from v (the end element's
  * derivative). 0, or -1 when it does not converge (v then unchanged). */
-static int slope_from_momenta(const cv_problem *q, double x, const double *y, const double *P,
-                              double *v, double *buf) {
+static int slope_from_momenta(const cv_problem *q, const double *mu, double x, const double *y,
+                              const double *P, double *v, double *buf) {
   int n = q->n;
   double *w = buf, *F = w + n, *Fy = F + 1, *Fp = Fy + n, *Fyy = Fp + n, *Fyp = Fyy + n * n;
   double *Fpp = Fyp + n * n, *r = Fpp + n * n;
   memcpy(w, v, (size_t)n * sizeof *w);
   for (int it = 0; it < 40; it++) {
     cv_partials o = {F, Fy, Fp, Fyy, Fyp, Fpp};
-    if (eval_point(q, x, y, w, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, &o) != 0) return -1;
+    if (eval_point(q, mu, x, y, w, CVAR_NEED_F | CVAR_NEED_GRAD | CVAR_NEED_HESS, &o) != 0)
+      return -1;
     double dn = 0.0, vn = 0.0;
     for (int i = 0; i < n; i++) r[i] = Fp[i] - P[i];
     if (dense_solve(n, Fpp, r) != 0) return -1;
@@ -119,6 +150,7 @@ cv_status cv_ends_end_data(const cv_solver *s, const cv_problem *q, int end, int
   size_t need = (size_t)m * (4 * (size_t)n + 2) + 4 * (size_t)n * n + 8 * (size_t)n + 4;
   double *buf = cv_malloc(need * sizeof *buf), *R = buf ? buf + need - 2 * (size_t)n : NULL;
   cv_status st = CVAR_OK;
+  const double *mu = s->mult + (size_t)d->nodes * q->nc; /* the integrals' multipliers */
   if (!buf) return CVAR_ENOMEM;
   /* the end values, and y' of the end element there */
   cv_lagrange(pe, cv_disc_eref(d, e)->xi, end ? 1.0 : -1.0, phi, dphi);
@@ -131,12 +163,13 @@ cv_status cv_ends_end_data(const cv_solver *s, const cv_problem *q, int end, int
   if (mode == 0) {
     st = end_reaction(s, q, end, R, buf);
     for (int i = 0; i < n && !st; i++)
-      P[i] = !q->fixed[2 * i + end] ? 0.0 : end ? R[i] : -R[i];       /* free: natural */
-    if (!st && slope_from_momenta(q, x, y, P, v, buf) != 0) mode = 1; /* the element's y' */
+      P[i] = !q->fixed[2 * i + end] ? 0.0 : end ? R[i] : -R[i];           /* free: natural */
+    if (!st && slope_from_momenta(q, mu, x, y, P, v, buf) != 0) mode = 1; /* element's y' */
   }
   double *F = buf, *Fy = F + 1, *Fp = Fy + n;
   cv_partials o = {F, Fy, Fp, NULL, NULL, NULL};
-  if (!st && eval_point(q, x, y, v, CVAR_NEED_F | CVAR_NEED_GRAD, &o) != 0) st = CVAR_ENONFINITE;
+  if (!st && eval_point(q, mu, x, y, v, CVAR_NEED_F | CVAR_NEED_GRAD, &o) != 0)
+    st = CVAR_ENONFINITE;
   if (!st) {
     double sum = -F[0], mag = fabs(F[0]);
     for (int i = 0; i < n; i++) {

@@ -381,6 +381,8 @@ struct cv_solver {
    * dimension the Morse index and the free count include (0: no end moved). */
   struct cv_ends_state *ends;
   int ends_dim;
+  int ends_neg; /* 1 when the reduced action decreases along the end's motion (ME-4): the
+                 * Morse index is the inner one (morse) plus this */
 };
 CV_HOT cv_status cv_solve_mesh(cv_solver *s, const cv_problem *p);
 /* One solve of p on its fixed interval: adaptive (--adapt, --tol) or on the mesh set. */

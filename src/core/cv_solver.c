@@ -239,7 +239,9 @@ double cv_solver_get_action(const cv_solver *s) { return s ? s->action : NAN; }
 double cv_solver_get_gradient_norm(const cv_solver *s) { return s ? s->gnorm : NAN; }
 int cv_solver_get_num_iterations(const cv_solver *s) { return s ? s->iterations : 0; }
 double cv_solver_get_time(const cv_solver *s) { return s ? s->time : 0.0; }
-int cv_solver_get_morse_index(const cv_solver *s) { return s ? s->morse : -1; }
+int cv_solver_get_morse_index(const cv_solver *s) {
+  return !s ? -1 : s->morse >= 0 ? s->morse + s->ends_neg : s->morse; /* ends: ME-4 */
+}
 int cv_solver_get_degenerate(const cv_solver *s) { return s ? s->degenerate : 0; }
 
 cv_status cv_solver_get_nodes(const cv_solver *s, double *x) {

@@ -129,6 +129,7 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
     bad = bad || cv_problem_add_integral(p, ex_integrand_eval, w->phase, c, NULL) != CVAR_OK;
   }
   (void)b;
+  if (!bad) bad = scene_problem_set_ends(s, p, NULL, 0) < 0; /* [ends] (scene_ends.c) */
   if (bad) {
     cv_problem_free(p);
     return NULL;

@@ -176,14 +176,9 @@ int sc_load_ends(sc_loader *L) {
       return -1;
     }
     seen[end] = en->line;
-    if (seen[!end]) {
+    if (s->ncons > 0) {
       sc_err(L->err, L->errlen, L->file, en->line,
-             "[ends]: both ends of the interval move; one moving end at a time is supported");
-      return -1;
-    }
-    if (s->ncons > 0 || s->nints > 0) {
-      sc_err(L->err, L->errlen, L->file, en->line,
-             "[ends] %s: a moving end with [constraints] or [integrals] is not supported", en->key);
+             "[ends] %s: a moving end with [constraints] is not supported", en->key);
       return -1;
     }
     if (load_end(L, en, end) < 0) return -1;

@@ -155,11 +155,69 @@ for flags in [(), ("--tol", "1e-8")]:
         check(what + " path %d max_nodal" % (k + 1),
               s.get("error", {}).get("max_nodal", 1) <= 1e-10, 1e-10, s.get("error"))
 
+# Without [exact]: both paths of --all get their error estimate (the enriched solve of the
+# inner problem on the solved interval; the far side's index 1 is the end's, ME-4).
+j, rows = solve("point_to_circle_r.scene", "--all")
+for k, s in enumerate(j.get("solutions", [])):
+    check("point_to_circle_r --all path %d error_estimate" % (k + 1),
+          s.get("error_estimate", 1) <= 1e-12, "<= 1e-12", s.get("error_estimate"))
+
+# A degenerate family (every radius of a circle from its centre): reported as degenerate,
+# never as a minimum.
+j, rows = solve("centred_circle.scene")
+check("centred_circle stationary_kind", j.get("stationary_kind") == "degenerate", "degenerate",
+      j.get("stationary_kind"))
+near("centred_circle length", j.get("action"), 2.0, 1e-12)
+
+# A free end with an integral constraint: H of L = F + mu K (ME-2). T^2 = 3 sqrt(2),
+# mu = -2 sqrt(2)/T, action 4T/3. Default mesh: T off by 1.0e-4 (O(h^2)); --tol 1e-10: 0.
+Ta = math.sqrt(3 * math.sqrt(2))
+for flags, tol in [((), 5e-4), (("--tol", "1e-10"), 1e-10)]:
+    j, rows = solve("free_time_area.scene", *flags)
+    what = "free_time_area " + " ".join(flags)
+    common(what, j, rows, [(0, 0), (Ta, tol)], (4 * Ta / 3, tol))
+    near(what + " multiplier", j.get("multipliers", {}).get("area"), -2 * math.sqrt(2) / Ta, tol)
+    check(what + " error.max_nodal", j.get("error", {}).get("max_nodal", 1) <= 10 * tol, 10 * tol,
+          j.get("error"))
+
+# Both ends move (ME-6): between two circles, plain and under --tol 1e-10; measured end
+# points within 2.1e-13 and paths within 5.2e-13 of the exact segment.
+a2, b2 = 2 / math.sqrt(5), 6 - 2 / math.sqrt(5)
+for flags in [(), ("--tol", "1e-10")]:
+    j, rows = solve("two_circles.scene", *flags)
+    what = "two_circles " + " ".join(flags)
+    common(what, j, rows, [(a2, 1e-11), (b2, 1e-11)], (math.sqrt(45) - 2, 1e-11))
+    check(what + " error.max_nodal", j.get("error", {}).get("max_nodal", 1) <= 1e-11, 1e-11,
+          j.get("error"))
+# An autonomous integrand with both ends free: a family of shifts, reported degenerate.
+j, rows = solve("shift_family.scene")
+check("shift_family stationary_kind", j.get("stationary_kind") == "degenerate", "degenerate",
+      j.get("stationary_kind"))
+iv = j.get("interval", [0, 0])
+near("shift_family duration", iv[1] - iv[0], T, 1e-5)
+
+# batch: a radius per row, each row's length sqrt(13) - r (the end found per row).
+r = subprocess.run([calcvar, "batch", os.path.join(scenes, "point_to_circle_r.scene"),
+                    os.path.join(scenes, "radius.csv"), "--threads", "2"],
+                   capture_output=True, text=True, timeout=300)
+check("batch exit status", r.returncode == 0, 0, "%d (%s)" % (r.returncode, r.stderr.strip()))
+table = list(csv.DictReader(r.stdout.splitlines()))
+check("batch rows", len(table) == 4, 4, len(table))
+for row in table:
+    near("batch r=%s length" % row.get("r"), float(row.get("action") or "nan"),
+         math.sqrt(13) - float(row.get("r")), 1e-12)
+
 # No stationary end point: exit 1 and a sentence, never a converged report.
 j, rows = solve("collapse.scene", expect_rc=1)
 check("collapse status", j.get("status") not in (None, "converged"), "not converged",
       j.get("status"))
 check("collapse message", "collapses" in j.get("message", ""), "... collapses ...",
+      j.get("message"))
+
+j, rows = solve("runaway.scene", expect_rc=1)
+check("runaway status", j.get("status") not in (None, "converged"), "not converged",
+      j.get("status"))
+check("runaway message", "runs away" in j.get("message", ""), "... runs away ...",
       j.get("message"))
 
 print("%d checks, %d failures" % (checks, failures))
