@@ -306,7 +306,11 @@ static run_result run_ipopt_scaled(int E, int p, double obj_scaling, double *You
   r.status = IpoptSolve(ip, v, NULL, &obj, NULL, NULL, NULL, &d);
   r.t = now() - t0;
   r.iters = d.iters;
-  r.length = obj;
+  /* S_h at the point IPOPT returns (its last iterate when it stopped early; obj is then
+   * not set). */
+  disc_fill(&d, v);
+  r.length = action(&d);
+  (void)obj;
   FreeIpoptProblem(ip);
   if (Yout) {
     Yout[0] = Yout[d.N] = 0.0;
@@ -332,6 +336,18 @@ static run_result run_ipopt(int E, int p, double *Yout) {
  * Scaling the objective by 1/h makes the multipliers O(1). */
 static run_result run_ipopt_h(int E, int p, double *Yout) {
   return run_ipopt_scaled(E, p, (double)E / (B - A), Yout);
+}
+
+/* IPOPT's ApplicationReturnStatus (IpReturnCodes_inc.h) other than Solve_Succeeded. */
+static const char *ipopt_status_name(int st) {
+  switch (st) {
+  case Solved_To_Acceptable_Level: return "  Solved_To_Acceptable_Level";
+  case Search_Direction_Becomes_Too_Small: return "  Search_Direction_Becomes_Too_Small";
+  case Maximum_Iterations_Exceeded: return "  Maximum_Iterations_Exceeded";
+  case Maximum_CpuTime_Exceeded: return "  Maximum_CpuTime_Exceeded (60 s)";
+  case Restoration_Failed: return "  Restoration_Failed";
+  default: return "  IPOPT failed";
+  }
 }
 
 static int guess_fn(int m, const double *x, double *y, void *user) {
@@ -447,7 +463,7 @@ int main(int argc, char **argv) {
         double el = fabs(r[k].length - L);
         printf("%2d %7d  %-14s %10.2f %5d %9.1e %9.1e %8.2f %10.1e%s%s\n", deg, E, names[k],
                1e3 * r[k].t, r[k].iters, el, max_nodal_error(E, deg, Y[k]), r[k].t / r[0].t, diff,
-               ok ? "" : (k == 0 ? "  not converged" : "  not Solve_Succeeded"),
+               ok ? "" : (k == 0 ? "  not converged" : ipopt_status_name(r[k].status)),
                r[k].runs == 1 && reps > 1 ? "  (1 run)" : "");
         if (check && k < 2 && (!ok || el > 1e-4)) bad |= 1 << k;
         if (check && k > 0 && diff > 1e-6) bad |= 4;
