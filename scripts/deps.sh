@@ -17,10 +17,12 @@ $SUDO apt-get install -y -qq --no-install-recommends \
   python3-mesonpy python3-build patchelf python3-venv python3-scipy python3-sympy \
   doxygen groff-base \
   libopenmpi-dev openmpi-bin \
-  g++ libgeographiclib-dev geographiclib-tools strace >/dev/null
+  g++ libgeographiclib-dev geographiclib-tools strace \
+  coinor-libipopt-dev >/dev/null
 # doxygen, groff: the API reference and the man page (tests 'docs'); OpenMPI: calcvar batch
 # under mpirun (test batch_mpi); strace: --continue opens its scene once (test cli_batch);
-# g++ and GeographicLib: bench/bench_geodesic only.
+# g++ and GeographicLib: bench/bench_geodesic only. coinor-libipopt-dev (IPOPT, EPL-2.0):
+# bench/bench_ipopt and its test ipopt_disk only; the library does not link it.
 # python3-scipy also serves the solve_bvp comparison of bench/work_precision.py and
 # bench/bench_python.py (run them with /usr/bin/python3, docs/performance.md).
 # bench/tol_convergence.py needs only matplotlib.
