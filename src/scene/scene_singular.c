@@ -206,6 +206,9 @@ int scene_interior_singularity(const scene *s, cv_solver *sv, double *xs, double
   int rc = nc < 0 ? -1 : scene_interior_singularity_of(s, sv, nc, c, xs, alpha);
   cv_free(c);
   if (rc != 0) return rc;
+  /* the value scan evaluates F(x, y, y') along the path: not for a second-order integrand,
+   * whose F needs y'' too (C1 scenes have only the poles the syntax shows) */
+  if (s->c1) return 0;
   double x0; /* no pole the syntax shows: look for one in the values */
   int z = value_peak(s, sv, &x0);
   if (z <= 0) return z;
