@@ -466,6 +466,35 @@ static void end_point(const cv_solver *s, int end, double *pt) {
   for (int i = 0; i < d->n; i++) pt[1 + i] = s->y[node * d->n + i];
 }
 
+/* The end of a search by a fan of starts (ME-5, OB-7): the stop sentence (covered: what
+ * the starts covered), the paths by increasing action with the first selected, or the
+ * first start's failure when none converged. Returns the search's status. */
+static cv_status fan_finish(cv_solver *s, struct cv_pathset *ps, int max, cv_status st,
+                            cv_status first, const char *msg0, const char *covered, double t0) {
+  cv_search_info *info = &ps->info;
+  if (st == CVAR_ENOMEM || st == CVAR_ECANCELLED || st == CVAR_ECALLBACK)
+    cv_set_msg(info->stop, sizeof info->stop, "the search stopped: %s", s->msg);
+  else if (ps->n >= max)
+    cv_set_msg(info->stop, sizeof info->stop, "found the %d path%s asked for", max,
+               max == 1 ? "" : "s");
+  else
+    cv_set_msg(info->stop, sizeof info->stop, "%s", covered);
+  info->found = ps->n;
+  if (ps->n > 0) {
+    qsort(ps->v, (size_t)ps->n, sizeof *ps->v, by_action);
+    ps->sel = 0;
+    path_give(s, &ps->v[0]);
+    st = CVAR_OK;
+  } else if (st == CVAR_OK || st == first) {
+    st = first == CVAR_OK ? CVAR_EMAXITER : first;
+    memcpy(s->msg, msg0, sizeof s->msg);
+  }
+  s->paths = ps;
+  s->status = st;
+  s->time = cv_now() - t0;
+  return st;
+}
+
 /* Every stationary path of a problem with a moving end (theory ME-5): the moving-end solve
  * from the start's end point and from points moved +-1/2, +-1, ... +-2 intervals along the
  * end's motion (the free end or the curve); paths are one when their end points agree to
@@ -511,32 +540,14 @@ static cv_status all_moving_ends(cv_solver *s, const cv_problem *p, int max) {
     memcpy(pts + (size_t)ps->n * (n + 1), pt, ((size_t)n + 1) * sizeof *pt);
     path_take(&ps->v[ps->n++], s);
   }
-  if (st == CVAR_ENOMEM || st == CVAR_ECANCELLED || st == CVAR_ECALLBACK)
-    cv_set_msg(info->stop, sizeof info->stop, "the search stopped: %s", s->msg);
-  else if (ps->n >= max)
-    cv_set_msg(info->stop, sizeof info->stop, "found the %d path%s asked for", max,
-               max == 1 ? "" : "s");
-  else
-    cv_set_msg(info->stop, sizeof info->stop,
-               "every start was tried (the start's end point and %d points along the end's "
-               "motion)",
-               nshift - 1);
-  info->found = ps->n;
-  if (ps->n > 0) {
-    qsort(ps->v, (size_t)ps->n, sizeof *ps->v, by_action);
-    ps->sel = 0;
-    path_give(s, &ps->v[0]);
-    s->ends_dim = 1;
-    st = CVAR_OK;
-  } else if (st == CVAR_OK || st == first) {
-    st = first == CVAR_OK ? CVAR_EMAXITER : first;
-    memcpy(s->msg, msg0, sizeof s->msg);
-  }
+  char covered[200];
+  cv_set_msg(covered, sizeof covered,
+             "every start was tried (the start's end point and %d points along the end's motion)",
+             nshift - 1);
   cv_free(pts);
   cv_free(pt);
-  s->paths = ps;
-  s->status = st;
-  s->time = cv_now() - t0;
+  st = fan_finish(s, ps, max, st, first, msg0, covered, t0);
+  if (ps->n > 0) s->ends_dim = 1;
   return st;
 }
 
@@ -626,33 +637,15 @@ static cv_status all_obstacles(cv_solver *s, const cv_problem *p, int max) {
     ests[ps->n] = est;
     path_take(&ps->v[ps->n++], s);
   }
-  if (st == CVAR_ENOMEM || st == CVAR_ECANCELLED || st == CVAR_ECALLBACK)
-    cv_set_msg(info->stop, sizeof info->stop, "the search stopped: %s", s->msg);
-  else if (ps->n >= max)
-    cv_set_msg(info->stop, sizeof info->stop, "found the %d path%s asked for", max,
-               max == 1 ? "" : "s");
-  else
-    cv_set_msg(info->stop, sizeof info->stop,
-               "with obstacles the search tries %d starts: the %s scaled by 1, -1, 2, -2, 1/2, "
-               "-1/2, 3 and -3 about the line between the ends (no deflation)",
-               nk, bump ? "sine bump (b - a)/2 sin(pi (x - a)/(b - a))" : "guess");
-  info->found = ps->n;
-  if (ps->n > 0) {
-    qsort(ps->v, (size_t)ps->n, sizeof *ps->v, by_action);
-    ps->sel = 0;
-    path_give(s, &ps->v[0]);
-    st = CVAR_OK;
-  } else {
-    st = first == CVAR_OK ? CVAR_EMAXITER : first;
-    memcpy(s->msg, msg0, sizeof s->msg);
-  }
+  char covered[300];
+  cv_set_msg(covered, sizeof covered,
+             "with obstacles the search tries %d starts: the %s scaled by 1, -1, 2, -2, 1/2, "
+             "-1/2, 3 and -3 about the line between the ends (no deflation)",
+             nk, bump ? "sine bump (b - a)/2 sin(pi (x - a)/(b - a))" : "guess");
   cv_free(seen);
   cv_free(ests);
   cv_free(cur);
-  s->paths = ps;
-  s->status = st;
-  s->time = cv_now() - t0;
-  return st;
+  return fan_finish(s, ps, max, st, first, msg0, covered, t0);
 }
 
 cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
