@@ -55,7 +55,8 @@ def main():
                 bad += 1
                 continue
             err = r.stderr.decode(errors="replace")
-            rows = [l for l in data.split(b"\n")[1:] if l.strip(b" \t\r")]
+            # the header is the first line that is not blank (blank lines are skipped)
+            rows = [l for l in data.split(b"\n") if l.strip(b" \t\r")][1:]
             problem = None
             if r.returncode not in (0, 1, 2) or "Sanitizer" in err or "runtime error" in err:
                 problem = "exit %d: %s" % (r.returncode, err[:300])
