@@ -280,10 +280,9 @@ typedef struct {
   double *gK;   /* gradient of one integral constraint */
   /* Inequalities (cv_kkt_active.c, theory OB-2): per node and constraint, 1 when the
    * node's row imposes G = 0, 0 when it imposes lambda = 0; the weights c of the
-   * active-set rule; how many decisions the last evaluation changed. NULL without them. */
+   * active-set rule. NULL without them. */
   unsigned char *active;
   double *cw;
-  long changed;
   int frozen;    /* 1: evaluations keep the decisions (line-search trials along one step) */
   double on_tol; /* OB-2: |G| <= on_tol (relative) counts as on the obstacle at the start;
                   * 0: 1e-12 (a solved path); the NLopt engine sets its constraint tolerance */

@@ -100,9 +100,8 @@ cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len) {
   return CVAR_OK;
 }
 
-/* The active-set decision of inequality kc at a node (OB-2), counted in k->changed when it
- * differs from the last evaluation's. Its weight c = h / (m_j |grad G|^2), h the
- * Hessian's diagonal along grad G, is set at the first evaluation with a Hessian (Ax: the
+/* The active-set decision of inequality kc at a node (OB-2). Its weight
+ * c = h m_j / (|grad G|^4 (b - a)^2), h the Hessian's diagonal along grad G, is set at the first evaluation with a Hessian (Ax: the
  * action's part is assembled, the constraints' not yet) and kept for the run, so that
  * every evaluation of one Newton run decides by the same rule. */
 static int decide(cv_kkt *k, const double *Ax, long node, int kc, int sense, double g,
@@ -129,7 +128,6 @@ static int decide(cv_kkt *k, const double *Ax, long node, int kc, int sense, dou
     if (Ax) k->cw[at] = c;
   }
   int a = cv_kkt_active_rule(sense, g, lam, c, k->eps);
-  k->changed += a != k->active[at];
   k->active[at] = (unsigned char)a;
   return a;
 }
@@ -204,7 +202,6 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
     if (Ax) cv_dzero(Ax + cp[c], (size_t)(cp[c + 1] - cp[c]));
   }
   if (dreg) cv_dzero(dreg, (size_t)nf);
-  k->changed = 0;
   st = cv_assemble(&k->as, p->F, p->user, Y, S, G, cp, Ax, 1.0, 1);
   if (st) return st;
   double hmax = 0.0; /* largest diagonal entry of the action's Hessian, for delta */

@@ -22,7 +22,6 @@ cv_status cv_kkt_active_init(cv_kkt *k) {
   k->cw = cv_malloc((m ? m : 1) * sizeof *k->cw);
   if (!k->active || !k->cw) return CVAR_ENOMEM;
   for (size_t i = 0; i < m; i++) k->cw[i] = NAN;
-  k->changed = 0;
   return CVAR_OK;
 }
 
