@@ -6,20 +6,93 @@
 
 #include "cv_internal.h"
 
-/* OB-4: the end of a contact run whose outermost active node is xa, next to the free node
- * xo (gap go > 0), from the gap at the next free node xoo (goo). A path that leaves a smooth
- * obstacle does so with its first derivative continuous (a first-order integrand: the gap
- * grows like C (x - x0)^2) or, for a second-order integrand on C^1 elements, with its
- * second derivative continuous too (like C |x - x0|^3): gap^(1/k), k = 2 or 3, is linear in
- * x near x0, and x0 is its zero. The active node itself may lie just outside the true
- * contact (its gap is then below the solve's accuracy), so x0 is kept between xo and xin,
- * the next active node inwards (xa when there is none). Without a usable second free
- * node: xa. */
-static double contact_end(double xa, double xin, double xo, double go, double xoo, double goo,
-                          double k) {
+/* OB-4 (two nodes): the end of a contact run whose outermost active node is xa, next to
+ * the free node xo (gap go > 0), from the gap at the next free node xoo (goo). A path that
+ * leaves a smooth obstacle does so with its first derivative continuous (a first-order
+ * integrand: the gap grows like C (x - x0)^2) or, for a second-order integrand on C^1
+ * elements, with its second derivative continuous too (like C |x - x0|^3): gap^(1/k),
+ * k = 2 or 3, is linear in x near x0, and x0 is its zero. Used when the free side has too
+ * few nodes for the fit below. Without a usable second free node: xa. */
+static double contact_end2(double xa, double xo, double go, double xoo, double goo, double k) {
   if (!(go > 0) || !(goo > go) || !isfinite(xoo)) return xa;
   double so = pow(go, 1.0 / k), soo = pow(goo, 1.0 / k);
-  double x0 = xo - so * (xoo - xo) / (soo - so);
+  return xo - so * (xoo - xo) / (soo - so);
+}
+
+/* LAPACK's least-squares solver (Fortran calling convention, as in mech_dense.c). */
+void dgels_(const char *trans, const int *m, const int *n, const int *nrhs, double *a,
+            const int *lda, double *b, const int *ldb, double *work, const int *lwork, int *info);
+
+enum { FIT_MAXN = 500, FIT_MAXM = 8 };
+
+/* x0 from the polynomial of degree m fitted by least squares to the gap at the n free
+ * nodes x[1..n] (x[0] = xa, the outermost active node; gap at the same offsets), in
+ * t = (x - xa) / L, L = |x[n] - xa|: the zero of its (k-1)-th derivative nearest xa, by
+ * Newton from t = 0. NAN when the fit or Newton fails. w: (n + 1) (m + 2) + 64 doubles. */
+static double fit_root(const double *x, const double *gap, int n, int m, int k, double *w) {
+  int rows = n, cols = m + 1, one = 1, lw = 64, info = 0;
+  double xa = x[0], L = x[n] - xa, *A = w, *b = A + (size_t)rows * cols, *wk = b + rows;
+  for (int i = 0; i < rows; i++) {
+    double t = (x[i + 1] - xa) / L, tp = 1.0;
+    for (int c = 0; c < cols; c++, tp *= t) A[(size_t)c * rows + i] = tp;
+    b[i] = gap[i + 1];
+  }
+  dgels_("N", &rows, &cols, &one, A, &rows, b, &rows, wk, &lw, &info);
+  if (info) return NAN;
+  /* the (k-1)-th and k-th derivatives of sum b_c t^c at t */
+  double t = 0.0;
+  for (int it = 0; it < 40; it++) {
+    double p = 0.0, dp = 0.0;
+    for (int c = m; c >= k - 1; c--) {
+      double f = 1.0; /* c! / (c - k + 1)! */
+      for (int q = 0; q < k - 1; q++) f *= c - q;
+      dp = dp * t + p;
+      p = p * t + f * b[c];
+    }
+    /* p = P^(k-1)(t) by Horner on the shifted coefficients; dp its derivative */
+    if (!(fabs(dp) > 0)) return NAN;
+    double dt = p / dp;
+    t -= dt;
+    if (!isfinite(t) || fabs(t) > 4.0) return NAN;
+    if (fabs(dt) <= 1e-15 * (1.0 + fabs(t))) return xa + t * L;
+  }
+  return NAN;
+}
+
+/* OB-4: the end of a contact run. xs[0] is the run's outermost active node, xs[1..nf] the
+ * free nodes beyond it (in order away from the run), g the gap at the same nodes, xin the
+ * next active node inwards. The free path is smooth up to x0, where the gap has a zero of
+ * order k (k = 2, or 3 for a second-order integrand on C^1 elements): x0 is the zero of
+ * the (k-1)-th derivative of a polynomial fitted to the gap at the free nodes nearest the
+ * run. The fit has two errors that pull opposite ways: the path's error, divided by the
+ * window's width, and the polynomial's, which grows with it; among degrees k..8 and
+ * windows of widths growing by sqrt(2), the estimate is the one that changed least from
+ * the next smaller window. Kept between the first free node and xin (the outermost active
+ * node may lie just outside the true contact, its gap below the solve's accuracy). */
+static double contact_end(const double *xs, const double *g, int nf, double xin, double k,
+                          double *w) {
+  double xa = xs[0], xo = nf >= 1 ? xs[1] : NAN;
+  if (nf < 1) return xa;
+  double x0 = contact_end2(xa, xo, g[1], nf >= 2 ? xs[2] : NAN, nf >= 2 ? g[2] : NAN, k);
+  /* the windows: every distinct node count within L of xa, L = the farthest free node's
+   * distance divided by sqrt(2) repeatedly (the nodes are graded towards the end, so
+   * counts growing by a fixed factor would jump from the graded nodes to far ones) */
+  int nw = 0, ns[128];
+  double L = fabs(xs[nf] - xa), d1 = fabs(xo - xa);
+  for (int n = nf; L >= d1 && nw < 128; L *= 0.70710678118654752) { /* 1/sqrt(2) */
+    while (n > 0 && fabs(xs[n] - xa) > L) n--;
+    if (n && (!nw || ns[nw - 1] != n)) ns[nw++] = n;
+  }
+  double best = INFINITY;
+  for (int m = (int)k; m <= FIT_MAXM && w; m += m < 6 ? 1 : 2) {
+    double prev = NAN;
+    for (int i = nw - 1; i >= 0; i--) {
+      if (ns[i] < m + 3) continue;
+      double e = fit_root(xs, g, ns[i], m, (int)k, w);
+      if (isfinite(e) && isfinite(prev) && fabs(e - prev) < best) best = fabs(e - prev), x0 = e;
+      prev = e;
+    }
+  }
   double lo = xin < xo ? xin : xo, hi = xin < xo ? xo : xin;
   return x0 < lo ? lo : x0 > hi ? hi : x0;
 }
@@ -71,14 +144,21 @@ cv_status cv_solver_get_contact(const cv_solver *s, const cv_problem *p, int k, 
   if (!x) return CVAR_ENOMEM;
   cv_disc_fill_nodes(d, x);
   cv_status st = node_gaps(s, p, k, x, gap);
+  /* the free nodes beside a run's end, in order away from it, and the fit's workspace */
+  double *buf = cv_malloc((2 * (FIT_MAXN + 1) + (size_t)(FIT_MAXN + 1) * (FIT_MAXM + 2) + 64) *
+                          sizeof *buf);
+  double *xs = buf, *gs = buf ? buf + FIT_MAXN + 1 : NULL, *w = buf ? gs + FIT_MAXN + 1 : NULL;
+  if (!buf) st = CVAR_ENOMEM;
   /* active: a node with a multiplier that is nonzero (an inactive row ends with lambda = 0
-   * exactly) or that sits on the obstacle (a second-order problem's multiplier is a point
-   * load at each end of a contact arc and zero inside it) */
+   * exactly) or, for a second-order problem, that sits on the obstacle (its multiplier is a
+   * point load at each end of a contact arc and zero inside it). Not for a first-order one:
+   * there the free nodes next to a contact end have gaps C (x - x0)^2 that can be below any
+   * fixed threshold, and counting them in would move the end outwards by their spacing. */
   double gmax = 0.0, kexp = d->herm ? 3.0 : 2.0;
   for (long j = 0; j < N; j++) gmax = cv_fmax(gmax, fabs(gap[j]));
 #define ACTIVE(j)                                                                                  \
   (cv_disc_lidx(d, (j), k) >= 0 &&                                                                 \
-   (s->mult[(j)*d->nc + k] != 0.0 || fabs(gap[(j)]) <= 1e-12 * cv_fmax(gmax, 1.0)))
+   (s->mult[(j)*d->nc + k] != 0.0 || (d->herm && fabs(gap[(j)]) <= 1e-12 * cv_fmax(gmax, 1.0))))
   for (long j = 0; j < N && !st;) {
     if (!ACTIVE(j)) {
       j++;
@@ -86,18 +166,23 @@ cv_status cv_solver_get_contact(const cv_solver *s, const cv_problem *p, int k, 
     }
     long j1 = j;
     while (j1 + 1 < N && ACTIVE(j1 + 1)) j1++;
-    double xs = x[j], xe = x[j1];
-    if (j >= 1)
-      xs = contact_end(x[j], x[j1 > j ? j + 1 : j], x[j - 1], gap[j - 1], j >= 2 ? x[j - 2] : NAN,
-                       j >= 2 ? gap[j - 2] : NAN, kexp);
-    if (j1 + 1 < N)
-      xe = contact_end(x[j1], x[j1 > j ? j1 - 1 : j1], x[j1 + 1], gap[j1 + 1],
-                       j1 + 2 < N ? x[j1 + 2] : NAN, j1 + 2 < N ? gap[j1 + 2] : NAN, kexp);
-    if (*count < cap) iv[2 * *count] = xs, iv[2 * *count + 1] = xe;
+    double x0 = x[j], x1 = x[j1];
+    for (int side = 0; side < 2; side++) {
+      long ja = side ? j1 : j, dir = side ? 1 : -1, in = j1 > j ? ja - dir : ja;
+      int nf = 0;
+      xs[0] = x[ja], gs[0] = gap[ja];
+      for (long i = ja + dir; i >= 0 && i < N && nf < FIT_MAXN && !ACTIVE(i); i += dir)
+        ++nf, xs[nf] = x[i], gs[nf] = gap[i];
+      double e = contact_end(xs, gs, nf, x[in], kexp, w);
+      if (side) x1 = e;
+      else x0 = e;
+    }
+    if (*count < cap) iv[2 * *count] = x0, iv[2 * *count + 1] = x1;
     ++*count;
     j = j1 + 1;
   }
 #undef ACTIVE
+  cv_free(buf);
   cv_free(x);
   return st;
 }

@@ -1,7 +1,7 @@
 /* src/mech/mech_dense.c — the dense linear algebra of the equilibrium and its modes, with
  * LAPACK: a pseudo-inverse Newton step, the constraints' tangent space, the generalised
  * symmetric eigenproblem and the gyroscopic pencil (docs/theory.md (P-9), (P-10), (P-12),
- * (P-13)). The only file of the library that calls LAPACK.
+ * (P-13)). With cv_contact.c (a least-squares fit), the only files that call LAPACK.
  * SPDX-License-Identifier: MIT */
 #include <math.h>
 #include <string.h>
