@@ -145,8 +145,8 @@ cv_status cv_solver_get_contact(const cv_solver *s, const cv_problem *p, int k, 
   cv_disc_fill_nodes(d, x);
   cv_status st = node_gaps(s, p, k, x, gap);
   /* the free nodes beside a run's end, in order away from it, and the fit's workspace */
-  double *buf = cv_malloc((2 * (FIT_MAXN + 1) + (size_t)(FIT_MAXN + 1) * (FIT_MAXM + 2) + 64) *
-                          sizeof *buf);
+  double *buf =
+      cv_malloc((2 * (FIT_MAXN + 1) + (size_t)(FIT_MAXN + 1) * (FIT_MAXM + 2) + 64) * sizeof *buf);
   double *xs = buf, *gs = buf ? buf + FIT_MAXN + 1 : NULL, *w = buf ? gs + FIT_MAXN + 1 : NULL;
   if (!buf) st = CVAR_ENOMEM;
   /* active: a node with a multiplier that is nonzero (an inactive row ends with lambda = 0
@@ -174,8 +174,10 @@ cv_status cv_solver_get_contact(const cv_solver *s, const cv_problem *p, int k, 
       for (long i = ja + dir; i >= 0 && i < N && nf < FIT_MAXN && !ACTIVE(i); i += dir)
         ++nf, xs[nf] = x[i], gs[nf] = gap[i];
       double e = contact_end(xs, gs, nf, x[in], kexp, w);
-      if (side) x1 = e;
-      else x0 = e;
+      if (side)
+        x1 = e;
+      else
+        x0 = e;
     }
     if (*count < cap) iv[2 * *count] = x0, iv[2 * *count + 1] = x1;
     ++*count;
