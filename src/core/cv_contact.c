@@ -179,6 +179,7 @@ cv_status cv_solver_get_contact(const cv_solver *s, const cv_problem *p, int k, 
       else
         x0 = e;
     }
+    if (x0 > x1) x0 = x1 = 0.5 * (x0 + x1); /* ends fitted past each other: one point */
     if (*count < cap) iv[2 * *count] = x0, iv[2 * *count + 1] = x1;
     ++*count;
     j = j1 + 1;

@@ -288,6 +288,8 @@ typedef struct {
                   * 0: 1e-12 (a solved path); the NLopt engine sets its constraint tolerance */
   double gscale; /* OB-5: crossings smaller than this (1% of max |G| at the nodes) pass */
   double eps;    /* > 0: the penalised rows of the path-following (OB-3); 0: exact (OB-2) */
+  double tg, tl; /* OB-2b: round-off margins of G and lambda against flipping a node */
+  int all_ineq;  /* every pointwise constraint is an inequality (OB-3a's merit applies) */
 } cv_kkt;
 CV_HOT cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const int *colptr);
 CV_HOT void cv_kkt_free(cv_kkt *k);
@@ -310,7 +312,11 @@ double cv_contact_gap_term(const cv_solver *s, const cv_problem *p, double *eta)
 int cv_kkt_step_crosses(cv_kkt *k, const double *Y, const double *Yt);
 /* Decide the row of inequality kc at node j from its value g, multiplier lam and the
  * weight c (OB-2): 1 active (impose G = 0), 0 inactive (impose lambda = 0). */
-int cv_kkt_active_rule(int sense, double g, double lam, double c, double eps);
+/* OB-3a: the penalised action's extra term and the slope correction (cv_kkt.c). */
+int cv_kkt_penalty(cv_kkt *k, const double *Y, const double *M, const double *Yt, double *pen,
+                   double *dslope);
+int cv_kkt_active_rule(int sense, double g, double lam, double c, double eps, int was, double tg,
+                       double tl);
 /* The row of an inactive node (lambda = 0): residual, diagonal. */
 void cv_kkt_inactive_row(cv_kkt *k, long node, int kc, int row, double lam, double *G, double *Ax,
                          double *dreg);

@@ -33,6 +33,8 @@ cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const in
     k->gK = cv_malloc((size_t)d->nfree * sizeof *k->gK);
     if (!k->gK) return CVAR_ENOMEM;
   }
+  k->all_ineq = 1;
+  for (int kc = 0; kc < p->nc; kc++) k->all_ineq &= p->pc[kc].sense != 0;
   if (cv_kkt_has_inequalities(p)) return cv_kkt_active_init(k);
   return CVAR_OK;
 }
@@ -123,11 +125,13 @@ static int decide(cv_kkt *k, const double *Ax, long node, int kc, int sense, dou
     /* the node's stiffness along grad G, hd / m_j ~ F_y'y' / h^2, brought to the scale of
      * the whole interval, F_y'y' / (b - a)^2: the penalty of OB-3 at eps = 1 is then as soft
      * as the path is stiff on the whole interval, on any mesh */
-    double L = d->b - d->a;
-    c = g2 > 0 && hd > 0 ? hd * mj / (g2 * g2 * L * L) : 1.0;
+    double L = d->b - d->a, r = mj / L; /* a second-order integrand (C^1 elements): the
+                                         * diagonal is F_y''y'' / h^3, the interval's
+                                         * stiffness F_y''y'' / (b - a)^4 */
+    c = g2 > 0 && hd > 0 ? hd * mj / (g2 * g2 * L * L) * (d->herm ? r * r : 1.0) : 1.0;
     if (Ax) k->cw[at] = c;
   }
-  int a = cv_kkt_active_rule(sense, g, lam, c, k->eps);
+  int a = cv_kkt_active_rule(sense, g, lam, c, k->eps, k->active[at], k->tg, k->tl);
   k->active[at] = (unsigned char)a;
   return a;
 }
@@ -159,7 +163,12 @@ long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M) {
   const cv_disc *d = k->d;
   int nc = d->nc;
   long changed = 0;
-  double gmax = 0.0;
+  double gmax = 0.0, lmax = 0.0;
+  for (long j = 0; j < d->nodes; j++)
+    for (int kc = 0; kc < nc; kc++)
+      if (k->prob->pc[kc].sense) lmax = cv_fmax(lmax, fabs(M[(size_t)j * nc + kc]));
+  /* OB-2b: the margins, round-off of the largest |G| (last pass) and the largest |lambda| */
+  k->tg = 1e-12 * 1e2 * k->gscale, k->tl = 1e-10 * lmax;
   for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
     int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
     for (int kc = 0; kc < nc; kc++) {
@@ -172,7 +181,7 @@ long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M) {
         if (cv_disc_lidx(d, node, kc) < 0) continue;
         size_t at = (size_t)node * nc + kc;
         double c = isnan(k->cw[at]) ? 1.0 : k->cw[at];
-        int a = cv_kkt_active_rule(sense, g[t], M[at], c, k->eps);
+        int a = cv_kkt_active_rule(sense, g[t], M[at], c, k->eps, k->active[at], k->tg, k->tl);
         gmax = cv_fmax(gmax, fabs(g[t]));
         changed += a != k->active[at];
         k->active[at] = (unsigned char)a;
@@ -181,6 +190,48 @@ long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M) {
   }
   k->gscale = 1e-2 * gmax;
   return changed;
+}
+
+/* OB-3a: the penalised action's extra term at Y, P - S = sum_j m_j c_j / (2 eps)
+ * min(0, s G_j)^2 over the inequality rows, into *pen; with Yt (not NULL) also, into
+ * *dslope, the part of the slope of P along Yt - Y that the Lagrangian's gradient at
+ * (Y, M) lacks: sum_j m_j (lam*_j - lam_j) grad G_j . (Yt - Y), lam*_j = (c_j / eps) s
+ * min(0, s G_j) the multiplier that makes that gradient P's. Returns 0, or -1 when a
+ * constraint fails to evaluate. */
+int cv_kkt_penalty(cv_kkt *k, const double *Y, const double *M, const double *Yt, double *pen,
+                   double *dslope) {
+  const cv_disc *d = k->d;
+  int nc = d->nc, n = cn_of(d);
+  double P = 0.0, sl = 0.0;
+  unsigned need = CVAR_NEED_F | (Yt ? CVAR_NEED_GRAD : 0u);
+  for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
+    int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
+    for (int kc = 0; kc < nc; kc++) {
+      int sense = k->prob->pc[kc].sense;
+      double *g, *gy, *gyy;
+      if (!sense) continue;
+      if (eval_constraint(k, kc, Y, j0, m, need, &g, &gy, &gyy)) return -1;
+      for (int t = 0; t < m; t++) {
+        long node = j0 + t;
+        int row = cv_disc_lidx(d, node, kc);
+        if (row < 0) continue;
+        size_t at = (size_t)node * nc + kc;
+        double c = isnan(k->cw[at]) ? 1.0 : k->cw[at], mj = d->mass[row];
+        double v = sense * g[t] < 0 ? sense * g[t] : 0.0;
+        P += mj * c / (2.0 * k->eps) * v * v;
+        if (!Yt) continue;
+        double dg = 0.0;
+        for (int i = 0; i < n; i++) {
+          long di = vdof(d, node, i);
+          dg += gy[(size_t)i * m + t] * (Yt[di] - Y[di]);
+        }
+        sl += mj * (c / k->eps * sense * v - M[at]) * dg;
+      }
+    }
+  }
+  *pen = P;
+  if (dslope) *dslope = sl;
+  return isfinite(P) && isfinite(sl) ? 0 : -1;
 }
 
 /* Gradient and Hessian of the discrete Lagrangian

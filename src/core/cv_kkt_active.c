@@ -28,10 +28,17 @@ cv_status cv_kkt_active_init(cv_kkt *k) {
 /* OB-2: with the constraint written as s G >= 0 (s = sense) and the multiplier of the
  * Lagrangian F + lambda G, the complementarity conditions s G >= 0, s lambda <= 0,
  * lambda G = 0 are min(c s G, -s lambda) = 0. The row imposes whichever of the two
- * arguments is the smaller: c s G (the constraint, active) or -s lambda (inactive). */
-int cv_kkt_active_rule(int sense, double g, double lam, double c, double eps) {
-  if (eps > 0) return sense * g < 0; /* OB-3: the penalty acts where G is violated */
-  return -sense * lam > c * sense * g;
+ * arguments is the smaller: c s G (the constraint, active) or -s lambda (inactive).
+ * OB-2b: a node where both are zero to round-off (inside a contact arc of a second-order
+ * problem, where the path lies on the obstacle with no load) would flip at every step on
+ * the sign of its round-off, and the iteration would never settle; so a node changes side
+ * only when the quantity that moves it is beyond its margin: an active node is released
+ * when -s lambda < -tl, an inactive one taken when s G < -tg (was: the node's side now). */
+int cv_kkt_active_rule(int sense, double g, double lam, double c, double eps, int was, double tg,
+                       double tl) {
+  if (eps > 0) return sense * g < (was ? tg : -tg); /* OB-3: the penalty acts where G is violated */
+  double v = -sense * lam - c * sense * g;
+  return was ? v > -tl : v > c * tg;
 }
 
 /* An inactive node's multiplier row: -m_j lambda = 0 on the diagonal -m_j (a negative pivot,

@@ -379,7 +379,8 @@ typedef struct {
  * an error of the integrand with its message. */
 static cv_status line_search(cv_solver *s, cv_kkt *kkt, const cv_homotopy *h, newton_ws *w,
                              const double *Yc, const double *Mc, double *Ax, double S, double slope,
-                             double phi, double wn, int use_S, int timed, trial *t) {
+                             double phi, double wn, int use_S, int timed, const double *pm,
+                             trial *t) {
   t->alpha = 1.0, t->St = t->phit = t->rnt = 0.0, t->stale = 0;
   for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
     if (ls > 0) apply_step(w, Yc, Mc, t->alpha);
@@ -404,6 +405,16 @@ static cv_status line_search(cv_solver *s, cv_kkt *kkt, const cv_homotopy *h, ne
       if ((use_S && t->St <= S + ARMIJO * t->alpha * slope) || wn <= 1.0) {
         t->stale = 1;
         return CVAR_OK;
+      }
+      if (pm) { /* OB-3a: the penalised action P, pm = {P at the iterate, its slope} */
+        double pen;
+        if (cv_kkt_penalty(kkt, w->Yt, w->Mt, NULL, &pen, NULL) == 0 &&
+            t->St + pen <= pm[0] + ARMIJO * t->alpha * pm[1]) {
+          t->stale = 1;
+          return CVAR_OK;
+        }
+        t->alpha *= 0.5;
+        continue;
       }
       t->phit = residual(w->d, w->gt, &t->rnt);
       if (t->phit <= (1.0 - 2.0 * ARMIJO * t->alpha) * phi) return CVAR_OK;
@@ -545,9 +556,21 @@ static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
       cv_set_msg_converged(s->msg, sizeof s->msg, s->iterations);
       goto cleanup;
     }
+    /* OB-3a: in a penalty stage at a minimum (the reduced Hessian positive definite) the
+     * Newton step in y is the semismooth Newton step of the penalised action P, which is
+     * then the merit: the residual's norm need not fall along a step that changes the
+     * active set, and in a fourth-order problem it often does not */
+    double pm[2], *pmp = NULL;
+    if (kkt.active && kkt.eps > 0 && kkt.all_ineq && d->ni == 0 && neg == ncon) {
+      double pen, dsl, sly = 0.0;
+      for (int f = 0; f < nf; f++)
+        if (w.gof[f] >= 0) sly += w.g[f] * w.delta[f];
+      if (cv_kkt_penalty(&kkt, Yc, Mc, w.Yt, &pen, &dsl) == 0 && sly + dsl < 0)
+        pm[0] = S + pen, pm[1] = sly + dsl, pmp = pm;
+    }
     trial t;
     st = line_search(s, &kkt, h, &w, Yc, Mc, Ax, S, slope, phi, wn,
-                     neg == 0 && !constrained && slope < 0, timed, &t);
+                     neg == 0 && !constrained && slope < 0, timed, pmp, &t);
     if (st == CVAR_ESTALL)
       cv_set_msg(s->msg, sizeof s->msg,
                  "no progress: the line search found no decrease along the Newton step at "
@@ -661,6 +684,7 @@ cleanup:
 #define OB_DIRECT_ITERATIONS 12
 static cv_status run_staged(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M) {
   static const double eps[] = {1e-3, 1e-6, 1e-9, 0.0};
+  const size_t neps = sizeof eps / sizeof *eps;
   size_t ny = (size_t)d->ndof, nm = (size_t)d->nodes * d->nc + d->ni;
   double *save = cv_malloc((ny + nm + 1) * sizeof *save);
   if (!save) {
@@ -677,10 +701,21 @@ static cv_status run_staged(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
   if (st == CVAR_EMAXITER || st == CVAR_ESTALL || st == CVAR_EDIVERGED) {
     cv_dcopy(Y, save, ny);
     cv_dcopy(M, save + ny, nm);
-    for (size_t k = 0; k < sizeof eps / sizeof *eps; k++) {
+    int stages = 0; /* stages converged: their path saved */
+    for (size_t k = 0; k < neps; k++) {
       st = newton_run(s, p, d, Y, M, NULL, eps[k]);
       total += s->iterations;
-      if (st) break;
+      if (!st && eps[k] > 0) {
+        cv_dcopy(save, Y, ny), cv_dcopy(save + ny, M, nm), stages++;
+        continue;
+      }
+      int retry = st == CVAR_EMAXITER || st == CVAR_ESTALL || st == CVAR_EDIVERGED;
+      if (!st || !stages || eps[k] == 0.0 || !retry) break;
+      /* OB-3: a later stage that fails (a stiff penalty can make the active set of a
+       * fourth-order problem wander): the exact iteration from the last stage that
+       * converged */
+      cv_dcopy(Y, save, ny), cv_dcopy(M, save + ny, nm);
+      k = neps - 2;
     }
   }
   cv_free(save);

@@ -262,11 +262,15 @@ y' = 1, -1
 [constraints]
 cap = y - l <= 0
 """
-for E, deg in (("6", "3"), ("30", "3")):  # degrees 5 and 7 fail here (docs/obstacles.md)
+# Degrees 5 and 7 and 300 elements need the round-off margins of OB-2b (the nodes inside
+# the contact arc carry no load: without them they flip sides on round-off forever), the
+# penalised action as the merit (OB-3a) and the penalty weight scaled as a fourth-order
+# stiffness; 3000 x p3 and --tol still fail (docs/obstacles.md).
+for E, deg in (("6", "3"), ("30", "3"), ("30", "5"), ("30", "7"), ("24", "5"), ("300", "3")):
     p, _ = run(BD, "--elements", E, "--degree", deg, "--json", "-")
     r = json.loads(p.stdout) if p.stdout else {}
     check("Bryson-Denham %sx%s" % (E, deg), r.get("status") == "converged" and
-          abs(r["action"] - 4) <= 1e-12 and r["morse_index"] == 0, r.get("message"))
+          abs(r["action"] - 4) <= 1e-12 and r["morse_index"] == 0, (r.get("message"), r.get("action")))
     if r.get("status") == "converged":
         (x0, x1), = r["contact"]["cap"]
         check("Bryson-Denham contact %sx%s" % (E, deg),
