@@ -290,11 +290,18 @@ typedef struct {
   double eps;    /* > 0: the penalised rows of the path-following (OB-3); 0: exact (OB-2) */
   double tg, tl; /* OB-2b: round-off margins of G and lambda against flipping a node */
   int all_ineq;  /* every pointwise constraint is an inequality (OB-3a's merit applies) */
+  double hmax;   /* the action's largest Hessian diagonal at the last evaluation (C-4's delta) */
+  size_t *chg;   /* OB-2c: node * nc + k of the decisions the last update changed */
+  long nchg, chgcap;
 } cv_kkt;
 CV_HOT cv_status cv_kkt_init(cv_kkt *k, const cv_problem *p, const cv_disc *d, const int *colptr);
 CV_HOT void cv_kkt_free(cv_kkt *k);
 /* Reject pointwise constraints that fail at an end whose unknowns are all fixed. */
 cv_status cv_kkt_check_ends(cv_kkt *k, const double *Y, char *msg, size_t len);
+/* OB-2c: swap the rows of the nodes the last cv_kkt_update_active changed into the system
+ * (G, Ax, dreg) evaluated at (Y, M) with the old set. */
+cv_status cv_kkt_apply_changes(cv_kkt *k, const double *Y, const double *M, double *G, double *Ax,
+                               double *dreg);
 /* Inequalities (cv_kkt_active.c, theory OB-1, OB-2). 1 when the problem has any. */
 int cv_kkt_has_inequalities(const cv_problem *p);
 cv_status cv_kkt_active_init(cv_kkt *k);

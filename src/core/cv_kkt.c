@@ -46,6 +46,7 @@ void cv_kkt_free(cv_kkt *k) {
   cv_free(k->gK);
   cv_free(k->active);
   cv_free(k->cw);
+  cv_free(k->chg);
 }
 
 /* Position of entry (r, c), r <= c, in the upper-triangle column layout (E-2). */
@@ -164,6 +165,7 @@ long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M) {
   int nc = d->nc;
   long changed = 0;
   double gmax = 0.0, lmax = 0.0;
+  k->nchg = 0;
   for (long j = 0; j < d->nodes; j++)
     for (int kc = 0; kc < nc; kc++)
       if (k->prob->pc[kc].sense) lmax = cv_fmax(lmax, fabs(M[(size_t)j * nc + kc]));
@@ -183,7 +185,8 @@ long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M) {
         double c = isnan(k->cw[at]) ? 1.0 : k->cw[at];
         int a = cv_kkt_active_rule(sense, g[t], M[at], c, k->eps, k->active[at], k->tg, k->tl);
         gmax = cv_fmax(gmax, fabs(g[t]));
-        changed += a != k->active[at];
+        if (a != k->active[at] && k->chg && k->nchg < k->chgcap) k->chg[k->nchg] = at;
+        if (a != k->active[at]) k->nchg++, changed++;
         k->active[at] = (unsigned char)a;
       }
     }
@@ -234,6 +237,50 @@ int cv_kkt_penalty(cv_kkt *k, const double *Y, const double *M, const double *Yt
   return isfinite(P) && isfinite(sl) ? 0 : -1;
 }
 
+/* Row lam_jk of node j and constraint kc (C-1, OB-2, OB-3), and its terms in the y rows,
+ * from G_k at the node (g, its gradient gy and Hessian gyy with stride m): on = 1 an
+ * imposing row (m_j G, or m_j (G - eps lam / c) in a penalty stage), 0 an inactive one
+ * (lambda = 0). With sgn = -1 the y-row terms are taken out again (the row's own entries
+ * are written either way). */
+static cv_status constraint_row(cv_kkt *k, long node, int kc, int row, int on, double sgn, double g,
+                                const double *gy, const double *gyy, int m, double lam, double *G,
+                                double *Ax, double *dreg) {
+  const cv_disc *d = k->d;
+  const int *cp = k->colptr;
+  int n = cn_of(d), nc = d->nc, sense = k->prob->pc[kc].sense;
+  double mj = d->mass[row], gg = 0.0;
+  if (!on) {
+    if (sgn > 0) cv_kkt_inactive_row(k, node, kc, row, lam, G, Ax, dreg);
+    return CVAR_OK;
+  }
+  /* OB-3: an active row of the path-following imposes G = eps lambda / c */
+  double cw = sense ? k->cw[(size_t)node * nc + kc] : 1.0;
+  double pen = sense && k->eps > 0 ? k->eps / (isnan(cw) ? 1.0 : cw) : 0.0;
+  if (sgn > 0) G[row] = mj * (g - pen * lam);
+  for (int i = 0; i < n; i++) {
+    int fi = cv_disc_fidx(d, vdof(d, node, i));
+    double gi = gy[(size_t)i * m];
+    if (!isfinite(gi)) return CVAR_ENONFINITE;
+    if (fi < 0) continue;
+    G[fi] += sgn * mj * lam * gi;
+    gg += mj * mj * gi * gi;
+    if (!Ax) continue;
+    Ax[pos(cp, fi, row)] = sgn > 0 ? mj * gi : 0.0;
+    for (int i2 = i; i2 < n; i2++) { /* upper triangle: fi <= fi2 */
+      int fi2 = cv_disc_fidx(d, vdof(d, node, i2));
+      double h2 = gyy[(size_t)(i * n + i2) * m];
+      if (!isfinite(h2)) return CVAR_ENONFINITE;
+      if (fi2 >= 0) Ax[pos(cp, fi, fi2)] += sgn * mj * lam * h2;
+    }
+  }
+  if (Ax && sgn > 0) {
+    double delta = 1e-12 * gg / k->hmax;
+    Ax[pos(cp, row, row)] = pen > 0 ? -mj * pen : -delta;
+    if (dreg) dreg[row] = pen > 0 ? 0.0 : delta;
+  }
+  return CVAR_OK;
+}
+
 /* Gradient and Hessian of the discrete Lagrangian
  *   L_h = S_h(Y) + sum_j m_j sum_k lam_jk G_k(x_j, Y_j) + sum_r nu_r (I_r(Y) - c_r)
  * with respect to all unknowns (C-3); *S is S_h alone. The multiplier rows' diagonal gets
@@ -244,7 +291,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
   const cv_disc *d = k->d;
   const cv_problem *p = k->prob;
   const int *cp = k->colptr;
-  int n = cn_of(d), nc = d->nc, nf = d->nfree; /* n: the constraints' unknowns */
+  int nc = d->nc, nf = d->nfree;
   cv_status st;
   /* The assembly clears the node rows and columns as it goes; the integral multipliers'
    * rows and columns (the last ni, dense, C-3) are cleared here. */
@@ -283,6 +330,7 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
   }
 
   /* Pointwise constraints at the nodes (C-1): row lam_jk holds m_j G_k(x_j, Y_j). */
+  if (Ax) k->hmax = hmax;
   unsigned need = CVAR_NEED_F | CVAR_NEED_GRAD | (Ax ? CVAR_NEED_HESS : 0u);
   for (long j0 = 0; j0 < d->nodes && nc > 0; j0 += CV_BATCH) {
     int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
@@ -295,39 +343,40 @@ cv_status cv_kkt_eval(cv_kkt *k, const double *Y, const double *M, double *S, do
         long node = j0 + t;
         int row = cv_disc_lidx(d, node, kc);
         if (row < 0) continue;
-        double mj = d->mass[row], lam = M[node * nc + kc], gg = 0.0;
+        double lam = M[node * nc + kc];
         if (!isfinite(g[t])) return CVAR_ENONFINITE;
-        if (sense && !decide(k, Ax, node, kc, sense, g[t], gy + t, m, lam)) {
-          cv_kkt_inactive_row(k, node, kc, row, lam, G, Ax, dreg);
-          continue;
-        }
-        /* OB-3: an active row of the path-following imposes G = eps lambda / c */
-        double cw = sense ? k->cw[(size_t)node * nc + kc] : 1.0;
-        double pen = sense && k->eps > 0 ? k->eps / (isnan(cw) ? 1.0 : cw) : 0.0;
-        G[row] = mj * (g[t] - pen * lam);
-        for (int i = 0; i < n; i++) {
-          int fi = cv_disc_fidx(d, vdof(d, node, i));
-          if (!isfinite(gy[i * m + t])) return CVAR_ENONFINITE;
-          if (fi < 0) continue;
-          G[fi] += mj * lam * gy[i * m + t];
-          gg += mj * mj * gy[i * m + t] * gy[i * m + t];
-          if (!Ax) continue;
-          Ax[pos(cp, fi, row)] = mj * gy[i * m + t];
-          for (int i2 = i; i2 < n; i2++) { /* upper triangle: fi <= fi2 */
-            int fi2 = cv_disc_fidx(d, vdof(d, node, i2));
-            double h2 = gyy[(i * n + i2) * m + t];
-            if (!isfinite(h2)) return CVAR_ENONFINITE;
-            if (fi2 >= 0) Ax[pos(cp, fi, fi2)] += mj * lam * h2;
-          }
-        }
-        if (Ax) {
-          double delta = 1e-12 * gg / hmax;
-          Ax[pos(cp, row, row)] = pen > 0 ? -mj * pen : -delta;
-          if (dreg) dreg[row] = pen > 0 ? 0.0 : delta;
-        }
+        int on = !sense || decide(k, Ax, node, kc, sense, g[t], gy + t, m, lam);
+        st = constraint_row(k, node, kc, row, on, 1.0, g[t], gy + t, gyy + t, m, lam, G, Ax, dreg);
+        if (st) return st;
       }
     }
   }
+  return CVAR_OK;
+}
+
+/* OB-2c: after cv_kkt_update_active changed the set at the point (Y, M) whose system
+ * (G, Ax, dreg) was evaluated with the old set, only the changed nodes' rows and their
+ * terms in the y rows differ: those are swapped in place (the old row's terms taken out,
+ * the new row's put in) instead of evaluating the whole system again. */
+cv_status cv_kkt_apply_changes(cv_kkt *k, const double *Y, const double *M, double *G, double *Ax,
+                               double *dreg) {
+  const cv_disc *d = k->d;
+  int nc = d->nc;
+  unsigned need = CVAR_NEED_F | CVAR_NEED_GRAD | (Ax ? CVAR_NEED_HESS : 0u);
+  for (long c = 0; c < k->nchg; c++) {
+    size_t at = k->chg[c];
+    long node = (long)(at / (size_t)nc);
+    int kc = (int)(at % (size_t)nc), row = cv_disc_lidx(d, node, kc);
+    double *g, *gy, *gyy, lam = M[at];
+    cv_status st = eval_constraint(k, kc, Y, node, 1, need, &g, &gy, &gyy);
+    if (st) return st;
+    if (!isfinite(g[0])) return CVAR_ENONFINITE;
+    int on = k->active[at];
+    st = constraint_row(k, node, kc, row, !on, -1.0, g[0], gy, gyy, 1, lam, G, Ax, dreg);
+    if (!st) st = constraint_row(k, node, kc, row, on, 1.0, g[0], gy, gyy, 1, lam, G, Ax, dreg);
+    if (st) return st;
+  }
+  k->nchg = 0;
   return CVAR_OK;
 }
 

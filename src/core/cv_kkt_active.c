@@ -20,7 +20,9 @@ cv_status cv_kkt_active_init(cv_kkt *k) {
   size_t m = (size_t)k->d->nodes * (size_t)k->d->nc;
   k->active = cv_calloc(m ? m : 1, 1);
   k->cw = cv_malloc((m ? m : 1) * sizeof *k->cw);
-  if (!k->active || !k->cw) return CVAR_ENOMEM;
+  k->chg = cv_malloc((m ? m : 1) * sizeof *k->chg);
+  k->chgcap = (long)m;
+  if (!k->active || !k->cw || !k->chg) return CVAR_ENOMEM;
   for (size_t i = 0; i < m; i++) k->cw[i] = NAN;
   return CVAR_OK;
 }

@@ -172,6 +172,9 @@ static cv_status eval_system(cv_kkt *kkt, const cv_homotopy *h, const newton_ws 
  * x_{k+1} = x_k + Kd^{-1} (b - K x_k) = x_k - Kd^{-1} (dreg .* x_k). */
 static cv_status solve_refined(newton_ws *w, int nf, int regularised) {
   cv_status st = cv_ldlt_solve(w->L, w->delta);
+  int any = 0; /* no regularised row (a penalty stage, OB-3): K is Kd, nothing to refine */
+  for (int f = 0; f < nf && regularised && !any; f++) any = w->dreg[f] != 0.0;
+  regularised = any;
   for (int it = 0; it < REFINE_STEPS && regularised && !st; it++) {
     for (int f = 0; f < nf; f++) w->corr[f] = -w->dreg[f] * w->delta[f];
     st = cv_ldlt_solve(w->L, w->corr);
@@ -413,8 +416,6 @@ static cv_status line_search(cv_solver *s, cv_kkt *kkt, const cv_homotopy *h, ne
           t->stale = 1;
           return CVAR_OK;
         }
-        t->alpha *= 0.5;
-        continue;
       }
       t->phit = residual(w->d, w->gt, &t->rnt);
       if (t->phit <= (1.0 - 2.0 * ARMIJO * t->alpha) * phi) return CVAR_OK;
@@ -565,7 +566,9 @@ static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
       double pen, dsl, sly = 0.0;
       for (int f = 0; f < nf; f++)
         if (w.gof[f] >= 0) sly += w.g[f] * w.delta[f];
-      if (cv_kkt_penalty(&kkt, Yc, Mc, w.Yt, &pen, &dsl) == 0 && sly + dsl < 0)
+      /* a decrease of P below its round-off cannot be seen: then the residual alone */
+      if (cv_kkt_penalty(&kkt, Yc, Mc, w.Yt, &pen, &dsl) == 0 &&
+          sly + dsl < -1e-10 * (fabs(S + pen) + 1.0))
         pm[0] = S + pen, pm[1] = sly + dsl, pmp = pm;
     }
     trial t;
@@ -624,9 +627,13 @@ static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
       }
       if (ch > 0) {
         done = 0;
-        kkt.frozen = 0;
-        st = eval_system(&kkt, h, &w, Yc, Mc, &S, w.g, Ax, w.dreg);
-        kkt.frozen = 1;
+        if (!h && kkt.nchg <= kkt.chgcap) {
+          st = cv_kkt_apply_changes(&kkt, Yc, Mc, w.g, Ax, w.dreg); /* OB-2c */
+        } else {
+          kkt.frozen = 0;
+          st = eval_system(&kkt, h, &w, Yc, Mc, &S, w.g, Ax, w.dreg);
+          kkt.frozen = 1;
+        }
         if (st) {
           cv_set_msg(s->msg, sizeof s->msg, "%s", where_failed(st));
           goto cleanup;
