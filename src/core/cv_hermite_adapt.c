@@ -132,11 +132,12 @@ cv_status cv_hermite_adapt(cv_solver *s, const cv_problem *p) {
     s->err_est = est;
     warm = 1;
     if (est <= tol) {
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "accuracy reached on %d elements of degree %d (%d nodes) after %d round%s, %ld "
-                 "Newton iterations in all; estimated max nodal error %.2g <= %.2g",
-                 E, 2 * r + 1, s->disc.nodes, s->rounds, s->rounds == 1 ? "" : "s", iters, est,
-                 tol);
+      cv_set_msg(
+          s->msg, sizeof s->msg,
+          "accuracy reached on %d elements of degree %d (%d nodes) after %d round%s, %ld "
+          "Newton iterations in all; estimated max error (at the nodes and inside the elements) "
+          "%.2g <= %.2g",
+          E, 2 * r + 1, s->disc.nodes, s->rounds, s->rounds == 1 ? "" : "s", iters, est, tol);
       st = CVAR_OK;
       goto cleanup;
     }
@@ -157,11 +158,13 @@ cv_status cv_hermite_adapt(cv_solver *s, const cv_problem *p) {
     long size = s->hp ? (long)E * r + 1 : E;
     if (!stop && size > s->adapt_max) stop = "the next mesh would exceed the cap";
     if (stop) {
-      cv_set_msg(s->msg, sizeof s->msg,
-                 "%s after %d round%s (cap %d %s): the estimated max nodal error reached is "
-                 "%.2g > %.2g",
-                 stop, s->rounds, s->rounds == 1 ? "" : "s", s->adapt_max,
-                 s->hp ? "nodes" : "elements", est, tol);
+      cv_set_msg(
+          s->msg, sizeof s->msg,
+          "%s after %d round%s (cap %d %s): the estimated max error (at the nodes and inside the "
+          "elements) reached is "
+          "%.2g > %.2g",
+          stop, s->rounds, s->rounds == 1 ? "" : "s", s->adapt_max, s->hp ? "nodes" : "elements",
+          est, tol);
       st = CVAR_EMAXITER;
       goto cleanup;
     }

@@ -57,6 +57,43 @@ for deg, tol_nodal in ((3, 1e-15), (5, 1e-15), (7, 1e-15)):
             check("beam degree %d action" % deg, j["error"]["action"] <= 1e-16, j["error"])
         check("beam degree %d nodes" % deg, j["nodes"] == 4 * (deg - 1) // 2 + 1, j["nodes"])
 
+# ---- --tol must see the path between the cubic's exact vertex values (theory H-7a): on
+# ---- vertices alone it stopped at 4 x p3 with an estimate of 6e-14 and an action error of
+# ---- 2.7e-6. The estimate must bound the true error inside the elements (sampled at 9
+# ---- points per element from the CSV's values and slopes by the cubic Hermite
+# ---- interpolant, the solution's own polynomial at degree 3) within a factor 10.
+for deg in (3, 5):
+    rc, j, err = solve_json("simply_supported_beam.scene", "--tol", "1e-10", "--degree", str(deg))
+    check("beam --tol degree %d" % deg, rc == 0 and j["error"]["action"] <= 1e-9 and
+          j["error_estimate"] <= 1e-10, (rc, err, j.get("error"), j.get("error_estimate")))
+rc, rows = solve_csv("simply_supported_beam.scene", "--elements", "4", "--degree", "3")
+# the same scene without [exact] (with it the report gives the true error, not an estimate)
+bare = os.path.join(os.environ.get("TMPDIR", "/tmp"), "c1_beam_%d.scene" % os.getpid())
+with open(scene("simply_supported_beam.scene")) as f:
+    text = f.read()
+with open(bare, "w") as f:
+    f.write(text[:text.index("[exact]")])
+r = subprocess.run([calcvar, "solve", bare, "--elements", "4", "--degree", "3", "--json", "-",
+                    "--quiet"], capture_output=True, text=True, timeout=60)
+os.unlink(bare)
+rc2, j = r.returncode, (json.loads(r.stdout) if r.stdout.strip() else {})
+if rc == 0 and rc2 == 0:
+    pts = [tuple(float(v) for v in r) for r in rows[1:]]
+    ex = lambda x: x * (1 - 2 * x * x + x ** 3) / 24
+    true = 0.0
+    for (x0, w0, s0), (x1, w1, s1) in zip(pts, pts[1:]):
+        h = x1 - x0
+        for k in range(1, 10):
+            t = k / 10
+            H = (2 * t ** 3 - 3 * t * t + 1) * w0 + (t ** 3 - 2 * t * t + t) * h * s0 + \
+                (-2 * t ** 3 + 3 * t * t) * w1 + (t ** 3 - t * t) * h * s1
+            true = max(true, abs(H - ex(x0 + t * h)))
+    est = j.get("error_estimate", 0.0)
+    check("beam 4 x p3 estimate sees the interior", true > 1e-6 and 0.1 * true <= est <= 10 * true,
+          (true, est))
+else:
+    check("beam 4 x p3 csv/estimate", False, (rc, rc2, err))
+
 # ---- cantilever: values, the CSV slope column, and the natural conditions at the free end
 # ---- (moment EI w'' and shear EI w''' zero), read off the last element's quintic through
 # ---- its three nodes' values and slopes (an independent Hermite reconstruction)
