@@ -322,6 +322,8 @@ int cv_kkt_step_crosses(cv_kkt *k, const double *Y, const double *Yt);
 /* OB-3a: the penalised action's extra term and the slope correction (cv_kkt.c). */
 int cv_kkt_penalty(cv_kkt *k, const double *Y, const double *M, const double *Yt, double *pen,
                    double *dslope);
+/* OB-3b: a penalty stage's start set from the path's sinking (cv_kkt.c). */
+long cv_kkt_stage_start(cv_kkt *k, const double *Y, double frac);
 int cv_kkt_active_rule(int sense, double g, double lam, double c, double eps, int was, double tg,
                        double tl);
 /* The row of an inactive node (lambda = 0): residual, diagonal. */
@@ -381,6 +383,7 @@ struct cv_solver {
    * ends_ok[k]: the last solve's end k passed that check (cv_solve_mesh; cleared with the
    * results). */
   int polish, ends_passed[2], ends_ok[2];
+  int stage_start;          /* OB-3b: the Newton run is a penalty stage after a converged one */
   double search_work;       /* cv_solve_all's work limit (cv_deflation.c) */
   struct cv_pathset *paths; /* the paths of the last cv_solve_all (cv_deflation.c) */
   /* The sparse LDL^T of the Hessian pattern of `disc` (CHOLMOD common, pattern, symbolic

@@ -281,6 +281,36 @@ static cv_status constraint_row(cv_kkt *k, long node, int kc, int row, int on, d
   return CVAR_OK;
 }
 
+/* OB-3b: the start set of a penalty stage after another: active exactly where the path
+ * sinks into the obstacle by more than frac of its deepest sinking, -s G > frac max(-s G).
+ * Returns the number of active nodes, or -1 when a constraint fails to evaluate. */
+long cv_kkt_stage_start(cv_kkt *k, const double *Y, double frac) {
+  const cv_disc *d = k->d;
+  int nc = d->nc;
+  double pmax = 0.0;
+  long na = 0;
+  for (int pass = 0; pass < 2; pass++)
+    for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
+      int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
+      for (int kc = 0; kc < nc; kc++) {
+        int sense = k->prob->pc[kc].sense;
+        double *g, *gy, *gyy;
+        if (!sense) continue;
+        if (eval_constraint(k, kc, Y, j0, m, CVAR_NEED_F, &g, &gy, &gyy)) return -1;
+        for (int t = 0; t < m; t++) {
+          long node = j0 + t;
+          if (cv_disc_lidx(d, node, kc) < 0) continue;
+          size_t at = (size_t)node * nc + kc;
+          if (!pass)
+            pmax = cv_fmax(pmax, -sense * g[t]);
+          else
+            na += k->active[at] = -sense * g[t] > frac * pmax;
+        }
+      }
+    }
+  return na;
+}
+
 /* Gradient and Hessian of the discrete Lagrangian
  *   L_h = S_h(Y) + sum_j m_j sum_k lam_jk G_k(x_j, Y_j) + sum_r nu_r (I_r(Y) - c_r)
  * with respect to all unknowns (C-3); *S is S_h alone. The multiplier rows' diagonal gets

@@ -7,6 +7,9 @@
 
 #include "cv_internal.h"
 
+/* OB-3b: a stage's start set, the nodes sunk by more than this fraction of the deepest */
+#define OB_STAGE_START 0.5
+
 /* A pivot below this fraction of its diagonal entry is treated as a degenerate direction.
  * Round-off in a pivot of a well-posed problem is ~ eps * (condition of the leading block);
  * 1e-11 leaves three orders of magnitude for that while still catching exact invariances,
@@ -502,6 +505,22 @@ static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
   have_K = 1;
   kkt.frozen = kkt.active != NULL; /* OB-2: set at the start, then by cv_kkt_update_active */
   if (kkt.active && cv_kkt_update_active(&kkt, Y, M) < 0) kkt.gscale = 0.0; /* its gscale */
+  if (kkt.active && s->stage_start && eps > 0) {
+    /* OB-3b: a stage after a converged one starts from the nodes sunk deepest into the
+     * obstacle only (a set too small, which a step corrects at once where the path then
+     * crosses the obstacle), not from all the nodes the softer penalty let it sink at
+     * (a set too large, which steps shrink a few nodes at a time) */
+    if (cv_kkt_stage_start(&kkt, Y, OB_STAGE_START) < 0) {
+      st = CVAR_ENONFINITE;
+      cv_set_msg(s->msg, sizeof s->msg, "an inequality constraint is not finite at the start");
+      goto cleanup;
+    }
+    st = eval_system(&kkt, h, &w, Y, M, &S, w.g, Ax, w.dreg);
+    if (st) {
+      cv_set_msg(s->msg, sizeof s->msg, "%s at the start of a stage", where_failed(st));
+      goto cleanup;
+    }
+  }
   double phi = residual(d, w.g, &s->gnorm);
   /* After a step accepted on S alone the merit phi and the reported residual of the new
    * iterate are left to the next pass over g (the step norm below), not computed in a pass
@@ -710,7 +729,9 @@ static cv_status run_staged(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
     cv_dcopy(M, save + ny, nm);
     int stages = 0; /* stages converged: their path saved */
     for (size_t k = 0; k < neps; k++) {
+      s->stage_start = k > 0 && stages > 0;
       st = newton_run(s, p, d, Y, M, NULL, eps[k]);
+      s->stage_start = 0;
       total += s->iterations;
       if (!st && eps[k] > 0) {
         cv_dcopy(save, Y, ny), cv_dcopy(save + ny, M, nm), stages++;
