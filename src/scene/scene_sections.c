@@ -240,6 +240,17 @@ static long top_comparison(const char *v, int *sense, int *oplen) {
  * SCENES.md; theory OB-1). The right-hand side must be 0. */
 static int load_constraint(sc_loader *L, const sc_entry *e, sc_item *it, const char *what) {
   int sense = 0, oplen = 0;
+  const char *typo = strstr(e->value, "=>") ? "=>" : strstr(e->value, "=<") ? "=<" : NULL;
+  if (typo) {
+    sc_err(L->err, L->errlen, L->file, e->line, "%s: '%s' is not an operator; write '%s'", what,
+           typo, typo[1] == '>' ? ">=" : "<=");
+    return -1;
+  }
+  if (strstr(e->value, "==")) {
+    sc_err(L->err, L->errlen, L->file, e->line,
+           "%s: an equality is written 'name = G' (it imposes G = 0), without '=='", what);
+    return -1;
+  }
   long at = top_comparison(e->value, &sense, &oplen);
   if (at < 0) return (it->expr = sc_parse(L, e, 0, e->value, what)) < 0 ? -1 : 0;
   if (sense == 2) {
@@ -249,23 +260,25 @@ static int load_constraint(sc_loader *L, const sc_entry *e, sc_item *it, const c
   }
   const char *rhs = e->value + at + oplen;
   while (*rhs == ' ' || *rhs == '\t') rhs++;
-  double zero;
-  ex_id rnode;
+  double zero = 0.0;
   char *lhs = cv_malloc((size_t)at + 1);
   if (!lhs) return nomem(L, e->line);
   memcpy(lhs, e->value, (size_t)at);
   lhs[at] = '\0';
+  while (at > 0 && (lhs[at - 1] == ' ' || lhs[at - 1] == '\t')) lhs[--at] = '\0';
   int rc = (it->expr = sc_parse(L, e, 0, lhs, what)) < 0 ? -1 : 0;
-  cv_free(lhs);
-  if (rc == 0 && sc_parse_const_node(L, e, (int)(rhs - e->value), rhs, what, &zero, &rnode) < 0)
-    rc = -1;
-  if (rc == 0 && zero != 0.0) {
+  ex_id rnode = rc ? -1 : sc_parse(L, e, (int)(rhs - e->value), rhs, what);
+  if (rnode < 0) rc = -1;
+  /* the right side must be the number 0: anything else (a number, x, an unknown, a
+   * parameter) belongs in G */
+  if (rc == 0 && (ex_eval_const(L->s->dag, rnode, &zero) != 0 || zero != 0.0)) {
     sc_err(L->err, L->errlen, L->file, e->line,
            "%s: an inequality is written 'G >= 0' or 'G <= 0' with 0 on the right; move '%s' "
-           "into G",
-           what, rhs);
+           "into G: %s - (%s) %s 0",
+           what, rhs, lhs, rhs, sense > 0 ? ">=" : "<=");
     rc = -1;
   }
+  cv_free(lhs);
   it->sense = sense;
   return rc;
 }

@@ -278,7 +278,10 @@ for E, deg in (("6", "3"), ("30", "3"), ("30", "5"), ("30", "7"), ("24", "5"), (
 
 # Bad input: FILE:LINE and exit 2.
 for G, what in (("y - (1 - x^2) >= 0 + 1", "0 on the right"), ("y - (1 - x^2) > 0", "strict"),
-                ("y - 3 >= 0", "violated at the fixed end")):
+                ("y - 3 >= 0", "violated at the fixed end"),
+                ("y >= 1 - x^2", "move '1 - x^2' into G: y - (1 - x^2) >= 0"),
+                ("y - (1 - x^2) => 0", "'=>' is not an operator; write '>='"),
+                ("y - (1 - x^2) == 0", "without '=='")):
     p, name = run(BUMP % (G, "1"))
     check("bad %r exit 2" % G, p.returncode == 2, p.returncode)
     check("bad %r message" % G, (":9:" in p.stderr) and (what in p.stderr), p.stderr)
