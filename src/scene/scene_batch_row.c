@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/cv_reuse.h"
+#include "core/cv_table_internal.h"
 #include "scene/scene_batch_internal.h"
 
 /* Parameter values of a row into inst (every parameter: given ones from the row, the
@@ -95,6 +96,10 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
   for (int i = 0; i < s->nparams; i++) w->pv[i] = s->params[i].value;
   ex_integrand_set_params(w->F, w->pv);
   int bad = cv_problem_set_integrand(p, ex_integrand_eval, w->F) != CVAR_OK;
+  /* a table's note ("the path left the grid of table ...") leads a failed row's message,
+   * as in scene_problem.c */
+  if (!bad && ex_integrand_has_tables(w->F))
+    bad = cv_problem_add_note(p, ex_integrand_note, w->F) != CVAR_OK;
   for (int i = 0; i < s->n && !bad; i++)
     for (int end = 0; end < 2 && !bad; end++)
       bad = (s->bc[i].free_end[end]
@@ -110,11 +115,15 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
     ex_integrand_set_params(w->cons[k], w->pv);
     bad = cv_problem_add_constraint(p, ex_integrand_eval_constraint, w->cons[k], NULL) != CVAR_OK ||
           cv_problem_set_constraint_sense(p, k, s->cons[k].sense) != CVAR_OK;
+    if (!bad && ex_integrand_has_tables(w->cons[k]))
+      bad = cv_problem_add_note(p, ex_integrand_note, w->cons[k]) != CVAR_OK;
   }
   for (int k = 0; k < s->nints && !bad; k++) {
     ex_integrand_set_params(w->ints[k], w->pv);
     bad = cv_problem_add_integral(p, ex_integrand_eval, w->ints[k], s->ints[k].value, NULL) !=
           CVAR_OK;
+    if (!bad && ex_integrand_has_tables(w->ints[k]))
+      bad = cv_problem_add_note(p, ex_integrand_note, w->ints[k]) != CVAR_OK;
   }
   /* periodic unknowns and the phase condition, after [integrals] as in scene_problem.c
    * (PB-1, PB-2); the condition's constant from this row's guess at the ends */
