@@ -7,9 +7,8 @@
 #include "cv_internal.h"
 #include "cv_reuse.h"
 
-/* HP-7a's aim (cv_adapt.c PILOT_AIM8) and trusted rate (PILOT_RATE8): a tail at AIM x tol
- * gives a nodal error of 0.04 .. 0.7 tol on degree 8 */
-#define REUSE_AIM  10.0
+/* HP-7a's trusted rate (cv_adapt.c PILOT_RATE8); the aim is CV_REUSE_AIM (cv_reuse.h) */
+#define REUSE_AIM  CV_REUSE_AIM
 #define REUSE_RATE 0.75
 /* An element whose tail is far below the aim still counts as this share of one element
  * (the h^9 rule would merge it with many neighbours, which its rate does not promise). */
@@ -86,6 +85,12 @@ static cv_status values_at(const cv_solver *s, int E, const double *t, const int
     cv_free(*y);
     *y = NULL;
   }
+  return st;
+}
+
+cv_status cv_reuse_set_start(cv_solver *s, int E, const double *t, const int *deg) {
+  cv_status st = cv_solver_set_mesh_hp(s, E, t, deg);
+  if (s) s->handed_on = st == CVAR_OK;
   return st;
 }
 

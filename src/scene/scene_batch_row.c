@@ -431,7 +431,7 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
     goto done;
   }
   int tol = w->inst->tol > 0, reuse = tol && w->hp_E > 0;
-  if (reuse && cv_solver_set_mesh_hp(w->sv, w->hp_E, w->hp_t, w->hp_deg) != CVAR_OK) {
+  if (reuse && cv_reuse_set_start(w->sv, w->hp_E, w->hp_t, w->hp_deg) != CVAR_OK) {
     reuse = 0; /* the scene's own start mesh, as configured */
     if (scene_solver_configure(w->inst, w->sv, err, sizeof err) != CVAR_OK) {
       r->status = CVAR_EINVAL;
