@@ -88,6 +88,16 @@ static cv_status values_at(const cv_solver *s, int E, const double *t, const int
   return st;
 }
 
+void cv_reuse_node_fractions(int E, const double *t, const int *deg, double *u) {
+  double xi[CV_MAX_DEGREE + 1], w[CV_MAX_DEGREE + 1];
+  int j = 0;
+  for (int e = 0; e < E; e++) {
+    cv_gauss_lobatto(deg[e], xi, w);
+    for (int l = 0; l < deg[e]; l++) u[j++] = t[e] + 0.5 * (t[e + 1] - t[e]) * (xi[l] + 1.0);
+  }
+  u[0] = 0.0, u[j] = 1.0;
+}
+
 cv_status cv_reuse_set_start(cv_solver *s, int E, const double *t, const int *deg) {
   cv_status st = cv_solver_set_mesh_hp(s, E, t, deg);
   if (s) s->handed_on = st == CVAR_OK;

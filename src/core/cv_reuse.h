@@ -20,6 +20,10 @@
 cv_status cv_reuse_mesh(const cv_solver *s, int *E, double **t, int **deg, double **y,
                         int *coarsened);
 
+/** The nodes of the mesh (E, t, deg) as fractions of its interval, 1 + sum deg of them in
+ * order (Gauss-Lobatto within each element): where the values of cv_reuse_mesh's y are. */
+void cv_reuse_node_fractions(int E, const double *t, const int *deg, double *u);
+
 /** HP-9: set s's mesh to (E, t, deg), a mesh cv_reuse_mesh handed on, as the start of the
  * next --tol rounds (cv_solver_set_mesh_hp), and tell them so: their pilot (HP-7) then
  * refines a degree-8 start only when a tail is above the aim that mesh was laid for

@@ -274,14 +274,18 @@ static void plain_estimate(worker *w, const cv_problem *p, cv_batch_result *r, c
 }
 
 /* The start of a warm row (theory (B-2)): the previous solution, shifted by the line that
- * moves its fixed end values onto this row's (node by node on the same layout). */
+ * moves its fixed end values onto this row's (node by node on the same layout, the line
+ * taken at each node's place: a line in the node's number instead bends the shift
+ * wherever the nodes are not evenly spaced — Gauss-Lobatto nodes of degree 8 crowd at the
+ * element ends — and a large shift, a ray fan turning from one side to the other, then
+ * started Newton from a wavy path that left the velocity grid). */
 static int warm_start(worker *w) {
   const scene *s = w->inst;
   int n = s->n, nn = w->prev_len / n;
   double *y = cv_malloc((size_t)w->prev_len * sizeof *y);
   if (!y) return -1;
   for (int j = 0; j < nn; j++) {
-    double t = nn > 1 ? (double)j / (nn - 1) : 0.0; /* only the ends need to be exact */
+    double t = w->prev_u ? w->prev_u[j] : nn > 1 ? (double)j / (nn - 1) : 0.0;
     for (int i = 0; i < n; i++) {
       double da = s->bc[i].free_end[0] ? 0.0 : s->bc[i].value[0] - w->prev_end[i];
       double db = s->bc[i].free_end[1] ? 0.0 : s->bc[i].value[1] - w->prev_end[n + i];
@@ -310,8 +314,11 @@ static void keep_mesh(const cv_batch *b, worker *w, int row) {
   int len = 1;
   for (int e = 0; e < E; e++) len += deg[e];
   cv_free(w->prev);
+  cv_free(w->prev_u);
   w->prev = y;
   w->prev_len = len * s->n;
+  if ((w->prev_u = cv_malloc((size_t)len * sizeof *w->prev_u)))
+    cv_reuse_node_fractions(E, t, deg, w->prev_u);
   for (int i = 0; i < s->n; i++) {
     w->prev_end[i] = s->bc[i].value[0];
     w->prev_end[s->n + i] = s->bc[i].value[1];
@@ -323,14 +330,25 @@ static void keep_for_warm(worker *w, int row) {
   const scene *s = w->inst;
   int len = cv_solver_get_num_nodes(w->sv) * s->n;
   if (len <= 0) return;
-  if (len != w->prev_len) {
+  if (len != w->prev_len || !w->prev_u) {
     cv_free(w->prev);
+    cv_free(w->prev_u);
     w->prev = cv_malloc((size_t)len * sizeof *w->prev);
+    w->prev_u = cv_malloc((size_t)(len / s->n) * sizeof *w->prev_u);
     w->prev_len = w->prev ? len : 0;
   }
   if (!w->prev || cv_solver_get_values(w->sv, w->prev) != CVAR_OK) {
     w->prev_row = -2;
     return;
+  }
+  if (w->prev_u && cv_solver_get_nodes(w->sv, w->prev_u) == CVAR_OK) {
+    int nn = len / s->n;
+    double a = w->prev_u[0], L = w->prev_u[nn - 1] - a;
+    for (int j = 0; j < nn; j++) w->prev_u[j] = L > 0 ? (w->prev_u[j] - a) / L : 0.0;
+    w->prev_u[0] = 0.0, w->prev_u[nn - 1] = 1.0;
+  } else {
+    cv_free(w->prev_u);
+    w->prev_u = NULL;
   }
   for (int i = 0; i < s->n; i++) {
     w->prev_end[i] = s->bc[i].value[0];
