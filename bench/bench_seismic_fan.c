@@ -119,8 +119,9 @@ static void check(const char *path, const double *rows, long n, result *r) {
     r->failed = n;
     return;
   }
-  int cs = column(line, "status"), ca = column(line, "action"), cn = column(line, "error_max_nodal"),
-      ce = column(line, "error_estimate"), cm = column(line, "message");
+  int cs = column(line, "status"), ca = column(line, "action"),
+      cn = column(line, "error_max_nodal"), ce = column(line, "error_estimate"),
+      cm = column(line, "message");
   char v[4096];
   for (long i = 0; i < n && fgets(line, sizeof line, f); i++) {
     r->rows++;
