@@ -9,6 +9,7 @@
 
 #include "cv_hermite.h"
 #include "cv_internal.h"
+#include "cv_reuse.h"
 
 #define MAX_ROUNDS 80
 /* Rounds without halving the best estimate before the loop counts as stalled (HP-6): few
@@ -227,9 +228,11 @@ static int next_size(const cv_disc *d, const double *eta, const double *sigma, d
 /* HP-7: after the first solve, when every element has degree >= 4 and decays smoothly
  * (sigma >= 1) and the largest predicted next coefficient is above tol, refine by those
  * predictions (HP-4 with eta = the tail) without the estimate: the enriched solve of a mesh
- * predicted to be too coarse is skipped. 1 when it refined (E, t, deg replaced), 0 when not, -1 out of memory. */
+ * predicted to be too coarse is skipped. On a degree-8 mesh a batch row handed on (HP-9),
+ * laid for tails of CV_REUSE_AIM x tol, only a tail above that aim is a miss: the estimate
+ * decides the rest. 1 when it refined (E, t, deg replaced), 0 when not, -1 out of memory. */
 static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where, double tol,
-                        int keep_bounds, int *E, double **t, int **deg) {
+                        int keep_bounds, int handed_on, int *E, double **t, int **deg) {
   const cv_disc *d = &s->disc;
   double tmax = 0.0;
   /* HP-7a lays new boundaries: not with breakpoints, which must stay boundaries */
@@ -243,7 +246,7 @@ static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where
     tmax = fmax(tmax, tail[e]);
     where[e] = 0.0;
   }
-  if (!(tmax > PILOT_MISS * tol)) return 0;
+  if (!(tmax > (all8 && handed_on ? CV_REUSE_AIM : PILOT_MISS) * tol)) return 0;
   if (all8 ? cv_hp_pilot_mesh(d, tail, PILOT_AIM8 * tol, &En, &tn, &dn)
            : cv_hp_refine(d, tail, sigma, where, 0.25 * tmax, PILOT_AIM * tol, 1, &En, &tn, &dn))
     return -1;
@@ -309,6 +312,8 @@ static void prefix_msg(cv_solver *s, const char *pre) {
  * estimate, refine. Ends with s holding the last round's solution and s->err_est. */
 cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   cv_status st;
+  int handed_on = s->handed_on; /* the start is a mesh a batch row handed on (HP-9) */
+  s->handed_on = 0;
   if (p->c1) return cv_hermite_adapt(s, p); /* C^1 elements: H-7, H-8 */
   cv_solver *f = cv_solver_new(&st);
   double *t = NULL, *eta = NULL, *sigma = NULL, *where = NULL;
@@ -368,7 +373,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       goto cleanup;
     }
     if (s->hp && s->rounds == 1) { /* HP-7: the first solve's own coefficients */
-      int r = pilot_refine(s, eta, sigma, where, tol, spec0.nbreak > 0, &E, &t, &deg);
+      int r = pilot_refine(s, eta, sigma, where, tol, spec0.nbreak > 0, handed_on, &E, &t, &deg);
       if (r < 0) {
         st = CVAR_ENOMEM;
         goto cleanup;

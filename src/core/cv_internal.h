@@ -367,6 +367,9 @@ struct cv_solver {
   double t_assemble, t_factor; /* seconds in assembly / LDL^T (bench/; from 512 unknowns) */
   double adapt_tol, err_est;   /* adaptive refinement (cv_adapt.c) */
   int adapt_max, rounds;
+  /* HP-9: the next rounds start from a mesh a batch row handed on (cv_reuse_set_start),
+   * laid for tails of at most CV_REUSE_AIM x tol; cleared when the rounds end */
+  int handed_on;
   double time_limit;        /* seconds for the rounds (HP-6); 0: none */
   int hp;                   /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
   int continuation, csteps; /* automatic continuation (cv_continuation.c) */

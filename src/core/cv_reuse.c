@@ -7,9 +7,8 @@
 #include "cv_internal.h"
 #include "cv_reuse.h"
 
-/* HP-7a's aim (cv_adapt.c PILOT_AIM8) and trusted rate (PILOT_RATE8): a tail at AIM x tol
- * gives a nodal error of 0.04 .. 0.7 tol on degree 8 */
-#define REUSE_AIM  10.0
+/* HP-7a's trusted rate (cv_adapt.c PILOT_RATE8); the aim is CV_REUSE_AIM (cv_reuse.h) */
+#define REUSE_AIM  CV_REUSE_AIM
 #define REUSE_RATE 0.75
 /* An element whose tail is far below the aim still counts as this share of one element
  * (the h^9 rule would merge it with many neighbours, which its rate does not promise). */
@@ -86,6 +85,22 @@ static cv_status values_at(const cv_solver *s, int E, const double *t, const int
     cv_free(*y);
     *y = NULL;
   }
+  return st;
+}
+
+void cv_reuse_node_fractions(int E, const double *t, const int *deg, double *u) {
+  double xi[CV_MAX_DEGREE + 1], w[CV_MAX_DEGREE + 1];
+  int j = 0;
+  for (int e = 0; e < E; e++) {
+    cv_gauss_lobatto(deg[e], xi, w);
+    for (int l = 0; l < deg[e]; l++) u[j++] = t[e] + 0.5 * (t[e + 1] - t[e]) * (xi[l] + 1.0);
+  }
+  u[0] = 0.0, u[j] = 1.0;
+}
+
+cv_status cv_reuse_set_start(cv_solver *s, int E, const double *t, const int *deg) {
+  cv_status st = cv_solver_set_mesh_hp(s, E, t, deg);
+  if (s) s->handed_on = st == CVAR_OK;
   return st;
 }
 

@@ -64,6 +64,7 @@ static void mesh_reset(cv_solver *s, int kind, int elements) {
   s->mesh.degrees = NULL;
   s->mesh.kind = kind;
   s->mesh.elements = elements;
+  s->handed_on = 0; /* a new mesh is no batch row's (cv_reuse_set_start marks one) */
 }
 
 cv_status cv_solver_set_elements(cv_solver *s, int elements) {

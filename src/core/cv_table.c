@@ -318,9 +318,48 @@ static void weights(int o, double t, double h, double w[4]) {
   }
 }
 
+/* The 4^d coefficients of the cell at `base` (dim 2 or 3), c[a_0 .. a_d-1] with a_k = 2 *
+ * (second derivative along k) + (corner along k), the last axis fastest: the order of the
+ * weights of TB-1. The last axis has stride 1, so each corner pair is adjacent. */
+static void gather(const cv_table *t, size_t base, double *c) {
+  const size_t s0 = t->stride[0], s1 = t->dim == 3 ? t->stride[1] : 0;
+  if (t->dim == 2) {
+    for (int mask = 0; mask < 4; mask++) {
+      const double *G = t->G[mask] + base;
+      int m0 = 2 * (mask & 1), m1 = mask & 2;
+      for (int c0 = 0; c0 < 2; c0++) {
+        const double *g = G + c0 * s0;
+        double *d = c + 4 * (m0 + c0) + m1;
+        d[0] = g[0], d[1] = g[1];
+      }
+    }
+    return;
+  }
+  for (int mask = 0; mask < 8; mask++) {
+    const double *G = t->G[mask] + base;
+    int m0 = 2 * (mask & 1), m1 = mask & 2, m2 = (mask >> 1) & 2;
+    for (int c0 = 0; c0 < 2; c0++)
+      for (int c1 = 0; c1 < 2; c1++) {
+        const double *g = G + c0 * s0 + c1 * s1;
+        double *d = c + 16 * (m0 + c0) + 4 * (m1 + c1) + m2;
+        d[0] = g[0], d[1] = g[1];
+      }
+  }
+}
+
+/* sum of w[a] r[a * stride] over a = 0..3 */
+static inline double dot4(const double *w, const double *r, int stride) {
+  return w[0] * r[0] + w[1] * r[stride] + w[2] * r[2 * stride] + w[3] * r[3 * stride];
+}
+
 /* TB-2 for several derivative orders at one point: the cell is found and the 4^d
  * coefficients (values and second-derivative arrays at the cell's corners) gathered once;
- * each order is then a contraction with per-axis weights, one axis at a time. */
+ * each order is then a contraction with per-axis weights, the first axis first. The
+ * weights of each axis and order, and the contractions over the first axis (per order
+ * along it) and over the first two (per pair of orders), are computed once and shared by
+ * the orders that begin alike: the partials of an integrand v(x, y, z) up to the second
+ * in y and z are all of order 0 in x, and six of them cost one contraction over x, three
+ * over y and six over z instead of six of each. */
 int cv_table_eval_multi(const cv_table *t, const double *u, int nord, const int (*ord)[3],
                         double *out) {
   int dim = t->dim;
@@ -337,50 +376,55 @@ int cv_table_eval_multi(const cv_table *t, const double *u, int nord, const int 
     tt[k] = (u[k] - a->x[i]) / hh[k];
     base += (size_t)i * t->stride[k];
   }
-  /* c[a_0 .. a_d-1], a_k = 2 * (second derivative along k) + (corner along k), the last
-   * axis fastest: the order of the weights of TB-1 */
   double c[64];
-  const size_t *st = t->stride;
   if (dim == 1) {
     c[0] = t->G[0][base], c[1] = t->G[0][base + 1];
     c[2] = t->G[1][base], c[3] = t->G[1][base + 1];
-  } else {
-    for (int mask = 0; mask < (1 << dim); mask++) {
-      const double *G = t->G[mask];
-      for (int cr = 0; cr < (1 << dim); cr++) {
-        size_t idx = base;
-        int lin = 0;
-        for (int k = 0; k < dim; k++) {
-          int ck = (cr >> k) & 1, mk = (mask >> k) & 1;
-          idx += (size_t)ck * st[k];
-          lin = lin * 4 + 2 * mk + ck;
-        }
-        c[lin] = G[idx];
-      }
+    for (int j = 0; j < nord; j++) {
+      double w[4];
+      weights(ord ? ord[j][0] : 0, tt[0], hh[0], w);
+      out[j] = dot4(w, c, 1);
     }
+    return 0;
   }
+  gather(t, base, c);
+  /* w[k][o]: the weights of axis k for order o (0..3; a higher order is zero), computed
+   * when first asked for (bit o of wset[k]); c1[o0]: c contracted over axis 0 with order
+   * o0 (4^(d-1) values); c2[4 o0 + o1]: over axes 0 and 1 (dim 3, 4 values) */
+  double w[3][4][4], c1[4][16], c2[16][4];
+  unsigned wset[3] = {0, 0, 0}, c1set = 0, c2set = 0;
+  int inner = dim == 3 ? 16 : 4;
   for (int j = 0; j < nord; j++) {
-    double w[3][4];
-    for (int k = 0; k < dim; k++) weights(ord ? ord[j][k] : 0, tt[k], hh[k], w[k]);
-    double sum = 0.0;
-    if (dim == 1) {
-      sum = w[0][0] * c[0] + w[0][1] * c[1] + w[0][2] * c[2] + w[0][3] * c[3];
-    } else if (dim == 2) {
-      for (int a = 0; a < 4; a++) {
-        const double *r = c + 4 * a;
-        sum += w[0][a] * (w[1][0] * r[0] + w[1][1] * r[1] + w[1][2] * r[2] + w[1][3] * r[3]);
+    int o[3] = {0, 0, 0}, zero = 0;
+    for (int k = 0; k < dim; k++) {
+      o[k] = ord ? ord[j][k] : 0;
+      if (o[k] < 0 || o[k] > 3) {
+        zero = 1;
+        break;
       }
-    } else {
-      for (int a = 0; a < 4; a++) {
-        double s1 = 0.0;
-        for (int b = 0; b < 4; b++) {
-          const double *r = c + 16 * a + 4 * b;
-          s1 += w[1][b] * (w[2][0] * r[0] + w[2][1] * r[1] + w[2][2] * r[2] + w[2][3] * r[3]);
-        }
-        sum += w[0][a] * s1;
+      if (!(wset[k] >> o[k] & 1u)) {
+        weights(o[k], tt[k], hh[k], w[k][o[k]]);
+        wset[k] |= 1u << o[k];
       }
     }
-    out[j] = sum;
+    if (zero) {
+      out[j] = 0.0;
+      continue;
+    }
+    if (!(c1set >> o[0] & 1u)) {
+      for (int q = 0; q < inner; q++) c1[o[0]][q] = dot4(w[0][o[0]], c + q, inner);
+      c1set |= 1u << o[0];
+    }
+    if (dim == 2) {
+      out[j] = dot4(w[1][o[1]], c1[o[0]], 1);
+      continue;
+    }
+    int key = 4 * o[0] + o[1];
+    if (!(c2set >> key & 1u)) {
+      for (int r = 0; r < 4; r++) c2[key][r] = dot4(w[1][o[1]], c1[o[0]] + r, 4);
+      c2set |= 1u << key;
+    }
+    out[j] = dot4(w[2][o[2]], c2[key], 1);
   }
   return 0;
 }

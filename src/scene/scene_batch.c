@@ -47,6 +47,7 @@ static void worker_free(cv_batch *b, worker *w) {
   cv_free(w->qv);
   cv_free(w->prev);
   cv_free(w->prev_end);
+  cv_free(w->prev_u);
   cv_free(w->hp_t);
   cv_free(w->hp_deg);
   cv_free(w->rv);

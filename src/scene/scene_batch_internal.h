@@ -24,6 +24,7 @@ typedef struct {
   double *prev; /* warm start: last converged nodal values */
   int prev_len, prev_row;
   double *prev_end; /* its end values [2n] */
+  double *prev_u;   /* where its nodes are, as fractions of its interval [prev_len / n] */
   /* --tol: the mesh the last converged row handed on (theory HP-9), on [0, 1] */
   int hp_E;
   double *hp_t;

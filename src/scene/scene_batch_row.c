@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "core/cv_reuse.h"
+#include "core/cv_table_internal.h"
 #include "scene/scene_batch_internal.h"
 
 /* Parameter values of a row into inst (every parameter: given ones from the row, the
@@ -95,6 +96,10 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
   for (int i = 0; i < s->nparams; i++) w->pv[i] = s->params[i].value;
   ex_integrand_set_params(w->F, w->pv);
   int bad = cv_problem_set_integrand(p, ex_integrand_eval, w->F) != CVAR_OK;
+  /* a table's note ("the path left the grid of table ...") leads a failed row's message,
+   * as in scene_problem.c */
+  if (!bad && ex_integrand_has_tables(w->F))
+    bad = cv_problem_add_note(p, ex_integrand_note, w->F) != CVAR_OK;
   for (int i = 0; i < s->n && !bad; i++)
     for (int end = 0; end < 2 && !bad; end++)
       bad = (s->bc[i].free_end[end]
@@ -110,11 +115,15 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
     ex_integrand_set_params(w->cons[k], w->pv);
     bad = cv_problem_add_constraint(p, ex_integrand_eval_constraint, w->cons[k], NULL) != CVAR_OK ||
           cv_problem_set_constraint_sense(p, k, s->cons[k].sense) != CVAR_OK;
+    if (!bad && ex_integrand_has_tables(w->cons[k]))
+      bad = cv_problem_add_note(p, ex_integrand_note, w->cons[k]) != CVAR_OK;
   }
   for (int k = 0; k < s->nints && !bad; k++) {
     ex_integrand_set_params(w->ints[k], w->pv);
     bad = cv_problem_add_integral(p, ex_integrand_eval, w->ints[k], s->ints[k].value, NULL) !=
           CVAR_OK;
+    if (!bad && ex_integrand_has_tables(w->ints[k]))
+      bad = cv_problem_add_note(p, ex_integrand_note, w->ints[k]) != CVAR_OK;
   }
   /* periodic unknowns and the phase condition, after [integrals] as in scene_problem.c
    * (PB-1, PB-2); the condition's constant from this row's guess at the ends */
@@ -265,14 +274,18 @@ static void plain_estimate(worker *w, const cv_problem *p, cv_batch_result *r, c
 }
 
 /* The start of a warm row (theory (B-2)): the previous solution, shifted by the line that
- * moves its fixed end values onto this row's (node by node on the same layout). */
+ * moves its fixed end values onto this row's (node by node on the same layout, the line
+ * taken at each node's place: a line in the node's number instead bends the shift
+ * wherever the nodes are not evenly spaced — Gauss-Lobatto nodes of degree 8 crowd at the
+ * element ends — and a large shift, a ray fan turning from one side to the other, then
+ * started Newton from a wavy path that left the velocity grid). */
 static int warm_start(worker *w) {
   const scene *s = w->inst;
   int n = s->n, nn = w->prev_len / n;
   double *y = cv_malloc((size_t)w->prev_len * sizeof *y);
   if (!y) return -1;
   for (int j = 0; j < nn; j++) {
-    double t = nn > 1 ? (double)j / (nn - 1) : 0.0; /* only the ends need to be exact */
+    double t = w->prev_u ? w->prev_u[j] : nn > 1 ? (double)j / (nn - 1) : 0.0;
     for (int i = 0; i < n; i++) {
       double da = s->bc[i].free_end[0] ? 0.0 : s->bc[i].value[0] - w->prev_end[i];
       double db = s->bc[i].free_end[1] ? 0.0 : s->bc[i].value[1] - w->prev_end[n + i];
@@ -301,8 +314,11 @@ static void keep_mesh(const cv_batch *b, worker *w, int row) {
   int len = 1;
   for (int e = 0; e < E; e++) len += deg[e];
   cv_free(w->prev);
+  cv_free(w->prev_u);
   w->prev = y;
   w->prev_len = len * s->n;
+  if ((w->prev_u = cv_malloc((size_t)len * sizeof *w->prev_u)))
+    cv_reuse_node_fractions(E, t, deg, w->prev_u);
   for (int i = 0; i < s->n; i++) {
     w->prev_end[i] = s->bc[i].value[0];
     w->prev_end[s->n + i] = s->bc[i].value[1];
@@ -314,14 +330,25 @@ static void keep_for_warm(worker *w, int row) {
   const scene *s = w->inst;
   int len = cv_solver_get_num_nodes(w->sv) * s->n;
   if (len <= 0) return;
-  if (len != w->prev_len) {
+  if (len != w->prev_len || !w->prev_u) {
     cv_free(w->prev);
+    cv_free(w->prev_u);
     w->prev = cv_malloc((size_t)len * sizeof *w->prev);
+    w->prev_u = cv_malloc((size_t)(len / s->n) * sizeof *w->prev_u);
     w->prev_len = w->prev ? len : 0;
   }
   if (!w->prev || cv_solver_get_values(w->sv, w->prev) != CVAR_OK) {
     w->prev_row = -2;
     return;
+  }
+  if (w->prev_u && cv_solver_get_nodes(w->sv, w->prev_u) == CVAR_OK) {
+    int nn = len / s->n;
+    double a = w->prev_u[0], L = w->prev_u[nn - 1] - a;
+    for (int j = 0; j < nn; j++) w->prev_u[j] = L > 0 ? (w->prev_u[j] - a) / L : 0.0;
+    w->prev_u[0] = 0.0, w->prev_u[nn - 1] = 1.0;
+  } else {
+    cv_free(w->prev_u);
+    w->prev_u = NULL;
   }
   for (int i = 0; i < s->n; i++) {
     w->prev_end[i] = s->bc[i].value[0];
@@ -422,7 +449,7 @@ void sc_batch_solve_row(cv_batch *b, worker *w, int row, const double *vals, cv_
     goto done;
   }
   int tol = w->inst->tol > 0, reuse = tol && w->hp_E > 0;
-  if (reuse && cv_solver_set_mesh_hp(w->sv, w->hp_E, w->hp_t, w->hp_deg) != CVAR_OK) {
+  if (reuse && cv_reuse_set_start(w->sv, w->hp_E, w->hp_t, w->hp_deg) != CVAR_OK) {
     reuse = 0; /* the scene's own start mesh, as configured */
     if (scene_solver_configure(w->inst, w->sv, err, sizeof err) != CVAR_OK) {
       r->status = CVAR_EINVAL;
