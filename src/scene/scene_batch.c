@@ -153,9 +153,17 @@ cv_batch *scene_batch_new(scene *s, char *err, size_t errlen) {
       goto nomem;
   /* Compile once: every expression of the problem with the parameters as inputs (y'' after
    * them and the width's slot, X-7). */
+  /* An integrand that jumps in y is compiled with the jumps smoothable, the width one more
+   * input after the parameters, as a solve compiles it (scene_problem.c, theory HC-4), so
+   * that each row is solved as `calcvar solve` would solve it. */
+  ex_id Fs =
+      s->c1 ? s->F : ex_smooth_jumps(s->dag, s->F, 1, 2 * s->n, 2 * s->n + 1 + b->np, &b->njumps);
+  if (Fs < 0) goto nomem;
   if (!(b->F =
             s->c1
                 ? ex_integrand_new_order(s->dag, s->n, b->np + 1, 2, s->F, b->need, msg, sizeof msg)
+            : b->njumps
+                ? ex_integrand_new_params(s->dag, s->n, b->np + 1, Fs, b->need, msg, sizeof msg)
                 : ex_integrand_new_params(s->dag, s->n, b->np, s->F, b->need, msg, sizeof msg))) {
     snprintf(err, errlen, "%s:%d: integrand: %s", s->file, s->F_line,
              msg[0] ? msg : "out of memory");

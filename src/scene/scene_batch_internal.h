@@ -38,6 +38,7 @@ struct cv_batch {
   int n, np;
   unsigned need;
   ex_integrand *F, **cons, **ints;
+  int njumps;          /* F's jumps in y, smoothable over a width after the parameters (HC-4) */
   ex_integrand *phase; /* K of the phase condition when the scene pins the shift (PB-2) */
   ex_tape *rep;        /* [report] integrands, nslots 1 + 2n + np */
   int nout;
