@@ -807,7 +807,7 @@ typedef struct {
                                there is no bound (the message says why, HP-3) */
   double *outputs;        /**< see above */
   int warm;               /**< 1: started from the previous row's solution */
-  char message[400];      /**< the report's sentence */
+  char message[1024];     /**< the report's sentence (a solve's message is at most 640 bytes) */
 } cv_batch_result;
 
 /** Read and compile the scene file (exit-2 kind of problems come back NULL with

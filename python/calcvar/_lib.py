@@ -138,7 +138,7 @@ class BatchResult(Structure):
     _fields_ = [("status", c_int), ("iterations", c_int), ("time_s", c_double),
                 ("has_result", c_int), ("action", c_double), ("morse_index", c_int),
                 ("error_max_nodal", c_double), ("error_estimate", c_double),
-                ("outputs", POINTER(c_double)), ("warm", c_int), ("message", ctypes.c_char * 400)]
+                ("outputs", POINTER(c_double)), ("warm", c_int), ("message", ctypes.c_char * 1024)]
 
 
 _sig("cv_batch_new", c_void_p, c_char_p, c_char_p, c_size_t)
