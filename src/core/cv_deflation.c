@@ -318,6 +318,11 @@ static cv_status defl_run(defl *w, const cv_solver *s, double *Y, int maxit, int
     }
     memcpy(Y, w->Yt, (size_t)d->ndof * sizeof *Y);
     memcpy(w->M, w->Mt, (w->nmult + 1) * sizeof *w->M);
+    if (s->progress) { /* a deflated step is a Newton step too: the caller may cancel */
+      cv_progress info = {
+          CVAR_PROGRESS_NEWTON, it + 1, sqrt(2.0 * phi), wn, alpha, St, 0, d->E, NAN};
+      if (s->progress(&info, s->progress_user) != 0) return CVAR_ECANCELLED;
+    }
     st = cv_kkt_eval(&w->kkt, Y, w->M, &St, w->g, Ax, w->dreg); /* and its Hessian */
     if (st) return st;
     phi = phit;
@@ -824,6 +829,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
     /* a start that begins within the limit runs to its end (at most DEFL_MAXIT) */
     st = w.nknown ? defl_run(&w, s, Y, DEFL_MAXIT, &it) : CVAR_OK;
     work += it;
+    if (st == CVAR_ECANCELLED || st == CVAR_ECALLBACK || st == CVAR_ENOMEM) goto stop;
     if (st) {
       info->failed++;
       continue;
@@ -835,6 +841,7 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
     work += s->iterations;
     s->adapt_tol = 0.0;
     cv_solver_set_start(s, 0, NULL);
+    if (st == CVAR_ECANCELLED || st == CVAR_ECALLBACK || st == CVAR_ENOMEM) goto stop;
     if (st) {
       info->failed++;
       continue;
@@ -848,6 +855,13 @@ cv_status cv_solve_all(cv_solver *s, const cv_problem *p, int max) {
   }
   st = CVAR_OK;
   goto finish;
+stop: /* cancelled by the progress callback, or a callback's or the memory's failure: the
+       * search ends with the paths found so far and that status */
+  if (st == CVAR_ENOMEM) goto nomem;
+  if (st == CVAR_ECANCELLED)
+    cv_set_msg(s->msg, sizeof s->msg, "cancelled by the progress callback after %d starts",
+               info->starts);
+  goto fail;
 nomem:
   st = CVAR_ENOMEM;
   cv_set_msg(s->msg, sizeof s->msg, "out of memory in the search for stationary paths");
