@@ -160,39 +160,98 @@ int cv_kkt_step_crosses(cv_kkt *k, const double *Y, const double *Yt) {
   return 0;
 }
 
+/* One inequality row at a node, as a sweep visits it: G_k there (g; its gradient gy with
+ * stride m when asked for), the row and the node * nc + k index of its decision. */
+typedef struct {
+  long node;
+  int kc, sense, row, m;
+  size_t at;
+  double g;
+  const double *gy;
+} ineq_row;
+
+/* Visit every inequality row at Y (constraints evaluated a batch of nodes at a time, with
+ * need); fn returns nonzero to stop. Returns 0, or -1 when a constraint fails to evaluate
+ * or fn stops. */
+static int sweep_inequalities(cv_kkt *k, const double *Y, unsigned need,
+                              int (*fn)(cv_kkt *, const ineq_row *, void *), void *ctx) {
+  const cv_disc *d = k->d;
+  int nc = d->nc;
+  for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
+    int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
+    for (int kc = 0; kc < nc; kc++) {
+      double *g, *gy, *gyy;
+      if (!k->prob->pc[kc].sense) continue;
+      if (eval_constraint(k, kc, Y, j0, m, need, &g, &gy, &gyy)) return -1;
+      for (int t = 0; t < m; t++) {
+        ineq_row r = {j0 + t,
+                      kc,
+                      k->prob->pc[kc].sense,
+                      cv_disc_lidx(d, j0 + t, kc),
+                      m,
+                      (size_t)(j0 + t) * nc + kc,
+                      g[t],
+                      gy + t};
+        if (r.row >= 0 && fn(k, &r, ctx)) return -1;
+      }
+    }
+  }
+  return 0;
+}
+
+typedef struct {
+  const double *M;
+  long changed;
+  double gmax;
+} update_ctx;
+
+static int update_one(cv_kkt *k, const ineq_row *r, void *ctx) {
+  update_ctx *u = ctx;
+  size_t at = r->at;
+  double c = isnan(k->cw[at]) ? 1.0 : k->cw[at];
+  int a = cv_kkt_active_rule(r->sense, r->g, u->M[at], c, k->eps, k->active[at], k->tg, k->tl);
+  u->gmax = cv_fmax(u->gmax, fabs(r->g));
+  if (a != k->active[at] && k->chg && k->nchg < k->chgcap) k->chg[k->nchg] = at;
+  if (a != k->active[at]) k->nchg++, u->changed++;
+  k->active[at] = (unsigned char)a;
+  return 0;
+}
+
 long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M) {
   const cv_disc *d = k->d;
   int nc = d->nc;
-  long changed = 0;
-  double gmax = 0.0, lmax = 0.0;
+  double lmax = 0.0;
   k->nchg = 0;
   for (long j = 0; j < d->nodes; j++)
     for (int kc = 0; kc < nc; kc++)
       if (k->prob->pc[kc].sense) lmax = cv_fmax(lmax, fabs(M[(size_t)j * nc + kc]));
   /* OB-2b: the margins, round-off of the largest |G| (last pass) and the largest |lambda| */
   k->tg = 1e-12 * 1e2 * k->gscale, k->tl = 1e-10 * lmax;
-  for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
-    int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
-    for (int kc = 0; kc < nc; kc++) {
-      int sense = k->prob->pc[kc].sense;
-      double *g, *gy, *gyy;
-      if (!sense) continue;
-      if (eval_constraint(k, kc, Y, j0, m, CVAR_NEED_F, &g, &gy, &gyy)) return -1;
-      for (int t = 0; t < m; t++) {
-        long node = j0 + t;
-        if (cv_disc_lidx(d, node, kc) < 0) continue;
-        size_t at = (size_t)node * nc + kc;
-        double c = isnan(k->cw[at]) ? 1.0 : k->cw[at];
-        int a = cv_kkt_active_rule(sense, g[t], M[at], c, k->eps, k->active[at], k->tg, k->tl);
-        gmax = cv_fmax(gmax, fabs(g[t]));
-        if (a != k->active[at] && k->chg && k->nchg < k->chgcap) k->chg[k->nchg] = at;
-        if (a != k->active[at]) k->nchg++, changed++;
-        k->active[at] = (unsigned char)a;
-      }
-    }
+  update_ctx u = {M, 0, 0.0};
+  if (sweep_inequalities(k, Y, CVAR_NEED_F, update_one, &u)) return -1;
+  k->gscale = 1e-2 * u.gmax;
+  return u.changed;
+}
+
+typedef struct {
+  const double *Y, *M, *Yt;
+  double P, sl;
+} penalty_ctx;
+
+static int penalty_one(cv_kkt *k, const ineq_row *r, void *ctx) {
+  penalty_ctx *q = ctx;
+  const cv_disc *d = k->d;
+  double c = isnan(k->cw[r->at]) ? 1.0 : k->cw[r->at], mj = d->mass[r->row];
+  double v = r->sense * r->g < 0 ? r->sense * r->g : 0.0;
+  q->P += mj * c / (2.0 * k->eps) * v * v;
+  if (!q->Yt) return 0;
+  double dg = 0.0;
+  for (int i = 0; i < cn_of(d); i++) {
+    long di = vdof(d, r->node, i);
+    dg += r->gy[(size_t)i * r->m] * (q->Yt[di] - q->Y[di]);
   }
-  k->gscale = 1e-2 * gmax;
-  return changed;
+  q->sl += mj * (c / k->eps * r->sense * v - q->M[r->at]) * dg;
+  return 0;
 }
 
 /* OB-3a: the penalised action's extra term at Y, P - S = sum_j m_j c_j / (2 eps)
@@ -203,38 +262,12 @@ long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M) {
  * constraint fails to evaluate. */
 int cv_kkt_penalty(cv_kkt *k, const double *Y, const double *M, const double *Yt, double *pen,
                    double *dslope) {
-  const cv_disc *d = k->d;
-  int nc = d->nc, n = cn_of(d);
-  double P = 0.0, sl = 0.0;
-  unsigned need = CVAR_NEED_F | (Yt ? CVAR_NEED_GRAD : 0u);
-  for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
-    int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
-    for (int kc = 0; kc < nc; kc++) {
-      int sense = k->prob->pc[kc].sense;
-      double *g, *gy, *gyy;
-      if (!sense) continue;
-      if (eval_constraint(k, kc, Y, j0, m, need, &g, &gy, &gyy)) return -1;
-      for (int t = 0; t < m; t++) {
-        long node = j0 + t;
-        int row = cv_disc_lidx(d, node, kc);
-        if (row < 0) continue;
-        size_t at = (size_t)node * nc + kc;
-        double c = isnan(k->cw[at]) ? 1.0 : k->cw[at], mj = d->mass[row];
-        double v = sense * g[t] < 0 ? sense * g[t] : 0.0;
-        P += mj * c / (2.0 * k->eps) * v * v;
-        if (!Yt) continue;
-        double dg = 0.0;
-        for (int i = 0; i < n; i++) {
-          long di = vdof(d, node, i);
-          dg += gy[(size_t)i * m + t] * (Yt[di] - Y[di]);
-        }
-        sl += mj * (c / k->eps * sense * v - M[at]) * dg;
-      }
-    }
-  }
-  *pen = P;
-  if (dslope) *dslope = sl;
-  return isfinite(P) && isfinite(sl) ? 0 : -1;
+  penalty_ctx q = {Y, M, Yt, 0.0, 0.0};
+  if (sweep_inequalities(k, Y, CVAR_NEED_F | (Yt ? CVAR_NEED_GRAD : 0u), penalty_one, &q))
+    return -1;
+  *pen = q.P;
+  if (dslope) *dslope = q.sl;
+  return isfinite(q.P) && isfinite(q.sl) ? 0 : -1;
 }
 
 /* Row lam_jk of node j and constraint kc (C-1, OB-2, OB-3), and its terms in the y rows,
@@ -281,34 +314,30 @@ static cv_status constraint_row(cv_kkt *k, long node, int kc, int row, int on, d
   return CVAR_OK;
 }
 
+typedef struct {
+  int pass;
+  double frac, pmax;
+  long na;
+} start_ctx;
+
+static int start_one(cv_kkt *k, const ineq_row *r, void *ctx) {
+  start_ctx *q = ctx;
+  double sink = -r->sense * r->g;
+  if (!q->pass)
+    q->pmax = cv_fmax(q->pmax, sink);
+  else
+    q->na += k->active[r->at] = sink > q->frac * q->pmax;
+  return 0;
+}
+
 /* OB-3b: the start set of a penalty stage after another: active exactly where the path
  * sinks into the obstacle by more than frac of its deepest sinking, -s G > frac max(-s G).
  * Returns the number of active nodes, or -1 when a constraint fails to evaluate. */
 long cv_kkt_stage_start(cv_kkt *k, const double *Y, double frac) {
-  const cv_disc *d = k->d;
-  int nc = d->nc;
-  double pmax = 0.0;
-  long na = 0;
-  for (int pass = 0; pass < 2; pass++)
-    for (long j0 = 0; j0 < d->nodes; j0 += CV_BATCH) {
-      int m = d->nodes - j0 < CV_BATCH ? (int)(d->nodes - j0) : CV_BATCH;
-      for (int kc = 0; kc < nc; kc++) {
-        int sense = k->prob->pc[kc].sense;
-        double *g, *gy, *gyy;
-        if (!sense) continue;
-        if (eval_constraint(k, kc, Y, j0, m, CVAR_NEED_F, &g, &gy, &gyy)) return -1;
-        for (int t = 0; t < m; t++) {
-          long node = j0 + t;
-          if (cv_disc_lidx(d, node, kc) < 0) continue;
-          size_t at = (size_t)node * nc + kc;
-          if (!pass)
-            pmax = cv_fmax(pmax, -sense * g[t]);
-          else
-            na += k->active[at] = -sense * g[t] > frac * pmax;
-        }
-      }
-    }
-  return na;
+  start_ctx q = {0, frac, 0.0, 0};
+  for (q.pass = 0; q.pass < 2; q.pass++)
+    if (sweep_inequalities(k, Y, CVAR_NEED_F, start_one, &q)) return -1;
+  return q.na;
 }
 
 /* Gradient and Hessian of the discrete Lagrangian
