@@ -88,13 +88,6 @@ cv_status cv_batch_check_row(cv_batch *b, const double *row, char *err, size_t e
 /* The phase condition's constant takes the guess of at most this many unknowns at once. */
 #define CV_BATCH_MAX_UNKNOWNS 64
 
-/* The smoothing hook of the core (theory HC-4), as in scene_problem.c: the width is the
- * integrand's last input. */
-static void set_width(void *user, double wd) {
-  ex_integrand *g = user;
-  ex_integrand_set_param(g, ex_integrand_num_params(g) - 1, wd);
-}
-
 /* A problem over the worker's clones, ends and integral constants of its instance. */
 cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
   const scene *s = w->inst;
@@ -108,7 +101,7 @@ cv_problem *sc_batch_row_problem(const cv_batch *b, worker *w) {
   if (!bad && ex_integrand_has_tables(w->F))
     bad = cv_problem_add_note(p, ex_integrand_note, w->F) != CVAR_OK;
   if (!bad && b->njumps > 0)
-    bad = cv_problem_set_smoothing(p, set_width, w->F, b->njumps) != CVAR_OK;
+    bad = cv_problem_set_smoothing(p, sc_set_smoothing_width, w->F, b->njumps) != CVAR_OK;
   for (int i = 0; i < s->n && !bad; i++)
     for (int end = 0; end < 2 && !bad; end++)
       bad = (s->bc[i].free_end[end]

@@ -139,6 +139,9 @@ int sc_parse_const(sc_loader *L, const sc_entry *e, int off, const char *text, c
                    double *value);
 /* The same, also giving the expression (an expression of the parameters when they are
  * inputs; node may be NULL). */
+/* The core's smoothing hook for an integrand compiled with its jumps smoothable: the width
+ * is its last input (theory HC-4; scene_problem.c). */
+void sc_set_smoothing_width(void *user, double w);
 int sc_parse_const_node(sc_loader *L, const sc_entry *e, int off, const char *text,
                         const char *what, double *value, ex_id *node);
 /* Value of a constant expression of the parameters at their current values (0, or -1 on
