@@ -234,11 +234,12 @@ typedef struct {
   const cv_problem *prob;
   const cv_disc *disc;
   double *buf; /* batch buffers */
-  double *K;   /* element matrix, ((p+1) n)^2 */
+  double *K;   /* element matrix, (p+1) n rows of ((p+1) n + 3) & ~3 */
   int *fl;     /* free index of each local dof, (p+1) n */
   double *x, *y, *dy;
   cv_partials out;
   int cb_status; /* last callback return value (>0 cannot evaluate, <0 abort) */
+  int qv;        /* points whose rows of fit the buffer of batch_general */
   long nevals;
   double *hbuf; /* C^1 elements: their own batch buffers (cv_hermite_assemble.c), else NULL */
 } cv_assembler;
