@@ -92,6 +92,18 @@ static inline __attribute__((always_inline)) void fill_batch(const int N, const 
   }
 }
 
+/* Two unknowns at degrees 5-8 (the hp rounds' degrees, paths in the plane), out of line:
+ * the code of a scalar solve stays as it was. */
+static __attribute__((noinline)) void fill_points2(cv_assembler *as, const double *Y,
+                                                   const cv_rule *r, int e0, int ne, int p) {
+  switch (p) {
+  case 5: fill_batch(2, 6, as, Y, r, e0, ne); return;
+  case 6: fill_batch(2, 7, as, Y, r, e0, ne); return;
+  case 7: fill_batch(2, 8, as, Y, r, e0, ne); return;
+  default: fill_batch(2, 9, as, Y, r, e0, ne); return;
+  }
+}
+
 static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int e0, int ne,
                         int p) {
   const cv_disc *d = as->disc;
@@ -103,6 +115,10 @@ static void fill_points(cv_assembler *as, const double *Y, const cv_rule *r, int
     case 4: fill_batch(1, 5, as, Y, r, e0, ne); return;
     default: break;
     }
+  }
+  if (d->n == 2 && p >= 5) {
+    fill_points2(as, Y, r, e0, ne, p);
+    return;
   }
   fill_batch(d->n, p + 1, as, Y, r, e0, ne);
 }
@@ -475,6 +491,11 @@ static void scatter(const int *flp, int nl, int ldk, int interior, const double 
     int fb = flp[bcol];
     if (fb < 0) continue;
     long c0 = colptr[fb], rs = fb + 1 - (colptr[fb + 1] - c0);
+    if (interior && hscale == 1.0) { /* the product by 1 is exact: left out */
+      double *col = Ax + c0 + flp[0] - rs;
+      for (int arow = 0; arow <= bcol; arow++) col[arow] += K[(size_t)arow * ldk + bcol];
+      continue;
+    }
     if (interior) {
       double *col = Ax + c0 + flp[0] - rs;
       for (int arow = 0; arow <= bcol; arow++) col[arow] += hscale * K[(size_t)arow * ldk + bcol];

@@ -83,13 +83,16 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
   cv_ldlt *L;
   if (nfree <= cv_ldlt_skyline_max ||
       (d->ni == 0 && nnz <= (long)cv_ldlt_skyline_band * (nfree > 0 ? nfree : 1))) {
-    /* One zeroed block: the object, A, U and the column pointers, with the exact count of
-     * entries (one more pass over the columns): one allocation instead of four, and fewer
-     * heap bytes for the first solve in a process to touch (docs/performance.md). */
+    /* One block: the object, A, U and the column pointers, with the exact count of entries
+     * (one more pass over the columns): one allocation instead of four, and fewer heap
+     * bytes for the first solve in a process to touch (docs/performance.md). The object
+     * and A are zeroed (a caller may sum into A before anything clears it); U is written
+     * whole by every factorisation before it is read. */
     size_t nz = (size_t)cv_disc_pattern(d, NULL, NULL);
     if (nz < 1) nz = 1;
-    L = cv_calloc(1, sizeof *L + 2 * nz * sizeof(double) + ((size_t)nfree + 1) * sizeof(int));
+    L = cv_malloc(sizeof *L + 2 * nz * sizeof(double) + ((size_t)nfree + 1) * sizeof(int));
     if (!L) return CVAR_ENOMEM;
+    memset(L, 0, sizeof *L + nz * sizeof(double));
     L->n = nfree;
     L->sky = 1;
     L->ax = (double *)(L + 1);
