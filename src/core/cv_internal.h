@@ -224,6 +224,8 @@ CV_HOT cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax
                                 size_t len);
 /* Solve in place: x <- A^{-1} x. */
 CV_HOT cv_status cv_ldlt_solve(cv_ldlt *L, double *x);
+/* x <- A^{-1} (-b): as x = -b and cv_ldlt_solve, the negation fused into a pass where it can be. */
+CV_HOT cv_status cv_ldlt_solve_neg(cv_ldlt *L, const double *b, double *x);
 /* x <- L^{-1} x (transpose 0) or L^{-T} x (transpose 1), L unit lower triangular. */
 cv_status cv_ldlt_solve_L(cv_ldlt *L, int transpose, double *x);
 /* The pivots D(j) of the last factorisation. */

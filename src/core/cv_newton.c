@@ -302,21 +302,25 @@ static void apply_step(newton_ws *w, const double *Y, const double *M, double al
 static double step_norm(cv_solver *s, newton_ws *w, const double *Yc, const double *Mc, double atol,
                         double *slope, double *phi, double *ymax) {
   const cv_disc *d = w->d;
-  double wn = 0.0, sl = 0.0, ym = 0.0, rs = 0.0, rmax = 0.0;
+  double wn = 0.0, sl = 0.0, ym = 0.0, rs = 0.0, rmax = 0.0, rtol = s->rtol;
+  /* in locals: the stores into Yt would otherwise reload them at every unknown */
+  const int *gof = w->gof, nf = d->nfree;
+  const double *delta = w->delta, *g = w->g, *imass = d->imass;
+  double *Yt = w->Yt, *Mt = w->Mt;
   int ny = 0;
-  for (int f = 0; f < d->nfree; f++) {
-    int gi = w->gof[f];
-    double df = w->delta[f], gf = w->g[f], r = gf * d->imass[f]; /* as in residual() */
+  for (int f = 0; f < nf; f++) {
+    int gi = gof[f];
+    double df = delta[f], gf = g[f], r = gf * imass[f]; /* as in residual() */
     sl += gf * df;
     rs += r * r;
     r = fabs(r);
     if (!(r <= rmax)) rmax = r;
     if (gi < 0) {
-      w->Mt[-1 - gi] = Mc[-1 - gi] + df;
+      Mt[-1 - gi] = Mc[-1 - gi] + df;
       continue;
     }
-    double yf = Yc[gi], ay = fabs(yf), v = df / (s->rtol * ay + atol);
-    w->Yt[gi] = yf + df;
+    double yf = Yc[gi], ay = fabs(yf), v = df / (rtol * ay + atol);
+    Yt[gi] = yf + df;
     wn += v * v;
     ny++;
     if (!(ay <= ym)) ym = ay;
@@ -506,8 +510,12 @@ static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
     if (st) goto cleanup;
     /* Each constraint row adds one negative pivot to a quasi-definite KKT matrix (N-1). */
     s->morse = neg - ncon;
-    for (int f = 0; f < nf; f++) w.delta[f] = -w.g[f];
-    st = w.tau != 0.0 ? solve_shifted(&w, Ax, constrained) : solve_refined(&w, nf, constrained);
+    if (w.tau == 0.0 && !constrained) { /* the step -H^{-1} g, the negation in the solve */
+      st = cv_ldlt_solve_neg(w.L, w.g, w.delta);
+    } else {
+      for (int f = 0; f < nf; f++) w.delta[f] = -w.g[f];
+      st = w.tau != 0.0 ? solve_shifted(&w, Ax, constrained) : solve_refined(&w, nf, constrained);
+    }
     if (timed) s->t_factor += cv_now() - tf;
     if (st) {
       cv_set_msg(s->msg, sizeof s->msg, "%s",
