@@ -355,6 +355,9 @@ struct cv_solver {
   double t_assemble, t_factor; /* seconds in assembly / LDL^T (bench/; from 512 unknowns) */
   double adapt_tol, err_est;   /* adaptive refinement (cv_adapt.c) */
   int adapt_max, rounds;
+  /* HP-7b: the pilot's aim (x tol) learnt from this solver's earlier rounds at tolerance
+   * aim_tol (0: none yet; the rounds and the mesh handed to the next batch row use it) */
+  double pilot_aim, aim_tol;
   double time_limit;        /* seconds for the rounds (HP-6); 0: none */
   int hp;                   /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
   int continuation, csteps; /* automatic continuation (cv_continuation.c) */
@@ -460,6 +463,8 @@ cv_status cv_estimate_indicators(const cv_solver *s, const cv_solver *f, double 
  * coefficients and the next coefficient it predicts, tail = |a_p| e^(-sigma) (the largest
  * over the unknowns); a prediction to refine by, never an estimate. */
 cv_status cv_estimate_pilot(const cv_solver *s, double *tail, double *sigma);
+/* HP-7b: the pilot's aim (a multiple of tol) for s's next rounds (cv_adapt.c). */
+double cv_pilot_aim(const cv_solver *s);
 /* HP-4, HP-5: the next mesh (on [0, 1], *t with *Enew + 1 entries, *deg with *Enew) from
  * d with the elements cv_hp_marked refined (hp = 0: bisected at their degree; hp = 2: hp
  * and smooth neighbours may be merged, HP-8); target:
