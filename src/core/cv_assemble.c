@@ -471,7 +471,7 @@ static void elem_base(elem_args *A) { elem_body(A); }
 static __attribute__((target("avx2"))) void elem_avx2(elem_args *A) { elem_body(A); }
 #endif
 
-/* The tiled element sums, AVX where the CPU has it (same results, theory A-3). */
+/* The tiled element sums, AVX where the CPU has it (same results, theory A-3a). */
 static void elem_sums(elem_args *A) {
 #ifdef CV_AVX2_CLONE
   if (__builtin_cpu_supports("avx2")) {
@@ -520,8 +520,9 @@ static void scatter(const int *flp, int nl, int ldk, int interior, const double 
  * b, and only b >= a (the scatter reads the upper triangle), half the products of the loop
  * over (i, j, l, r) and unit stride (n = 2, p = 8: 3x faster, docs/performance.md). The rows
  * of all the element's points are made first and K summed over them a tile of rows and
- * columns at a time in registers (elem_sums: n = 2, p = 8 another 2.x, docs/performance.md);
- * a rule with more points than the buffer holds (a singular end's) goes point by point.
+ * columns at a time in registers (elem_sums, theory A-3a: n = 2, p = 8 another 3x fewer
+ * instructions, docs/performance.md); a rule with more points than the buffer holds (a
+ * singular end's) goes point by point.
  * Returns the batch's part of S; *bad as in batch_scalar. */
 static __attribute__((noinline)) CV_VECTORIZE double batch_general(cv_assembler *as,
                                                                    const cv_rule *r, int e0, int ne,
