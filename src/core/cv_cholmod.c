@@ -284,24 +284,6 @@ static void skyline_factor(cv_ldlt *L) {
       int pi = cp[i], fi = i + 1 - (cp[i + 1] - pi), k0 = fi > fj ? fi : fj;
       const double *ui = u + pi - fi;
       double g = aj[i];
-      if (i + 1 < j && j < L->mono) {
-        /* g_i and g_{i+1} side by side: two chains of additions instead of one, each in
-         * its own order (k increasing; f_{i+1} >= f_i in the node blocks), g_{i+1}'s last
-         * term, of g_i, once that is done */
-        int pn = cp[i + 1], fn = i + 2 - (cp[i + 2] - pn), k1 = fn > fj ? fn : fj;
-        const double *un = u + pn - fn;
-        double h = aj[i + 1];
-        int k = k0;
-        for (; k < k1 && k < i; k++) g -= ui[k] * uj[k];
-        for (; k < i; k++) {
-          g -= ui[k] * uj[k];
-          h -= un[k] * uj[k];
-        }
-        if (k1 <= i) h -= un[i] * g;
-        uj[i] = g;
-        uj[++i] = h;
-        continue;
-      }
       for (int k = k0; k < i; k++) g -= ui[k] * uj[k]; /* uj[k] holds g_k until below */
       uj[i] = g;
     }
