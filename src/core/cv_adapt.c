@@ -221,6 +221,25 @@ static int next_size(const cv_disc *d, const double *eta, const double *sigma, d
  * nodal error, which the estimate measures and compares with tol, was measured at 0.004 to
  * 0.07 of the largest predicted tail on the smooth reference problems (tails 1e-9..1e-14) */
 #define PILOT_AIM8 10.0
+/* HP-7b: the aim learnt from the rounds of this solver's earlier solves: a round laid by the
+ * pilot whose estimate missed tol by a factor x lowers it by 2x (at most 10x at a time), one
+ * within tol / 10 raises it by 1.25, between PILOT_AIM8 / 100 and PILOT_AIM8 */
+#define AIM_MISS_MARGIN 0.5
+#define AIM_RELAX       1.25
+double cv_pilot_aim(const cv_solver *s) {
+  return s->pilot_aim > 0 && s->aim_tol == s->adapt_tol ? s->pilot_aim : PILOT_AIM8;
+}
+
+static void pilot_learn(cv_solver *s, double est, double tol) {
+  double aim = cv_pilot_aim(s);
+  if (est > tol)
+    aim *= fmax(0.1, AIM_MISS_MARGIN * tol / est);
+  else if (est < 0.1 * tol)
+    aim *= AIM_RELAX;
+  s->pilot_aim = fmin(PILOT_AIM8, fmax(0.01 * PILOT_AIM8, aim));
+  s->aim_tol = tol;
+}
+
 /* ... and trusted from a Legendre rate of 0.75 (HP-4's smooth is 1): an oscillation of 0.85
  * periods per degree-8 element decays at 0.96, and the h^9 of HP-7a over-states what
  * halving such an element gains (its rate also grows by ln 2), so it is not too few */
@@ -229,7 +248,7 @@ static int next_size(const cv_disc *d, const double *eta, const double *sigma, d
  * (sigma >= 1) and the largest predicted next coefficient is above tol, refine by those
  * predictions (HP-4 with eta = the tail) without the estimate: the enriched solve of a mesh
  * predicted to be too coarse is skipped. On a degree-8 mesh a batch row handed on (HP-9),
- * laid for tails of CV_REUSE_AIM x tol, only a tail above that aim is a miss: the estimate
+ * laid for tails of cv_pilot_aim x tol, only a tail above that aim is a miss: the estimate
  * decides the rest. 1 when it refined (E, t, deg replaced), 0 when not, -1 out of memory. */
 static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where, double tol,
                         int keep_bounds, int handed_on, int *E, double **t, int **deg) {
@@ -246,8 +265,8 @@ static int pilot_refine(cv_solver *s, double *tail, double *sigma, double *where
     tmax = fmax(tmax, tail[e]);
     where[e] = 0.0;
   }
-  if (!(tmax > (all8 && handed_on ? CV_REUSE_AIM : PILOT_MISS) * tol)) return 0;
-  if (all8 ? cv_hp_pilot_mesh(d, tail, PILOT_AIM8 * tol, &En, &tn, &dn)
+  if (!(tmax > (all8 && handed_on ? cv_pilot_aim(s) : PILOT_MISS) * tol)) return 0;
+  if (all8 ? cv_hp_pilot_mesh(d, tail, cv_pilot_aim(s) * tol, &En, &tn, &dn)
            : cv_hp_refine(d, tail, sigma, where, 0.25 * tmax, PILOT_AIM * tol, 1, &En, &tn, &dn))
     return -1;
   long nodes = 1;
@@ -317,7 +336,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
   if (p->c1) return cv_hermite_adapt(s, p); /* C^1 elements: H-7, H-8 */
   cv_solver *f = cv_solver_new(&st);
   double *t = NULL, *eta = NULL, *sigma = NULL, *where = NULL;
-  int *deg = NULL, E = 0, stalled = 0, warm = 0, misses = 0, halved_nodes = 1;
+  int *deg = NULL, E = 0, stalled = 0, warm = 0, misses = 0, halved_nodes = 1, piloted = 0;
   long iters = 0, iters_ref = 0; /* Newton iterations of all rounds; of the enriched solves */
   double tol = s->adapt_tol, best = INFINITY, t0 = cv_now();
   cv_meshspec spec0 = s->mesh;
@@ -380,6 +399,7 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
       }
       if (r > 0) {
         warm = 2;
+        piloted = 1; /* the next round's estimate judges the pilot's aim (HP-7b) */
         continue;
       }
     }
@@ -393,6 +413,8 @@ cv_status cv_adapt_run(cv_solver *s, const cv_problem *p) {
     if (!st && est > tol) st = cv_estimate_indicators(s, f, eta, sigma, where);
     if (!st && est > tol && obstacles) cv_contact_gap_term(s, p, eta);
     iters_ref += f->iterations;
+    if (!st && piloted) pilot_learn(s, est, tol);
+    piloted = 0;
     if (st == CVAR_ENOMEM) goto cleanup;
     if (st) {
       /* HP-3: no bound from this mesh; halve every element and start the next round from

@@ -28,7 +28,8 @@ struct cv_ldlt {
   double *ax, *u; /* A, and U = L^T with D(j) in place of U(j,j), column by column */
   long minor;     /* first zero pivot, n if none */
   long mono;      /* columns 0 .. mono - 1 have nondecreasing first rows */
-  int tri;        /* every column has at most 2 entries: a tridiagonal matrix */
+  int tri;        /* every column has at most 2 entries: a tridiagonal matrix; 2 when
+                   * every column but the first has exactly 2 (column j at 2j - 1, 2j) */
 };
 
 /* Up to this many unknowns the skyline factor is used (tests may lower it to 0 to
@@ -83,13 +84,16 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
   cv_ldlt *L;
   if (nfree <= cv_ldlt_skyline_max ||
       (d->ni == 0 && nnz <= (long)cv_ldlt_skyline_band * (nfree > 0 ? nfree : 1))) {
-    /* One zeroed block: the object, A, U and the column pointers, with the exact count of
-     * entries (one more pass over the columns): one allocation instead of four, and fewer
-     * heap bytes for the first solve in a process to touch (docs/performance.md). */
+    /* One block: the object, A, U and the column pointers, with the exact count of entries
+     * (one more pass over the columns): one allocation instead of four, and fewer heap
+     * bytes for the first solve in a process to touch (docs/performance.md). The object
+     * and A are zeroed (a caller may sum into A before anything clears it); U is written
+     * whole by every factorisation before it is read. */
     size_t nz = (size_t)cv_disc_pattern(d, NULL, NULL);
     if (nz < 1) nz = 1;
-    L = cv_calloc(1, sizeof *L + 2 * nz * sizeof(double) + ((size_t)nfree + 1) * sizeof(int));
+    L = cv_malloc(sizeof *L + 2 * nz * sizeof(double) + ((size_t)nfree + 1) * sizeof(int));
     if (!L) return CVAR_ENOMEM;
+    memset(L, 0, sizeof *L + nz * sizeof(double));
     L->n = nfree;
     L->sky = 1;
     L->ax = (double *)(L + 1);
@@ -100,6 +104,7 @@ cv_status cv_ldlt_new(const cv_disc *d, int *gof, cv_ldlt **out, char *msg, size
     L->mono = nfree;
     L->tri = 1;
     for (int c = 0; c < nfree && L->tri; c++) L->tri = L->colp[c + 1] - L->colp[c] <= 2;
+    if (L->tri && nfree > 0 && nnz == 2L * nfree - 1) L->tri = 2; /* 1, 2, 2, ...: regular */
     for (int c = 1, f0 = 0; c < nfree; c++) {
       int f = c + 1 - (L->colp[c + 1] - L->colp[c]);
       if (f < f0) {
@@ -212,6 +217,32 @@ static inline void pivot_count(pivot_stats *ps, long j, double dj, double a_jj) 
 
 /* ... with the pivot statistics taken in the same pass (one pass over the factor's memory
  * instead of two: at 10^6 unknowns each pass streams 36 MB). */
+/* The regular tridiagonal envelope (tri = 2): column j at 2j - 1 (row j - 1) and 2j, so the
+ * column pointers are not read (at 10^6 unknowns a stream of 4 MB in each pass). */
+static void skyline_factor_tri2(cv_ldlt *L, pivot_stats *ps) {
+  const double *ax = L->ax;
+  double *u = L->u;
+  long n = L->n, minor = n;
+  double dprev = 0.0;
+  for (long j = 0; j < n; j++) {
+    double dj = ax[2 * j];
+    if (j > 0) {
+      double g = ax[2 * j - 1];
+      double uij = dprev == 0.0 ? 0.0 : g / dprev; /* a zero pivot contributes nothing */
+      u[2 * j - 1] = uij;
+      dj -= dprev == 0.0 ? 0.0 : uij * g;
+    }
+    if (j >= minor)
+      dj = 0.0;
+    else if (dj == 0.0)
+      minor = j;
+    u[2 * j] = dj;
+    dprev = dj;
+    pivot_count(ps, j, dj, ax[2 * j]);
+  }
+  L->minor = minor;
+}
+
 static void skyline_factor_tri(cv_ldlt *L, pivot_stats *ps) {
   const int *cp = L->colp;
   const double *ax = L->ax;
@@ -294,7 +325,9 @@ static cv_status factor_cholmod(cv_ldlt *L, char *msg, size_t len) {
 
 cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax, char *msg, size_t len) {
   pivot_stats ps = {0, -1, INFINITY, 0.0};
-  if (L->sky && L->tri) {
+  if (L->sky && L->tri == 2) {
+    skyline_factor_tri2(L, &ps);
+  } else if (L->sky && L->tri) {
     skyline_factor_tri(L, &ps);
   } else {
     if (L->sky) {
@@ -383,6 +416,10 @@ static inline __attribute__((always_inline)) void backward_Lt(const cv_ldlt *L, 
  * row and U^{-1} an update per column. */
 CV_HOT static void sky_forward(const cv_ldlt *L, double *x) { /* x <- U^{-T} x */
   const int *cp = L->colp;
+  if (L->tri == 2) { /* the same operations without the column pointers */
+    for (long j = 1; j < L->n; j++) x[j] -= L->u[2 * j - 1] * x[j - 1];
+    return;
+  }
   for (long j = 0; j < L->n; j++) {
     int fj = (int)j + 1 - (cp[j + 1] - cp[j]);
     const double *uj = L->u + cp[j] - fj;
@@ -402,6 +439,15 @@ CV_HOT static void sky_backward(const cv_ldlt *L, int diag, double *x) {
   const int *cp = L->colp;
   const double *u = L->u;
   long n = L->n, mono = L->mono, e = mono - 1;
+  if (L->tri == 2) {   /* the same operations without the column pointers */
+    double next = 0.0; /* x[j + 1], final */
+    for (long j = n - 1; j >= 0; j--) {
+      double xj = diag ? x[j] / u[2 * j] : x[j];
+      if (j + 1 < n) xj -= u[2 * j + 1] * next;
+      x[j] = next = xj;
+    }
+    return;
+  }
   for (long j = n - 1; j >= 0; j--) {
     double xj = diag ? x[j] / u[cp[j + 1] - 1] : x[j];
     if (j < mono) {
@@ -412,6 +458,18 @@ CV_HOT static void sky_backward(const cv_ldlt *L, int diag, double *x) {
       if (r + 1 - (cp[r + 1] - cp[r]) <= j) xj -= u[cp[r + 1] - 1 - (r - j)] * x[r];
     x[j] = xj;
   }
+}
+
+cv_status cv_ldlt_solve_neg(cv_ldlt *L, const double *b, double *x) {
+  if (L->sky && L->tri == 2 && L->n > 0) { /* x = -b fused into the forward pass */
+    const double *u = L->u;
+    double prev = x[0] = -b[0];
+    for (long j = 1; j < L->n; j++) x[j] = prev = -b[j] - u[2 * j - 1] * prev;
+    sky_backward(L, 1, x);
+    return CVAR_OK;
+  }
+  for (long j = 0; j < L->n; j++) x[j] = -b[j];
+  return cv_ldlt_solve(L, x);
 }
 
 cv_status cv_ldlt_solve(cv_ldlt *L, double *x) {

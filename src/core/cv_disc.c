@@ -264,9 +264,11 @@ long cv_disc_pattern(const cv_disc *d, int *colptr, int *gof) {
     else if (J > 1 && ++since == p)
       e++, since = 0;
     long r0 = cv_disc_elem_first(d, e);
-    /* the node's unknowns in increasing order: y components, then multipliers */
+    /* the node's unknowns in increasing order: y components, then multipliers (an
+     * interior node's: its block's first index and on, cv_disc_fidx without its division) */
+    int inner = J > 0 && J < d->nodes - 1, c0 = inner ? cv_disc_node_first(d, J) : 0;
     for (int t = 0; t < n + nc; t++) {
-      int c = t < n ? cv_disc_fidx(d, J * n + t) : cv_disc_lidx(d, J, t - n);
+      int c = inner ? c0 + t : t < n ? cv_disc_fidx(d, J * n + t) : cv_disc_lidx(d, J, t - n);
       if (c < 0) continue;
       if (gof) gof[c] = t < n ? (int)(J * n + t) : -1 - (int)(J * nc + t - n);
       nnz += (long)c - r0 + 1;

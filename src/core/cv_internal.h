@@ -224,6 +224,8 @@ CV_HOT cv_status cv_ldlt_factor(cv_ldlt *L, int *neg, double *dmin, double *dmax
                                 size_t len);
 /* Solve in place: x <- A^{-1} x. */
 CV_HOT cv_status cv_ldlt_solve(cv_ldlt *L, double *x);
+/* x <- A^{-1} (-b): as x = -b and cv_ldlt_solve, the negation fused into a pass where it can be. */
+CV_HOT cv_status cv_ldlt_solve_neg(cv_ldlt *L, const double *b, double *x);
 /* x <- L^{-1} x (transpose 0) or L^{-T} x (transpose 1), L unit lower triangular. */
 cv_status cv_ldlt_solve_L(cv_ldlt *L, int transpose, double *x);
 /* The pivots D(j) of the last factorisation. */
@@ -234,11 +236,12 @@ typedef struct {
   const cv_problem *prob;
   const cv_disc *disc;
   double *buf; /* batch buffers */
-  double *K;   /* element matrix, ((p+1) n)^2 */
+  double *K;   /* element matrix, (p+1) n rows of ((p+1) n + 3) & ~3 */
   int *fl;     /* free index of each local dof, (p+1) n */
   double *x, *y, *dy;
   cv_partials out;
   int cb_status; /* last callback return value (>0 cannot evaluate, <0 abort) */
+  int qv;        /* points whose rows of fit the buffer of batch_general */
   long nevals;
   double *hbuf; /* C^1 elements: their own batch buffers (cv_hermite_assemble.c), else NULL */
 } cv_assembler;
@@ -368,8 +371,11 @@ struct cv_solver {
   double adapt_tol, err_est;   /* adaptive refinement (cv_adapt.c) */
   int adapt_max, rounds;
   /* HP-9: the next rounds start from a mesh a batch row handed on (cv_reuse_set_start),
-   * laid for tails of at most CV_REUSE_AIM x tol; cleared when the rounds end */
+   * laid for tails of at most cv_pilot_aim x tol; cleared when the rounds end */
   int handed_on;
+  /* HP-7b: the pilot's aim (x tol) learnt from this solver's earlier rounds at tolerance
+   * aim_tol (0: none yet; the rounds and the mesh handed to the next batch row use it) */
+  double pilot_aim, aim_tol;
   double time_limit;        /* seconds for the rounds (HP-6); 0: none */
   int hp;                   /* 1: --tol (hp, HP-1..HP-6); 0: --adapt at a fixed degree */
   int continuation, csteps; /* automatic continuation (cv_continuation.c) */
@@ -476,6 +482,8 @@ cv_status cv_estimate_indicators(const cv_solver *s, const cv_solver *f, double 
  * coefficients and the next coefficient it predicts, tail = |a_p| e^(-sigma) (the largest
  * over the unknowns); a prediction to refine by, never an estimate. */
 cv_status cv_estimate_pilot(const cv_solver *s, double *tail, double *sigma);
+/* HP-7b: the pilot's aim (a multiple of tol) for s's next rounds (cv_adapt.c). */
+double cv_pilot_aim(const cv_solver *s);
 /* HP-4, HP-5: the next mesh (on [0, 1], *t with *Enew + 1 entries, *deg with *Enew) from
  * d with the elements cv_hp_marked refined (hp = 0: bisected at their degree; hp = 2: hp
  * and smooth neighbours may be merged, HP-8); target:

@@ -22,6 +22,10 @@
  * inertia, and the refinement stops after this many sweeps. */
 #define SHIFT_PIVOT      1e-13
 #define SHIFT_REFINE_MAX 100
+/* N-4a: the chord test is tried after a step of weighted norm (N-4) up to CHORD_STEP /
+ * sqrt(rtol): relative to |y| at most 0.1 sqrt(rtol), so that Newton's next step, of the
+ * order of its square (quadratic convergence), is about rtol / 100 */
+#define CHORD_STEP 0.1
 
 typedef struct {
   const cv_disc *d;
@@ -308,21 +312,25 @@ static void apply_step(newton_ws *w, const double *Y, const double *M, double al
 static double step_norm(cv_solver *s, newton_ws *w, const double *Yc, const double *Mc, double atol,
                         double *slope, double *phi, double *ymax) {
   const cv_disc *d = w->d;
-  double wn = 0.0, sl = 0.0, ym = 0.0, rs = 0.0, rmax = 0.0;
+  double wn = 0.0, sl = 0.0, ym = 0.0, rs = 0.0, rmax = 0.0, rtol = s->rtol;
+  /* in locals: the stores into Yt would otherwise reload them at every unknown */
+  const int *gof = w->gof, nf = d->nfree;
+  const double *delta = w->delta, *g = w->g, *imass = d->imass;
+  double *Yt = w->Yt, *Mt = w->Mt;
   int ny = 0;
-  for (int f = 0; f < d->nfree; f++) {
-    int gi = w->gof[f];
-    double df = w->delta[f], gf = w->g[f], r = gf * d->imass[f]; /* as in residual() */
+  for (int f = 0; f < nf; f++) {
+    int gi = gof[f];
+    double df = delta[f], gf = g[f], r = gf * imass[f]; /* as in residual() */
     sl += gf * df;
     rs += r * r;
     r = fabs(r);
     if (!(r <= rmax)) rmax = r;
     if (gi < 0) {
-      w->Mt[-1 - gi] = Mc[-1 - gi] + df;
+      Mt[-1 - gi] = Mc[-1 - gi] + df;
       continue;
     }
-    double yf = Yc[gi], ay = fabs(yf), v = df / (s->rtol * ay + atol);
-    w->Yt[gi] = yf + df;
+    double yf = Yc[gi], ay = fabs(yf), v = df / (rtol * ay + atol);
+    Yt[gi] = yf + df;
     wn += v * v;
     ny++;
     if (!(ay <= ym)) ym = ay;
@@ -385,7 +393,7 @@ typedef struct {
  * an error of the integrand with its message. */
 static cv_status line_search(cv_solver *s, cv_kkt *kkt, const cv_homotopy *h, newton_ws *w,
                              const double *Yc, const double *Mc, double *Ax, double S, double slope,
-                             double phi, double wn, int use_S, int timed, const double *pm,
+                             double phi, double wn, int use_S, int timed, int noH, const double *pm,
                              trial *t) {
   t->alpha = 1.0, t->St = t->phit = t->rnt = 0.0, t->stale = 0;
   for (int ls = 0; ls < MAX_BACKTRACK; ls++) {
@@ -397,7 +405,8 @@ static cv_status line_search(cv_solver *s, cv_kkt *kkt, const cv_homotopy *h, ne
     double ta = timed ? cv_now() : 0.0;
     /* A step within the tolerance is the last one (taken in full below): the Hessian
      * there would not be used, so only F and the gradient are evaluated. */
-    double *Axt = wn <= 1.0 && !kkt->active ? NULL : Ax; /* OB-2: the set may change */
+    /* (noH: N-4a, the chord test at the trial point needs its gradient alone) */
+    double *Axt = (wn <= 1.0 || noH) && !kkt->active ? NULL : Ax; /* OB-2: the set may change */
     cv_status ast = eval_system(kkt, h, w, w->Yt, w->Mt, &t->St, w->gt, Axt, w->dreg);
     if (timed) s->t_assemble += cv_now() - ta;
     if (ast == CVAR_ECALLBACK || ast == CVAR_ENOMEM) {
@@ -426,6 +435,20 @@ static cv_status line_search(cv_solver *s, cv_kkt *kkt, const cv_homotopy *h, ne
     t->alpha *= 0.5;
   }
   return CVAR_ESTALL;
+}
+
+/* N-4a: the weighted RMS norm (N-4) of the step in w->delta at the iterate Yc. */
+static double chord_norm(const cv_solver *s, const newton_ws *w, const double *Yc, double atol) {
+  double wn = 0.0;
+  int ny = 0;
+  for (int f = 0; f < w->d->nfree; f++) {
+    int gi = w->gof[f];
+    if (gi < 0) continue;
+    double v = w->delta[f] / (s->rtol * fabs(Yc[gi]) + atol);
+    wn += v * v;
+    ny++;
+  }
+  return sqrt(wn / (ny ? ny : 1));
 }
 
 /* Workspace and constraint system of one Newton run from (Y, M): the trial buffers start
@@ -480,6 +503,9 @@ static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
   if (st) goto cleanup;
   kkt.eps = eps;
   int constrained = ncon > 0;
+  /* N-4a: in the rounds of --tol (whose answers the estimate judges), a full step small
+   * enough to be Newton's next-to-last is followed by the chord step from its factor */
+  int chord_ok = s->adapt_tol > 0 && s->hp && !s->polish && !constrained && !h && !kkt.active;
   /* Absolute floor of the step tolerance: atol times the size of the solution (STYLE 8). */
   for (long i = 0; i < d->ndof; i++)
     if (fabs(Y[i]) > scale) scale = fabs(Y[i]);
@@ -537,8 +563,12 @@ static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
     if (st) goto cleanup;
     /* Each constraint row adds one negative pivot to a quasi-definite KKT matrix (N-1). */
     s->morse = neg - ncon;
-    for (int f = 0; f < nf; f++) w.delta[f] = -w.g[f];
-    st = w.tau != 0.0 ? solve_shifted(&w, Ax, constrained) : solve_refined(&w, nf, constrained);
+    if (w.tau == 0.0 && !constrained) { /* the step -H^{-1} g, the negation in the solve */
+      st = cv_ldlt_solve_neg(w.L, w.g, w.delta);
+    } else {
+      for (int f = 0; f < nf; f++) w.delta[f] = -w.g[f];
+      st = w.tau != 0.0 ? solve_shifted(&w, Ax, constrained) : solve_refined(&w, nf, constrained);
+    }
     if (timed) s->t_factor += cv_now() - tf;
     if (st) {
       cv_set_msg(s->msg, sizeof s->msg, "%s",
@@ -591,8 +621,9 @@ static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
         pm[0] = S + pen, pm[1] = sly + dsl, pmp = pm;
     }
     trial t;
+    int chord = chord_ok && w.tau == 0.0 && wn > 1.0 && wn <= CHORD_STEP / sqrt(s->rtol);
     st = line_search(s, &kkt, h, &w, Yc, Mc, Ax, S, slope, phi, wn,
-                     neg == 0 && !constrained && slope < 0, timed, pmp, &t);
+                     neg == 0 && !constrained && slope < 0, timed, chord, pmp, &t);
     if (st == CVAR_ESTALL)
       cv_set_msg(s->msg, sizeof s->msg,
                  "no progress: the line search found no decrease along the Newton step at "
@@ -633,6 +664,26 @@ static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
     /* With inequalities, converged also means that the last evaluation kept the active set
      * of the one before (OB-2): the step was Newton's for the final set. */
     int done = wn <= 1.0 && alpha == 1.0;
+    if (chord) {
+      /* N-4a: the chord step -H_k^{-1} g(y_k+1) from the last factor; within the tolerance,
+       * it is taken and the solve ends (its error is that of the Newton step there times
+       * the relative change of H over the step before); else H at y_k+1 as usual */
+      st = alpha == 1.0 ? cv_ldlt_solve_neg(w.L, w.g, w.delta) : CVAR_OK;
+      if (!st && alpha == 1.0 && chord_norm(s, &w, Yc, atol) <= 1.0) {
+        for (int f = 0; f < nf; f++) Yc[w.gof[f]] += w.delta[f];
+        s->iterations++;
+        done = 1;
+      } else {
+        st = eval_system(&kkt, h, &w, Yc, Mc, &S, w.g, Ax, w.dreg);
+        if (st) {
+          cv_set_msg(s->msg, sizeof s->msg, "%s", where_failed(st));
+          goto cleanup;
+        }
+        s->action = S;
+        phi = residual(d, w.g, &s->gnorm);
+        stale = 0;
+      }
+    }
     if (kkt.active) {
       /* OB-2: the step was Newton's for the active set of the iterate it started from (the
        * line search kept it); the new iterate decides the set again, and a changed set

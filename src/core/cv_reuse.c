@@ -7,8 +7,9 @@
 #include "cv_internal.h"
 #include "cv_reuse.h"
 
-/* HP-7a's trusted rate (cv_adapt.c PILOT_RATE8); the aim is CV_REUSE_AIM (cv_reuse.h) */
-#define REUSE_AIM  CV_REUSE_AIM
+/* HP-7a's trusted rate (PILOT_RATE8); the aim is the pilot's (cv_pilot_aim: HP-7a's
+ * PILOT_AIM8, a tail at 10 tol giving a nodal error of 0.04 .. 0.7 tol on degree 8, or
+ * what HP-7b learnt), and the next row's pilot treats only a tail above it as a miss */
 #define REUSE_RATE 0.75
 /* An element whose tail is far below the aim still counts as this share of one element
  * (the h^9 rule would merge it with many neighbours, which its rate does not promise). */
@@ -19,7 +20,7 @@
  * smooth, or a singular end or breakpoint to keep). */
 static double shares(const cv_solver *s, double *r) {
   const cv_disc *d = &s->disc;
-  double tol = s->adapt_tol, total = 0.0;
+  double tol = s->adapt_tol, total = 0.0, aim = cv_pilot_aim(s);
   if (!s->hp || !(tol > 0) || d->sing_a || d->sing_b || s->mesh.nbreak > 0) return -1.0;
   for (long e = 0; e < d->E; e++)
     if (cv_disc_edeg(d, e) != CV_MAX_DEGREE) return -1.0;
@@ -31,7 +32,7 @@ static double shares(const cv_solver *s, double *r) {
       total = -1.0;
       break;
     }
-    r[e] = fmax(REUSE_MIN_SHARE, pow(r[e] / (REUSE_AIM * tol), 1.0 / (CV_MAX_DEGREE + 1)));
+    r[e] = fmax(REUSE_MIN_SHARE, pow(r[e] / (aim * tol), 1.0 / (CV_MAX_DEGREE + 1)));
     total += r[e];
   }
   cv_free(sigma);

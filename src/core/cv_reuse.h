@@ -6,10 +6,6 @@
 
 #include "calcvar.h"
 
-/* HP-7a's aim (cv_adapt.c PILOT_AIM8): the mesh handed on is laid for Legendre tails of at
- * most CV_REUSE_AIM x tol, which gives a nodal error of 0.04 .. 0.7 tol on degree 8 */
-#define CV_REUSE_AIM 10.0
-
 /** HP-9: from s's last converged --tol solve (cv_solver_set_tol), the mesh to start the
  * next problem's rounds from: s's final mesh, or, when it is finer than the tolerance needs
  * (every element of degree 8, smooth, no singular end, no breakpoint), fewer degree-8
@@ -27,7 +23,7 @@ void cv_reuse_node_fractions(int E, const double *t, const int *deg, double *u);
 /** HP-9: set s's mesh to (E, t, deg), a mesh cv_reuse_mesh handed on, as the start of the
  * next --tol rounds (cv_solver_set_mesh_hp), and tell them so: their pilot (HP-7) then
  * refines a degree-8 start only when a tail is above the aim that mesh was laid for
- * (CV_REUSE_AIM x tol), not above tol, so that the row does not refine by one element the mesh
+ * (cv_pilot_aim x tol: HP-7a's 10 tol, or what HP-7b learnt), not above tol, so that the row does not refine by one element the mesh
  * just coarsened for it. The mark lasts for the next rounds only. */
 cv_status cv_reuse_set_start(cv_solver *s, int E, const double *t, const int *deg);
 
