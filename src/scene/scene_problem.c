@@ -81,7 +81,8 @@ cv_problem *scene_problem_new(const scene *s, unsigned max_need, char *err, size
   why = cv_problem_set_integrand_owned(p, ex_integrand_eval, ig, ex_integrand_release);
   if (why == CVAR_OK && ex_integrand_has_tables(ig)) /* names a table whose grid was left */
     why = cv_problem_add_note(p, ex_integrand_note, ig);
-  if (why == CVAR_OK && njumps > 0) why = cv_problem_set_smoothing(p, sc_set_smoothing_width, ig, njumps);
+  if (why == CVAR_OK && njumps > 0)
+    why = cv_problem_set_smoothing(p, sc_set_smoothing_width, ig, njumps);
   if (why != CVAR_OK) {
     sc_err(err, errlen, s->file, s->F_line, "integrand: %s", cv_strerror(why));
     goto fail;
