@@ -392,7 +392,6 @@ struct cv_solver {
    * ends_ok[k]: the last solve's end k passed that check (cv_solve_mesh; cleared with the
    * results). */
   int polish, ends_passed[2], ends_ok[2];
-  int stage_start;          /* OB-3b: the Newton run is a penalty stage after a converged one */
   double search_work;       /* cv_solve_all's work limit (cv_deflation.c) */
   struct cv_pathset *paths; /* the paths of the last cv_solve_all (cv_deflation.c) */
   /* The sparse LDL^T of the Hessian pattern of `disc` (CHOLMOD common, pattern, symbolic

@@ -226,7 +226,7 @@ long cv_kkt_update_active(cv_kkt *k, const double *Y, const double *M) {
     for (int kc = 0; kc < nc; kc++)
       if (k->prob->pc[kc].sense) lmax = cv_fmax(lmax, fabs(M[(size_t)j * nc + kc]));
   /* OB-2b: the margins, round-off of the largest |G| (last pass) and the largest |lambda| */
-  k->tg = 1e-12 * 1e2 * k->gscale, k->tl = 1e-10 * lmax;
+  k->tg = 1e-10 * k->gscale, k->tl = 1e-10 * lmax; /* gscale: 1e-2 max |G| */
   update_ctx u = {M, 0, 0.0};
   if (sweep_inequalities(k, Y, CVAR_NEED_F, update_one, &u)) return -1;
   k->gscale = 1e-2 * u.gmax;

@@ -481,8 +481,10 @@ static cv_status run_init(cv_solver *s, const cv_problem *p, cv_disc *d, newton_
   return st;
 }
 
+/* eps > 0: a penalty stage (OB-3); after_stage: one that follows a converged stage, which
+ * starts from the deepest-sunk nodes (OB-3b). */
 static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M,
-                            const cv_homotopy *h, double eps) {
+                            const cv_homotopy *h, double eps, int after_stage) {
   newton_ws w;
   cv_kkt kkt;
   cv_status st;
@@ -531,7 +533,7 @@ static cv_status newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
   have_K = 1;
   kkt.frozen = kkt.active != NULL; /* OB-2: set at the start, then by cv_kkt_update_active */
   if (kkt.active && cv_kkt_update_active(&kkt, Y, M) < 0) kkt.gscale = 0.0; /* its gscale */
-  if (kkt.active && s->stage_start && eps > 0) {
+  if (kkt.active && after_stage && eps > 0) {
     /* OB-3b: a stage after a converged one starts from the nodes sunk deepest into the
      * obstacle only (a set too small, which a step corrects at once where the path then
      * crosses the obstacle), not from all the nodes the softer penalty let it sink at
@@ -772,7 +774,7 @@ static cv_status run_staged(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
   cv_dcopy(save + ny, M, nm);
   int maxit = s->maxit, total = 0;
   s->maxit = maxit < OB_DIRECT_ITERATIONS ? maxit : OB_DIRECT_ITERATIONS;
-  cv_status st = newton_run(s, p, d, Y, M, NULL, 0.0);
+  cv_status st = newton_run(s, p, d, Y, M, NULL, 0.0, 0);
   s->maxit = maxit;
   total = s->iterations;
   if (st == CVAR_EMAXITER || st == CVAR_ESTALL || st == CVAR_EDIVERGED) {
@@ -780,9 +782,7 @@ static cv_status run_staged(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
     cv_dcopy(M, save + ny, nm);
     int stages = 0; /* stages converged: their path saved */
     for (size_t k = 0; k < neps; k++) {
-      s->stage_start = k > 0 && stages > 0;
-      st = newton_run(s, p, d, Y, M, NULL, eps[k]);
-      s->stage_start = 0;
+      st = newton_run(s, p, d, Y, M, NULL, eps[k], stages > 0);
       total += s->iterations;
       if (!st && eps[k] > 0) {
         cv_dcopy(save, Y, ny), cv_dcopy(save + ny, M, nm), stages++;
@@ -813,6 +813,6 @@ static cv_status run_staged(cv_solver *s, const cv_problem *p, cv_disc *d, doubl
 
 cv_status cv_newton_run(cv_solver *s, const cv_problem *p, cv_disc *d, double *Y, double *M,
                         const cv_homotopy *h) {
-  if (h || !cv_kkt_has_inequalities(p)) return newton_run(s, p, d, Y, M, h, 0.0);
+  if (h || !cv_kkt_has_inequalities(p)) return newton_run(s, p, d, Y, M, h, 0.0, 0);
   return run_staged(s, p, d, Y, M);
 }
